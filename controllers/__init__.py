@@ -1,0 +1,29 @@
+"""Lateral controllers and their registry.
+
+Every controller implements `controllers.base.Controller`; `make_controller(name, geometry)` builds one by its
+registered name and `CONTROLLERS` lists them.
+"""
+
+from __future__ import annotations
+
+from controllers.base import Controller, Measurement
+from controllers.pure_pursuit import PurePursuit, PurePursuitConfig
+from workbench.errors import WorkbenchInputError
+from workbench.vehicles.base import VehicleGeometry
+
+#: name -> controller class, in the order `workbench controllers` lists them.
+CONTROLLERS: dict[str, type[Controller]] = {
+    PurePursuit.name: PurePursuit,
+}
+
+
+def make_controller(name: str, geometry: VehicleGeometry, config: object | None = None) -> Controller:
+    """Build the controller registered under `name` for a vehicle, with its default config unless one is given."""
+    try:
+        cls = CONTROLLERS[name]
+    except KeyError:
+        raise WorkbenchInputError(f"unknown controller {name!r}; choose one of {', '.join(CONTROLLERS)}") from None
+    return cls(geometry, config)
+
+
+__all__ = ["CONTROLLERS", "Controller", "Measurement", "PurePursuit", "PurePursuitConfig", "make_controller"]

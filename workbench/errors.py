@@ -20,7 +20,7 @@ def require_finite(name: str, values: object) -> None:
     bad = ~np.isfinite(arr)
     if bad.any():
         index = int(np.flatnonzero(bad.ravel())[0])
-        raise WorkbenchInputError(f"{name} must be finite numbers; entry {index} is {arr.ravel()[index]!r}")
+        raise WorkbenchInputError(f"{name} must be finite numbers; entry {index} is {float(arr.ravel()[index])!r}")
 
 
 def require_positive(name: str, value: float) -> None:

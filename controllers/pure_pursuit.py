@@ -1,0 +1,67 @@
+"""Pure pursuit (Coulter 1992): steer onto the circular arc through the rear axle and a lookahead point.
+
+The lookahead distance grows with speed, l_d = clip(k v, l_min, l_max). The target is the first path point ahead
+of the foot point at Euclidean distance l_d from the rear-axle centre; when the vehicle is farther than that
+from the path, l_d is raised to |CTE| + l_min so that a target ahead always exists and the approach is at most
+about 45 degrees. Curvature kappa = 2 sin(alpha) / l_d, road-wheel angle tan(phi) = L kappa.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import ClassVar
+
+from controllers.base import Controller, Measurement
+from workbench.errors import WorkbenchInputError, require_positive
+from workbench.path import PathTracker, ReferencePath
+
+
+@dataclass(frozen=True)
+class PurePursuitConfig:
+    """lookahead_gain_s: l_d per unit speed (s); min_lookahead_m, max_lookahead_m: bounds on l_d (m)."""
+
+    lookahead_gain_s: float = 0.8
+    min_lookahead_m: float = 4.0
+    max_lookahead_m: float = 30.0
+
+    def __post_init__(self) -> None:
+        require_positive("lookahead_gain_s", self.lookahead_gain_s)
+        require_positive("min_lookahead_m", self.min_lookahead_m)
+        require_positive("max_lookahead_m", self.max_lookahead_m)
+        if self.max_lookahead_m < self.min_lookahead_m:
+            raise WorkbenchInputError(
+                f"max_lookahead_m ({self.max_lookahead_m}) must be >= min_lookahead_m ({self.min_lookahead_m})"
+            )
+
+
+class PurePursuit(Controller):
+    name: ClassVar[str] = "pure-pursuit"
+    config_type: ClassVar[type] = PurePursuitConfig
+
+    def reset(self, path: ReferencePath) -> None:
+        self._tracker: PathTracker = path.tracker(0.0)
+        self._diag = {"lookahead_m": 0.0, "target_s_m": 0.0, "curvature_cmd_1pm": 0.0}
+
+    def step(self, measurement: Measurement, path: ReferencePath) -> float:
+        cfg = self.config
+        m = measurement
+        foot = self._tracker.update(m.x_m, m.y_m)
+        lookahead = min(max(cfg.lookahead_gain_s * m.speed_mps, cfg.min_lookahead_m), cfg.max_lookahead_m)
+        lookahead = max(lookahead, abs(foot.cte_m) + cfg.min_lookahead_m)
+        target_s = path.s_at_euclidean_distance(foot.s_m, m.x_m, m.y_m, lookahead)
+        tx, ty = path.position(target_s)
+        dx, dy = float(tx) - m.x_m, float(ty) - m.y_m
+        distance = math.hypot(dx, dy)
+        if distance < 1e-6:  # at the very end of an open path: hold the path's curvature
+            curvature = foot.curvature_1pm
+        else:
+            alpha = math.atan2(dy, dx) - m.yaw_rad
+            curvature = 2.0 * math.sin(alpha) / distance
+        self._diag = {"lookahead_m": lookahead, "target_s_m": target_s, "curvature_cmd_1pm": curvature}
+        return self.saturate(self.geometry.steer_wheel_for_curvature(curvature))
+
+    @property
+    def diagnostics(self) -> Mapping[str, float]:
+        return self._diag

@@ -1,0 +1,103 @@
+"""The `workbench` command line: list scenarios, vehicles and controllers; run a closed-loop simulation."""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+from collections.abc import Sequence
+from pathlib import Path
+
+from controllers import CONTROLLERS, make_controller
+from workbench.errors import WorkbenchInputError
+from workbench.scenarios import ScenarioOptions, describe_scenarios, make_scenario
+from workbench.simulator import Simulation, SimulationConfig
+from workbench.vehicles import VEHICLES, make_vehicle
+
+EXIT_INPUT_ERROR = 2
+EXIT_RUN_FAILED = 1
+
+
+def _parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="workbench", description="Design, tune and compare lateral (steering) controllers."
+    )
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+
+    scen = sub.add_parser("scenarios", help="list the named scenarios")
+    scen.add_argument("--track", type=Path, help="Zandvoort track CSV (TUMFTM racetrack-database format)")
+    sub.add_parser("vehicles", help="list the vehicle models")
+    sub.add_parser("controllers", help="list the controllers")
+
+    run = sub.add_parser("run", help="simulate one controller on one vehicle along one scenario")
+    run.add_argument("scenario", help="a scenario name (see `workbench scenarios`) or a waypoint CSV file")
+    run.add_argument("--controller", default="pure-pursuit", help="controller name (default: pure-pursuit)")
+    run.add_argument("--vehicle", default="kinematic-bicycle", help="vehicle model (default: kinematic-bicycle)")
+    run.add_argument("--speed", type=float, default=30.0, metavar="KMH", help="target speed, km/h (default 30)")
+    run.add_argument("--out", type=Path, required=True, metavar="DIR", help="output directory")
+    run.add_argument("--track", type=Path, help="track CSV for the zandvoort scenario")
+    run.add_argument("--laps", type=int, default=1, help="laps of a closed path (default 1)")
+    run.add_argument("--controller-rate-hz", type=float, default=50.0, help="controller rate (default 50 Hz)")
+    run.add_argument("--plant-rate-hz", type=float, default=1000.0, help="plant integration rate (default 1 kHz)")
+    run.add_argument("--lat-accel-g", type=float, default=0.3, help="speed-profile lateral bound (default 0.3 g)")
+    run.add_argument("--no-plots", action="store_true", help="write the trace and metrics only")
+    return parser
+
+
+def _run(args: argparse.Namespace) -> int:
+    vehicle = make_vehicle(args.vehicle)
+    controller = make_controller(args.controller, vehicle.geometry)
+    scenario = make_scenario(
+        args.scenario, ScenarioOptions(vehicle_width_m=vehicle.geometry.width_m, track_file=args.track)
+    )
+    config = SimulationConfig(
+        speed_kmh=args.speed,
+        laps=args.laps,
+        controller_rate_hz=args.controller_rate_hz,
+        plant_rate_hz=args.plant_rate_hz,
+        max_lateral_accel_g=args.lat_accel_g,
+    )
+    result = Simulation(scenario, vehicle, controller, config).run(progress=sys.stderr.isatty())
+    written = result.save(args.out, with_plots=not args.no_plots)
+    m = result.metrics
+
+    def fmt(value: float | None, unit: str) -> str:
+        return "n/a" if value is None or (isinstance(value, float) and math.isnan(value)) else f"{value:.3f} {unit}"
+
+    print(f"{scenario.name}: {controller.name} on {vehicle.name} at {args.speed:g} km/h -> {result.status.value}")
+    print(f"  distance {fmt(m.distance_m, 'm')} of {fmt(m.path_length_m, 'm')}")
+    print(f"  max |CTE| {fmt(m.max_abs_cte_m, 'm')}, RMS CTE {fmt(m.rms_cte_m, 'm')}")
+    print(
+        f"  max |steering-wheel angle| {fmt(m.max_abs_steer_wheel_deg, 'deg')}, "
+        f"max |lateral acceleration| {fmt(m.max_abs_lat_accel_g, 'g')}"
+    )
+    print(f"  controller step median {fmt(m.step_time_median_us, 'us')}, p99 {fmt(m.step_time_p99_us, 'us')}")
+    print(f"  wrote {len(written)} files to {args.out}")
+    if not result.completed:
+        print(f"workbench: run did not complete: {result.message} (partial trace kept in {args.out})", file=sys.stderr)
+        return EXIT_RUN_FAILED
+    return 0
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    args = _parser().parse_args(argv)
+    try:
+        if args.command == "scenarios":
+            for name, description in describe_scenarios(ScenarioOptions(track_file=args.track)):
+                print(f"{name:<12} {description}")
+        elif args.command == "vehicles":
+            for name, factory in VEHICLES.items():
+                print(f"{name:<22} {factory().describe()}")
+        elif args.command == "controllers":
+            for name, cls in CONTROLLERS.items():
+                print(f"{name:<14} {cls.summary()}")
+        else:
+            return _run(args)
+    except WorkbenchInputError as exc:
+        print(f"workbench: error: {exc}", file=sys.stderr)
+        return EXIT_INPUT_ERROR
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

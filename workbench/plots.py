@@ -1,0 +1,95 @@
+"""Plots of one run: trajectory over the reference (with cones), CTE vs distance, steering vs time, speed."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import matplotlib.pyplot as plt
+import numpy as np
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+
+    from workbench.result import SimulationResult
+
+
+def _axes(ax: Axes | None) -> Axes:
+    if ax is None:
+        _, ax = plt.subplots(figsize=(8, 4.5), layout="constrained")
+    return ax
+
+
+def _label(result: SimulationResult) -> str:
+    return f"{result.controller} on {result.vehicle}"
+
+
+def _distance(result: SimulationResult) -> np.ndarray:
+    return result.trace["progress_m"]
+
+
+def trajectory(result: SimulationResult, ax: Axes | None = None) -> Axes:
+    ax = _axes(ax)
+    path = result.path
+    ax.plot(path.x_m, path.y_m, "k--", lw=1.0, label="reference")
+    ax.plot(result.trace["x_m"], result.trace["y_m"], lw=1.5, label=f"{_label(result)} (rear axle)")
+    if "trailer_x_m" in result.trace:
+        ax.plot(result.trace["trailer_x_m"], result.trace["trailer_y_m"], lw=1.0, alpha=0.7, label="trailer rear axle")
+    cones = result.scenario.cones_xy
+    if cones is not None:
+        ax.plot(cones[:, 0], cones[:, 1], "^", color="tab:orange", ms=5, label="cones")
+    ax.set(xlabel="x (m)", ylabel="y (m)", title=f"{result.scenario.name}: tracked trajectory")
+    width, height = np.ptp(path.x_m), np.ptp(path.y_m)
+    if min(width, height) > 0.25 * max(width, height):  # true shape unless the path is long and thin (a DLC)
+        ax.set_aspect("equal", adjustable="datalim")
+    ax.legend(loc="best", fontsize="small")
+    return ax
+
+
+def cte_vs_distance(result: SimulationResult, ax: Axes | None = None) -> Axes:
+    ax = _axes(ax)
+    ax.plot(_distance(result), result.trace["cte_m"], label=_label(result))
+    ax.axhline(0.0, color="k", lw=0.5)
+    ax.set(xlabel="distance along path (m)", ylabel="cross-track error (m)", title="CTE at the rear-axle centre")
+    ax.legend(loc="best", fontsize="small")
+    return ax
+
+
+def steering_vs_time(result: SimulationResult, ax: Axes | None = None) -> Axes:
+    ax = _axes(ax)
+    t = result.trace["t_s"]
+    ax.plot(t, np.degrees(result.trace["steer_wheel_cmd_rad"]), lw=1.0, label="command")
+    ax.plot(t, np.degrees(result.trace["steer_wheel_rad"]), lw=1.5, label="measured")
+    ax.set(xlabel="time (s)", ylabel="steering-wheel angle (deg)", title=f"Steering: {_label(result)}")
+    ax.legend(loc="best", fontsize="small")
+    return ax
+
+
+def speed_vs_distance(result: SimulationResult, ax: Axes | None = None) -> Axes:
+    ax = _axes(ax)
+    d = _distance(result)
+    ax.plot(d, result.trace["speed_ref_mps"] * 3.6, "k--", lw=1.0, label="planned")
+    ax.plot(d, result.trace["speed_mps"] * 3.6, lw=1.5, label="actual")
+    ax.set(xlabel="distance along path (m)", ylabel="speed (km/h)", title="Speed")
+    ax.legend(loc="best", fontsize="small")
+    return ax
+
+
+RUN_PLOTS = {
+    "trajectory.png": trajectory,
+    "cte_vs_distance.png": cte_vs_distance,
+    "steering_vs_time.png": steering_vs_time,
+    "speed_vs_distance.png": speed_vs_distance,
+}
+
+
+def save_run_plots(result: SimulationResult, out_dir: Path) -> list[Path]:
+    """Write the four standard plots of a run as PNG files in out_dir."""
+    written = []
+    for filename, draw in RUN_PLOTS.items():
+        ax = draw(result, None)
+        path = out_dir / filename
+        ax.figure.savefig(path, dpi=120)
+        plt.close(ax.figure)
+        written.append(path)
+    return written

@@ -1,0 +1,257 @@
+"""Closed-loop simulation: a controller steering a plant along a scenario's path at a planned speed.
+
+Fixed steps: the controller (and the PI speed controller) run at `controller_rate_hz`; between two controller
+steps the plant integrates `plant_rate_hz / controller_rate_hz` RK4 steps with the commands held (zero-order
+hold). One row of the trace is logged per controller step. The run ends when the vehicle reaches the end of an
+open path or completes the requested laps of a closed one; it stops early, keeping its partial trace and saying
+why, on a time-out, when the vehicle leaves the path by more than `max_abs_cte_m`, when the plant state stops
+being finite, or when the controller fails.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+from tqdm import tqdm
+
+from controllers.base import Controller, Measurement
+from workbench.errors import WorkbenchInputError, require_in_range, require_positive
+from workbench.path import ReferencePath, wrap_angle
+from workbench.result import SimulationResult, Status
+from workbench.scenarios import Scenario
+from workbench.speed_control import PISpeedController, PISpeedGains
+from workbench.speed_profile import G_MPS2, SpeedLimits, plan_speed_profile
+from workbench.vehicles.base import VehicleModel
+
+#: Spacing (m) of the points the speed profile is planned on (the paper plans on its waypoints).
+SPEED_PLAN_SPACING_M = 1.0
+
+
+@dataclass(frozen=True)
+class SimulationConfig:
+    """How a run is simulated.
+
+    speed_kmh: the speed asked for (km/h), the maximum of the planned profile; max_lateral_accel_g: the profile's
+    lateral acceleration bound (the paper: 0.3 g); max_accel_mps2, max_decel_mps2: its longitudinal bounds;
+    controller_rate_hz, plant_rate_hz: step rates (the plant rate must be a whole multiple); laps: laps of a
+    closed path; max_time_s: time-out (None: three times the planned lap time plus 30 s); max_abs_cte_m: a run
+    whose |CTE| exceeds this has left the path and stops.
+    """
+
+    speed_kmh: float = 30.0
+    max_lateral_accel_g: float = 0.3
+    max_accel_mps2: float = 1.0
+    max_decel_mps2: float = 2.0
+    controller_rate_hz: float = 50.0
+    plant_rate_hz: float = 1000.0
+    laps: int = 1
+    max_time_s: float | None = None
+    max_abs_cte_m: float = 30.0
+
+    def __post_init__(self) -> None:
+        require_in_range("speed_kmh", self.speed_kmh, 1e-3, 400.0, "km/h (must be > 0)")
+        require_in_range("max_lateral_accel_g", self.max_lateral_accel_g, 0.01, 2.0, "g")
+        require_positive("max_accel_mps2", self.max_accel_mps2)
+        require_positive("max_decel_mps2", self.max_decel_mps2)
+        require_in_range("controller_rate_hz", self.controller_rate_hz, 1.0, 10_000.0, "Hz")
+        require_in_range("plant_rate_hz", self.plant_rate_hz, 1.0, 100_000.0, "Hz")
+        ratio = self.plant_rate_hz / self.controller_rate_hz
+        if ratio < 1 or abs(ratio - round(ratio)) > 1e-9:
+            raise WorkbenchInputError(
+                f"plant_rate_hz ({self.plant_rate_hz}) must be a whole multiple of controller_rate_hz "
+                f"({self.controller_rate_hz}); the ratio is {ratio:g}"
+            )
+        if isinstance(self.laps, bool) or not isinstance(self.laps, int) or self.laps < 1:
+            raise WorkbenchInputError(f"laps must be a whole number >= 1; got {self.laps!r}")
+        if self.max_time_s is not None:
+            require_positive("max_time_s", self.max_time_s)
+        require_positive("max_abs_cte_m", self.max_abs_cte_m)
+
+    @property
+    def substeps(self) -> int:
+        return round(self.plant_rate_hz / self.controller_rate_hz)
+
+    @property
+    def speed_mps(self) -> float:
+        return self.speed_kmh / 3.6
+
+
+def plan_path_speed(path: ReferencePath, config: SimulationConfig) -> ReferencePath:
+    """The path carrying the planned speed: the paper's smart velocity waypoints (section 6), capped by any speed
+    the path's waypoints already carry."""
+    n = max(3, math.ceil(path.length_m / SPEED_PLAN_SPACING_M))
+    s_plan = np.linspace(0.0, path.length_m, n + 1)
+    if path.closed:
+        s_plan = s_plan[:-1]
+    x, y = path.position(s_plan)
+    limits = SpeedLimits(
+        max_speed_mps=config.speed_mps,
+        max_lateral_accel_mps2=config.max_lateral_accel_g * G_MPS2,
+        max_accel_mps2=config.max_accel_mps2,
+        max_decel_mps2=config.max_decel_mps2,
+        min_speed_mps=min(1.0, config.speed_mps),
+    )
+    profile = plan_speed_profile(x, y, limits, closed=path.closed)
+    planned = profile.speed_mps
+    if path.closed:  # close the loop for interpolation
+        s_plan, planned = np.append(s_plan, path.length_m), np.append(planned, planned[0])
+    speed = np.interp(path.s_m, s_plan, planned)
+    if path.speed_mps is not None:
+        speed = np.minimum(speed, path.speed_mps)
+    return path.with_speed(speed)
+
+
+class Simulation:
+    """A scenario, a vehicle and a controller, wired once; `run()` simulates and returns a SimulationResult."""
+
+    def __init__(
+        self,
+        scenario: Scenario,
+        vehicle: VehicleModel,
+        controller: Controller,
+        config: SimulationConfig | None = None,
+    ) -> None:
+        self.scenario = scenario
+        self.vehicle = vehicle
+        self.controller = controller
+        self.config = config or SimulationConfig()
+        self.path = plan_path_speed(scenario.path, self.config)
+
+    def run(self, progress: bool = False) -> SimulationResult:
+        cfg, path, vehicle, controller = self.config, self.path, self.vehicle, self.controller
+        dt = 1.0 / cfg.controller_rate_hz
+        total_length = path.length_m * (cfg.laps if path.closed else 1)
+        mean_speed = float(np.mean(path.speed_mps))
+        max_time = cfg.max_time_s or 3.0 * total_length / mean_speed + 30.0
+        max_steps = math.ceil(max_time / dt) + 1
+
+        x0, y0, yaw0 = self.scenario.initial_pose()
+        state = vehicle.initial_state(x0, y0, yaw0, float(path.speed_mps[0]))
+        tracker = path.tracker(0.0)
+        controller.reset(path)
+        speed_controller = PISpeedController(PISpeedGains())
+
+        log = _TraceLog(vehicle.output_names, max_steps)
+        status, message = Status.TIMEOUT, f"did not finish within {max_time:.1f} s"
+        steer_cmd = accel_cmd = 0.0
+        bar = tqdm(total=round(total_length), unit="m", delay=2.0, disable=not progress, leave=False)
+        t = 0.0
+        for _ in range(max_steps):
+            out = vehicle.outputs(state, steer_cmd, accel_cmd)
+            x, y, yaw, vx, vy, yaw_rate, steer_wheel = out[:7]
+            foot = tracker.update(x, y)
+            if abs(foot.cte_m) > cfg.max_abs_cte_m:
+                status = Status.LEFT_PATH
+                message = (
+                    f"|CTE| = {abs(foot.cte_m):.1f} m exceeds max_abs_cte_m = {cfg.max_abs_cte_m} m at t = {t:.2f} s"
+                )
+                break
+            if (foot.at_end and not path.closed) or foot.progress_m >= total_length:
+                status, message = Status.COMPLETED, "completed"
+                break
+            measurement = Measurement(t, x, y, vx, vy, yaw, yaw_rate, steer_wheel)
+            start = time.perf_counter()
+            try:
+                steer_cmd = controller.step(measurement, path)
+            except Exception as exc:  # reported in the result, never hidden
+                status, message = Status.CONTROLLER_FAILED, f"{controller.name} raised {type(exc).__name__}: {exc}"
+                break
+            step_time = time.perf_counter() - start
+            if not math.isfinite(steer_cmd):
+                status = Status.CONTROLLER_FAILED
+                message = f"{controller.name} returned a non-finite steering command ({steer_cmd}) at t = {t:.2f} s"
+                break
+            speed = math.hypot(vx, vy)
+            speed_ref = float(path.speed(foot.s_m))
+            accel_cmd = speed_controller.step(speed_ref, speed, dt)
+            log.append(
+                t,
+                out,
+                steer_cmd,
+                accel_cmd,
+                speed,
+                speed_ref,
+                foot,
+                float(wrap_angle(yaw - foot.heading_rad)),
+                step_time,
+                controller.diagnostics,
+            )
+            state = vehicle.advance(state, steer_cmd, accel_cmd, dt, cfg.substeps)
+            t += dt
+            if not np.all(np.isfinite(state)):
+                bad = [n for n, v in zip(vehicle.state_names, state, strict=False) if not math.isfinite(v)]
+                status = Status.DIVERGED
+                message = f"the {vehicle.name} state diverged at t = {t:.2f} s (non-finite: {', '.join(bad)})"
+                break
+            bar.update(round(foot.progress_m) - bar.n)
+        bar.close()
+        return SimulationResult(
+            trace=log.to_dict(),
+            status=status,
+            message=message,
+            scenario=self.scenario,
+            path=path,
+            controller=controller.name,
+            vehicle=vehicle.name,
+            config=cfg,
+        )
+
+
+class _TraceLog:
+    """Preallocated columns for the trace, one row per controller step."""
+
+    def __init__(self, output_names: tuple[str, ...], capacity: int) -> None:
+        self.output_names = output_names
+        self.outputs = np.empty((capacity, len(output_names)))
+        self.signals = np.empty((capacity, 11))
+        self.diagnostics: dict[str, np.ndarray] = {}
+        self.capacity = capacity
+        self.n = 0
+
+    SIGNALS = (
+        "t_s",
+        "steer_wheel_cmd_rad",
+        "accel_cmd_mps2",
+        "speed_mps",
+        "speed_ref_mps",
+        "path_s_m",
+        "progress_m",
+        "cte_m",
+        "heading_error_rad",
+        "path_curvature_1pm",
+        "step_time_s",
+    )
+
+    def append(self, t, out, steer_cmd, accel_cmd, speed, speed_ref, foot, heading_error, step_time, diagnostics):
+        i = self.n
+        self.outputs[i] = out
+        self.signals[i] = (
+            t,
+            steer_cmd,
+            accel_cmd,
+            speed,
+            speed_ref,
+            foot.s_m,
+            foot.progress_m,
+            foot.cte_m,
+            heading_error,
+            foot.curvature_1pm,
+            step_time,
+        )
+        for key, value in diagnostics.items():
+            column = self.diagnostics.get(key)
+            if column is None:
+                column = self.diagnostics[key] = np.full(self.capacity, np.nan)
+            column[i] = value
+        self.n += 1
+
+    def to_dict(self) -> dict[str, np.ndarray]:
+        n = self.n
+        trace = {"t_s": self.signals[:n, 0].copy()}
+        trace.update({name: self.outputs[:n, k].copy() for k, name in enumerate(self.output_names)})
+        trace.update({name: self.signals[:n, k].copy() for k, name in enumerate(self.SIGNALS) if k > 0})
+        trace.update({f"ctrl_{key}": col[:n].copy() for key, col in self.diagnostics.items()})
+        return trace

@@ -1,0 +1,119 @@
+"""Kinematic bicycle with a first-order, rate-limited steering actuator, referenced at the rear-axle centre.
+
+States: x_m, y_m (rear-axle centre), yaw_rad, speed_mps, road_wheel_angle_rad.
+    x' = v cos(yaw), y' = v sin(yaw), yaw' = v tan(delta) / L,
+    v' = a (v stays >= 0), delta' = clip((delta_cmd - delta) / tau, +-rate_max), delta_cmd = clip(sw_cmd / i_s).
+No tyre slip: the path curvature follows the road-wheel angle exactly (tan(delta) = L kappa), so this plant shows
+none of the lag of the paper's section 5. It is the reference the dynamic models must approach at low speed.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import ClassVar
+
+import numpy as np
+from numba import njit
+
+from workbench.errors import require_in_range, require_positive
+from workbench.vehicles.base import VehicleGeometry, VehicleModel
+
+
+@dataclass(frozen=True)
+class KinematicBicycleParams:
+    """Parameters; defaults describe a C-class car (CommonRoad vehicle 2, a BMW 320i, from
+    commonroad-vehicle-models `parameters_vehicle2`: a + b = 1.156 + 1.423 m, width 1.61 m, road-wheel angle
+    limit 1.066 rad, road-wheel rate limit 0.4 rad/s).
+    """
+
+    wheelbase_m: float = 2.578  # CommonRoad vehicle 2: a + b
+    width_m: float = 1.61  # CommonRoad vehicle 2: w
+    steering_ratio: float = 15.0  # assumed: typical passenger-car rack (14-16:1); CommonRoad gives none
+    max_road_wheel_angle_rad: float = 1.066  # CommonRoad vehicle 2: steering.max
+    max_road_wheel_rate_rad_s: float = 0.4  # CommonRoad vehicle 2: steering.v_max
+    steering_time_constant_s: float = 0.05  # assumed: electric power-steering position loop
+    max_accel_mps2: float = 3.0  # assumed comfort limit (CommonRoad's 11.5 m/s^2 is the tyre limit)
+    max_decel_mps2: float = 8.0  # assumed: about 0.8 g braking
+
+    def __post_init__(self) -> None:
+        require_in_range("wheelbase_m", self.wheelbase_m, 0.5, 15.0, "m")
+        require_in_range("width_m", self.width_m, 0.5, 4.0, "m")
+        require_in_range("steering_ratio", self.steering_ratio, 1.0, 60.0)
+        require_in_range("max_road_wheel_angle_rad", self.max_road_wheel_angle_rad, 0.01, 1.5, "rad")
+        require_positive("max_road_wheel_rate_rad_s", self.max_road_wheel_rate_rad_s)
+        require_in_range("steering_time_constant_s", self.steering_time_constant_s, 1e-3, 2.0, "s")
+        require_positive("max_accel_mps2", self.max_accel_mps2)
+        require_positive("max_decel_mps2", self.max_decel_mps2)
+
+
+@njit(cache=True)
+def _derivatives(state, p, delta_cmd, accel):  # pragma: no cover - compiled
+    yaw, v, delta = state[2], state[3], state[4]
+    out = np.empty(5)
+    out[0] = v * math.cos(yaw)
+    out[1] = v * math.sin(yaw)
+    out[2] = v * math.tan(delta) / p[0]
+    out[3] = 0.0 if (v <= 0.0 and accel < 0.0) else accel
+    rate = (delta_cmd - delta) / p[3]
+    out[4] = min(max(rate, -p[2]), p[2])
+    return out
+
+
+@njit(cache=True)
+def _rk4(state, p, delta_cmd, accel, h, n):  # pragma: no cover - compiled
+    s = state.copy()
+    for _ in range(n):
+        k1 = _derivatives(s, p, delta_cmd, accel)
+        k2 = _derivatives(s + 0.5 * h * k1, p, delta_cmd, accel)
+        k3 = _derivatives(s + 0.5 * h * k2, p, delta_cmd, accel)
+        k4 = _derivatives(s + h * k3, p, delta_cmd, accel)
+        s = s + h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+        if s[3] < 0.0:
+            s[3] = 0.0
+    return s
+
+
+class KinematicBicycle(VehicleModel):
+    name: ClassVar[str] = "kinematic-bicycle"
+    state_names: ClassVar[tuple[str, ...]] = ("x_m", "y_m", "yaw_rad", "speed_mps", "road_wheel_angle_rad")
+
+    def __init__(self, params: KinematicBicycleParams | None = None) -> None:
+        self.params = params or KinematicBicycleParams()
+        p = self.params
+        self._p = np.array(
+            [p.wheelbase_m, p.max_road_wheel_angle_rad, p.max_road_wheel_rate_rad_s, p.steering_time_constant_s]
+        )
+        self._geometry = VehicleGeometry(
+            wheelbase_m=p.wheelbase_m,
+            steering_ratio=p.steering_ratio,
+            max_road_wheel_angle_rad=p.max_road_wheel_angle_rad,
+            max_steer_wheel_rate_rad_s=p.max_road_wheel_rate_rad_s * p.steering_ratio,
+            width_m=p.width_m,
+        )
+
+    @property
+    def geometry(self) -> VehicleGeometry:
+        return self._geometry
+
+    def initial_state(self, x_m: float, y_m: float, yaw_rad: float, speed_mps: float) -> np.ndarray:
+        return np.array([x_m, y_m, yaw_rad, speed_mps, 0.0], dtype=float)
+
+    def _inputs(self, steer_wheel_cmd_rad: float, accel_cmd_mps2: float) -> tuple[float, float]:
+        p = self.params
+        delta_cmd = min(
+            max(steer_wheel_cmd_rad / p.steering_ratio, -p.max_road_wheel_angle_rad), p.max_road_wheel_angle_rad
+        )
+        accel = min(max(accel_cmd_mps2, -p.max_decel_mps2), p.max_accel_mps2)
+        return delta_cmd, accel
+
+    def advance(
+        self, state: np.ndarray, steer_wheel_cmd_rad: float, accel_cmd_mps2: float, dt_s: float, substeps: int
+    ) -> np.ndarray:
+        delta_cmd, accel = self._inputs(steer_wheel_cmd_rad, accel_cmd_mps2)
+        return _rk4(state, self._p, delta_cmd, accel, dt_s / substeps, substeps)
+
+    def outputs(self, state: np.ndarray, steer_wheel_cmd_rad: float, accel_cmd_mps2: float) -> np.ndarray:
+        x, y, yaw, v, delta = state
+        yaw_rate = v * math.tan(delta) / self.params.wheelbase_m
+        return np.array([x, y, yaw, v, 0.0, yaw_rate, delta * self.params.steering_ratio, delta, v * yaw_rate])
