@@ -1,0 +1,93 @@
+"""The workbench CLI: listing, a full run's files, and clear errors with exit code 2 for bad input."""
+
+from __future__ import annotations
+
+import json
+import shutil
+import subprocess
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from workbench.cli import main
+from workbench.metrics import METRIC_KEYS
+
+
+def test_scenarios_lists_every_named_scenario(capsys: pytest.CaptureFixture[str], monkeypatch) -> None:
+    monkeypatch.delenv("WORKBENCH_ZANDVOORT_CSV", raising=False)
+    assert main(["scenarios"]) == 0
+    out = capsys.readouterr().out
+    for name in ("figure8", "dlc", "fig17", "zandvoort"):
+        assert name in out
+    assert "download" in out  # zandvoort says where to get its file
+
+
+def test_run_dlc_writes_trace_metrics_and_plots(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    out = tmp_path / "dlc"
+    args = ["run", "dlc", "--controller", "pure-pursuit", "--vehicle", "kinematic-bicycle", "--out", str(out)]
+    assert main(args) == 0
+    metrics = json.loads((out / "metrics.json").read_text())
+    assert tuple(metrics)[: len(METRIC_KEYS)] == METRIC_KEYS
+    assert metrics["scenario"] == "dlc" and metrics["completed"] is True
+    assert metrics["max_ltr"] is None and metrics["max_offtracking_m"] is None
+    assert 0 < metrics["max_abs_cte_m"] < 0.3
+    trace = pd.read_parquet(out / "trace.parquet")
+    for column in ("t_s", "x_m", "y_m", "cte_m", "steer_wheel_rad", "speed_mps", "lat_accel_mps2", "step_time_s"):
+        assert column in trace.columns
+    assert np.isfinite(trace.select_dtypes("number").to_numpy()).all()
+    assert trace["cte_m"].abs().max() == pytest.approx(metrics["max_abs_cte_m"])
+    for png in ("trajectory.png", "cte_vs_distance.png", "steering_vs_time.png", "speed_vs_distance.png"):
+        assert (out / png).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert "completed" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize(
+    ("args", "needle"),
+    [
+        (["run", "nowhere", "--out", "X"], "unknown scenario 'nowhere'"),
+        (["run", "dlc", "--controller", "magic", "--out", "X"], "unknown controller 'magic'"),
+        (["run", "dlc", "--vehicle", "hovercraft", "--out", "X"], "unknown vehicle 'hovercraft'"),
+        (["run", "dlc", "--speed", "0", "--out", "X"], "speed_kmh"),
+        (["run", "dlc", "--speed", "-10", "--out", "X"], "speed_kmh"),
+        (["run", "dlc", "--speed", "nan", "--out", "X"], "speed_kmh"),
+        (["run", "missing.csv", "--out", "X"], "does not exist"),
+    ],
+)
+def test_bad_input_exits_2_with_a_message(args: list[str], needle: str, capsys, tmp_path: Path) -> None:
+    args = [a if a != "X" else str(tmp_path / "out") for a in args]
+    assert main(args) == 2
+    err = capsys.readouterr().err
+    assert needle in err
+    assert "Traceback" not in err
+
+
+@pytest.mark.parametrize(
+    ("content", "needle"),
+    [
+        ("a,b\n1,2\n3,4\n5,6\n", "x"),
+        ("x,y\n0,0\n1,nan\n2,0\n", "nan"),
+        ("x,y\n0,0\n1,1\n", "at least 3"),
+        ("x,y\n0,0\n0,0\n1,1\n", "repeat"),
+    ],
+)
+def test_malformed_waypoint_file_exits_2(content: str, needle: str, tmp_path: Path, capsys) -> None:
+    path = tmp_path / "bad.csv"
+    path.write_text(content)
+    assert main(["run", str(path), "--out", str(tmp_path / "out")]) == 2
+    assert needle in capsys.readouterr().err.lower()
+
+
+def test_waypoint_csv_runs_as_a_scenario(tmp_path: Path) -> None:
+    s = np.linspace(0, 80, 41)
+    pd.DataFrame({"x": s, "y": 2.0 * np.sin(s / 15.0)}).to_csv(tmp_path / "wiggle.csv", index=False)
+    assert main(["run", str(tmp_path / "wiggle.csv"), "--out", str(tmp_path / "o"), "--no-plots"]) == 0
+    assert json.loads((tmp_path / "o" / "metrics.json").read_text())["completed"] is True
+
+
+@pytest.mark.skipif(shutil.which("workbench") is None, reason="console script not installed (pip install -e .)")
+def test_console_script_is_installed() -> None:
+    done = subprocess.run(["workbench", "scenarios"], capture_output=True, text=True, check=False, timeout=120)
+    assert done.returncode == 0, done.stderr
+    assert "fig17" in done.stdout

@@ -1,0 +1,167 @@
+"""Closed-loop simulator: termination, laps, failures reported with partial traces, physics sanity."""
+
+from __future__ import annotations
+
+import math
+from typing import ClassVar
+
+import numpy as np
+import pytest
+
+from controllers import PurePursuit
+from controllers.base import Controller, Measurement
+from workbench.clothoid_chain import ClothoidChain
+from workbench.errors import WorkbenchInputError
+from workbench.path import ReferencePath
+from workbench.result import Status
+from workbench.scenarios import Scenario, make_scenario
+from workbench.simulator import Simulation, SimulationConfig
+from workbench.speed_profile import G_MPS2
+from workbench.vehicles import KinematicBicycle
+
+
+def _scenario(path: ReferencePath, offset: float = 0.0, heading_error: float = 0.0) -> Scenario:
+    return Scenario(path.name, path, "test", initial_offset_m=offset, initial_heading_error_rad=heading_error)
+
+
+def _circle(radius: float = 25.0) -> ReferencePath:
+    return ClothoidChain(curvature_1pm=1.0 / radius).arc(2 * math.pi * radius).to_path("circle", closed=True)
+
+
+def _run(scenario: Scenario, config: SimulationConfig | None = None, controller: Controller | None = None):
+    vehicle = KinematicBicycle()
+    controller = controller or PurePursuit(vehicle.geometry)
+    return Simulation(scenario, vehicle, controller, config or SimulationConfig()).run()
+
+
+def test_straight_on_path_stays_on_path() -> None:
+    result = _run(_scenario(ClothoidChain().straight(100.0).to_path("straight")))
+    assert result.status is Status.COMPLETED
+    assert result.metrics.max_abs_cte_m < 1e-9
+    assert result.metrics.max_abs_steer_wheel_deg < 1e-6
+    # The run ends at the end of the path, within one controller step of travel.
+    assert result.trace["progress_m"][-1] == pytest.approx(100.0, abs=8.34 / 50 + 1e-6)
+
+
+def test_ten_metres_off_the_path_still_runs_and_converges() -> None:
+    result = _run(_scenario(ClothoidChain().straight(200.0).to_path("straight"), offset=10.0))
+    assert result.status is Status.COMPLETED
+    assert result.trace["cte_m"][0] == pytest.approx(10.0, abs=1e-9)
+    assert abs(result.trace["cte_m"][-1]) < 0.05
+
+
+def test_closed_loop_runs_the_requested_laps() -> None:
+    path = _circle(30.0)
+    result = _run(_scenario(path), SimulationConfig(speed_kmh=30.0, laps=2))
+    assert result.status is Status.COMPLETED
+    assert result.trace["progress_m"][-1] == pytest.approx(2 * path.length_m, abs=0.5)
+    assert result.metrics.path_length_m == pytest.approx(2 * path.length_m)
+    assert result.metrics.distance_m == pytest.approx(2 * path.length_m, rel=0.01)
+
+
+def test_steady_cornering_matches_v2_over_r_and_the_speed_profile_bound() -> None:
+    radius = 25.0
+    result = _run(_scenario(_circle(radius)), SimulationConfig(speed_kmh=60.0))
+    v_bound = math.sqrt(0.3 * G_MPS2 * radius)  # the profile's lateral limit, below 60 km/h
+    trace = result.trace
+    late = trace["t_s"] > trace["t_s"][-1] / 2
+    assert np.all(trace["speed_ref_mps"] <= v_bound * 1.01)
+    assert np.median(trace["speed_mps"][late]) == pytest.approx(v_bound, rel=0.02)
+    lat = trace["lat_accel_mps2"][late]
+    v = trace["speed_mps"][late]
+    # Kinematic bicycle in steady cornering: a_y = v^2 kappa, with kappa the realised path curvature ~ 1/R.
+    assert np.median(lat) == pytest.approx(np.median(v**2) / radius, rel=0.02)
+    # Once the start-up transient (wheels straight on a curve) is over, the 0.3 g bound holds.
+    assert np.max(np.abs(lat)) <= 0.3 * G_MPS2 * 1.03
+
+
+def test_plant_rate_convergence() -> None:
+    """RK4 at 1 kHz and 4 kHz give the same closed-loop trace (integration error far below the CTE)."""
+    scenario = make_scenario("fig17")
+    a = _run(scenario, SimulationConfig(plant_rate_hz=1000.0))
+    b = _run(scenario, SimulationConfig(plant_rate_hz=4000.0))
+    n = min(a.trace["t_s"].size, b.trace["t_s"].size)
+    assert np.max(np.abs(a.trace["cte_m"][:n] - b.trace["cte_m"][:n])) < 1e-6
+
+
+def test_every_step_is_timed() -> None:
+    result = _run(make_scenario("fig17"))
+    assert np.all(result.trace["step_time_s"] > 0)
+    assert 0 < result.metrics.step_time_median_us <= result.metrics.step_time_p99_us
+
+
+class _Failing(Controller):
+    name: ClassVar[str] = "failing"
+    config_type: ClassVar[type] = dict
+
+    def __init__(self, geometry, mode: str, after: int = 20) -> None:
+        super().__init__(geometry, {})
+        self.mode, self.after = mode, after
+
+    def reset(self, path: ReferencePath) -> None:
+        self.n = 0
+
+    def step(self, measurement: Measurement, path: ReferencePath) -> float:
+        self.n += 1
+        if self.n > self.after:
+            if self.mode == "nan":
+                return float("nan")
+            raise RuntimeError("solver exploded")
+        return 0.0
+
+
+@pytest.mark.parametrize(
+    ("mode", "needle"), [("nan", "non-finite steering"), ("raise", "RuntimeError: solver exploded")]
+)
+def test_controller_failure_is_reported_and_the_partial_trace_kept(mode: str, needle: str) -> None:
+    vehicle = KinematicBicycle()
+    scenario = _scenario(ClothoidChain().straight(100.0).to_path("straight"))
+    result = Simulation(scenario, vehicle, _Failing(vehicle.geometry, mode)).run()
+    assert result.status is Status.CONTROLLER_FAILED
+    assert needle in result.message
+    assert result.trace["t_s"].size == 20
+    assert result.metrics.completed is False
+
+
+class _Diverging(KinematicBicycle):
+    def advance(self, state, steer, accel, dt, substeps):
+        new = super().advance(state, steer, accel, dt, substeps)
+        if new[0] > 30.0:
+            new[2] = np.nan
+        return new
+
+
+def test_diverging_plant_stops_with_a_clear_message_and_keeps_the_trace() -> None:
+    vehicle = _Diverging()
+    scenario = _scenario(ClothoidChain().straight(100.0).to_path("straight"))
+    result = Simulation(scenario, vehicle, PurePursuit(vehicle.geometry)).run()
+    assert result.status is Status.DIVERGED
+    assert "yaw_rad" in result.message
+    assert result.trace["x_m"][-1] == pytest.approx(30.0, abs=0.2)
+    assert np.all(np.isfinite(result.to_pandas().drop(columns=["ctrl_lookahead_m"]).to_numpy()))
+
+
+def test_leaving_the_path_stops_the_run() -> None:
+    vehicle = KinematicBicycle()
+    scenario = _scenario(ClothoidChain().straight(300.0).to_path("straight"), heading_error=math.radians(60))
+    result = Simulation(
+        scenario, vehicle, _Failing(vehicle.geometry, "nan", after=10**9), SimulationConfig(max_abs_cte_m=5.0)
+    ).run()
+    assert result.status is Status.LEFT_PATH
+    assert "max_abs_cte_m = 5.0" in result.message
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "needle"),
+    [
+        ({"speed_kmh": 0.0}, "speed_kmh"),
+        ({"speed_kmh": -5.0}, "speed_kmh"),
+        ({"speed_kmh": float("nan")}, "speed_kmh"),
+        ({"plant_rate_hz": 1010.0}, "whole multiple"),
+        ({"laps": 0}, "laps"),
+        ({"max_lateral_accel_g": 0.0}, "max_lateral_accel_g"),
+    ],
+)
+def test_bad_configuration_is_rejected(kwargs: dict, needle: str) -> None:
+    with pytest.raises(WorkbenchInputError, match=needle):
+        SimulationConfig(**kwargs)
