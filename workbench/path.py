@@ -21,6 +21,7 @@ import numpy as np
 from scipy.interpolate import BSpline, make_interp_spline
 
 from workbench.errors import WorkbenchInputError, require_positive
+from workbench.path_search import closest_in_window, first_beyond, windowed_projection
 from workbench.waypoints import Waypoints
 
 #: Default spacing of the path's samples along s (m). Linear interpolation between samples is then exact to
@@ -118,7 +119,6 @@ class ReferencePath:
         # Segment geometry for projections, computed once.
         self._seg_dx = np.diff(self.x_m)
         self._seg_dy = np.diff(self.y_m)
-        self._seg_len2 = self._seg_dx**2 + self._seg_dy**2
 
     # ------------------------------------------------------------------ construction
     @classmethod
@@ -214,47 +214,19 @@ class ReferencePath:
         Searches forward along the path (at most one lap of a loop); interpolates between samples. Returns the end
         of an open path when no point ahead is that far away.
         """
-        ds = self.spacing_m
-        start = int(self.wrap_s(s_from_m) // ds)
-        n_seg = self.x_m.size - 1
-        limit = n_seg if self.closed else n_seg - start
-        chunk = max(16, int(2.0 * distance_m / ds) + 2)
-        offset = 0
-        while offset < limit:
-            idx = start + np.arange(offset, min(offset + chunk, limit) + 1)
-            if self.closed:
-                idx %= n_seg
-            d = np.hypot(self.x_m[idx] - x_m, self.y_m[idx] - y_m)
-            hit = np.flatnonzero(d >= distance_m)
-            if hit.size:
-                k = int(hit[0])
-                if k == 0:
-                    return float(self.wrap_s(s_from_m))
-                d0, d1 = d[k - 1], d[k]
-                frac = (distance_m - d0) / (d1 - d0) if d1 > d0 else 1.0
-                return float(self.wrap_s((start + offset + k - 1 + frac) * ds))
-            offset += chunk
-        return self.length_m if not self.closed else float(self.wrap_s(s_from_m))
+        s_from = float(self.wrap_s(s_from_m))
+        index = first_beyond(
+            self.x_m, self.y_m, float(x_m), float(y_m), s_from / self.spacing_m, float(distance_m), self.closed
+        )
+        if index < 0.0:  # no point ahead is that far: the end of an open path
+            return self.length_m if not self.closed else s_from
+        return min(index * self.spacing_m, self.length_m)
 
     # ------------------------------------------------------------------ projection
-    def closest_on_segments(self, x_m: float, y_m: float, seg: np.ndarray) -> tuple[int, float, float]:
-        """Closest point among the given segment indices: (position in `seg`, parameter t in [0, 1], distance^2)."""
-        ax = self.x_m[seg]
-        ay = self.y_m[seg]
-        dx = self._seg_dx[seg]
-        dy = self._seg_dy[seg]
-        t = np.clip(((x_m - ax) * dx + (y_m - ay) * dy) / self._seg_len2[seg], 0.0, 1.0)
-        ex = ax + t * dx - x_m
-        ey = ay + t * dy - y_m
-        d2 = ex * ex + ey * ey
-        k = int(np.argmin(d2))
-        return k, float(t[k]), float(d2[k])
-
     def project_global(self, x_m: float, y_m: float) -> float:
         """Arc length of the closest point over the whole path (no progress tracking; ambiguous at crossings)."""
-        seg = np.arange(self.x_m.size - 1)
-        k, t, _ = self.closest_on_segments(x_m, y_m, seg)
-        return float((seg[k] + t) * self.spacing_m)
+        j, t, _ = closest_in_window(self.x_m, self.y_m, float(x_m), float(y_m), 0, self.x_m.size - 2, False)
+        return float((j + t) * self.spacing_m)
 
     def tracker(self, initial_s_m: float | None = None) -> PathTracker:
         """A progress-following projector; starts at initial_s_m or, if None, at the global closest point."""
@@ -311,10 +283,10 @@ class PathTracker:
 
         i = min(int(s_new / path.spacing_m), self._n_seg - 1)
         frac = s_new / path.spacing_m - i
-        fx = path.x_m[i] + frac * path._seg_dx[i]
-        fy = path.y_m[i] + frac * path._seg_dy[i]
-        heading = path.heading_rad[i] + frac * (path.heading_rad[i + 1] - path.heading_rad[i])
-        curvature = path.curvature_1pm[i] + frac * (path.curvature_1pm[i + 1] - path.curvature_1pm[i])
+        fx = float(path.x_m[i] + frac * path._seg_dx[i])
+        fy = float(path.y_m[i] + frac * path._seg_dy[i])
+        heading = float(path.heading_rad[i] + frac * (path.heading_rad[i + 1] - path.heading_rad[i]))
+        curvature = float(path.curvature_1pm[i] + frac * (path.curvature_1pm[i + 1] - path.curvature_1pm[i]))
         # Signed CTE: component of (position - foot) along the path's left normal.
         cte = -(x_m - fx) * math.sin(heading) + (y_m - fy) * math.cos(heading)
         at_end = (not path.closed) and s_new >= path.length_m - 1e-9
@@ -323,23 +295,7 @@ class PathTracker:
     def _windowed_search(self, x_m: float, y_m: float, s_center: float, half_width_m: float) -> float:
         path = self.path
         ds = path.spacing_m
-        n_seg = self._n_seg
-        center = int(s_center / ds)
-        half = math.ceil(half_width_m / ds)
-        lo, hi = center - half, center + half
-        max_span = n_seg if path.closed else n_seg + 2 * half
-        while True:
-            if not path.closed:
-                lo, hi = max(lo, 0), min(hi, n_seg - 1)
-            seg = np.arange(lo, hi + 1)
-            if path.closed:
-                seg %= n_seg
-            k, t, _ = path.closest_on_segments(x_m, y_m, seg)
-            on_low_edge = k == 0 and t == 0.0 and (path.closed or lo > 0)
-            on_high_edge = k == seg.size - 1 and t == 1.0 and (path.closed or hi < n_seg - 1)
-            if not (on_low_edge or on_high_edge) or hi - lo >= max_span:
-                return float((seg[k] + t) * ds) if not path.closed else float(((seg[k] + t) * ds) % path.length_m)
-            if on_low_edge:
-                lo -= half
-            if on_high_edge:
-                hi += half
+        index = windowed_projection(
+            path.x_m, path.y_m, x_m, y_m, int(s_center / ds), math.ceil(half_width_m / ds), path.closed
+        )
+        return min(index * ds, path.length_m)

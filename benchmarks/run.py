@@ -1,0 +1,148 @@
+"""Speed benchmarks: controller steps, path projection, plant integration and whole simulations.
+
+Prints a table and writes JSON (median, p99, real-time factor). Goals live here, not in timed tests; each entry
+names its goal, and `--check` exits non-zero when a goal is missed.
+
+    python benchmarks/run.py [--out benchmarks/results/latest.json] [--track ZANDVOORT.csv] [--check]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import platform
+import sys
+import time
+from collections.abc import Callable
+from dataclasses import asdict, dataclass
+from pathlib import Path
+
+import numpy as np
+
+from controllers import make_controller
+from workbench.scenarios import ZANDVOORT_ENV, ScenarioOptions, make_scenario
+from workbench.simulator import Simulation, SimulationConfig
+from workbench.vehicles import make_vehicle
+
+DEFAULT_TRACK = Path(__file__).resolve().parents[2] / "shared" / "tracks" / "Zandvoort_track.csv"
+
+
+@dataclass
+class Entry:
+    name: str
+    median_us: float | None = None
+    p99_us: float | None = None
+    real_time_factor: float | None = None
+    wall_s: float | None = None
+    simulated_s: float | None = None
+    goal: str | None = None
+    goal_met: bool | None = None
+    note: str | None = None
+
+
+def time_calls(fn: Callable[[], object], n: int) -> np.ndarray:
+    """Wall time (us) of n calls of fn, after 20 warm-up calls."""
+    for _ in range(20):
+        fn()
+    out = np.empty(n)
+    for i in range(n):
+        start = time.perf_counter()
+        fn()
+        out[i] = (time.perf_counter() - start) * 1e6
+    return out
+
+
+def bench_tracker(scenario_name: str, options: ScenarioOptions) -> Entry:
+    path = make_scenario(scenario_name, options).path
+    s = np.linspace(0, path.length_m, 20_001)[:-1]
+    xs, ys = path.position(s)
+    xs = xs + 0.5 * np.sin(s / 7.0)
+    tracker = path.tracker(0.0)
+    points = iter(zip(xs.tolist(), ys.tolist(), strict=True))
+    times = time_calls(lambda: tracker.update(*next(points)), 19_000)
+    return Entry(f"path tracker update ({scenario_name})", float(np.median(times)), float(np.percentile(times, 99)))
+
+
+def bench_plant(vehicle_name: str) -> Entry:
+    vehicle = make_vehicle(vehicle_name)
+    state = vehicle.initial_state(0.0, 0.0, 0.0, 8.33)
+    holder = [state]
+
+    def step() -> None:
+        holder[0] = vehicle.advance(holder[0], 0.3, 0.0, 0.02, 20)
+
+    times = time_calls(step, 5000)
+    return Entry(
+        f"{vehicle_name}: advance 20 RK4 substeps (one 50 Hz step at 1 kHz)",
+        float(np.median(times)),
+        float(np.percentile(times, 99)),
+    )
+
+
+def bench_run(scenario_name: str, controller_name: str, vehicle_name: str, options: ScenarioOptions,
+              speed_kmh: float = 30.0, goal_rtf: float | None = None) -> Entry:  # fmt: skip
+    vehicle = make_vehicle(vehicle_name)
+    scenario = make_scenario(scenario_name, ScenarioOptions(vehicle.geometry.width_m, options.track_file))
+    controller = make_controller(controller_name, vehicle.geometry)
+    sim = Simulation(scenario, vehicle, controller, SimulationConfig(speed_kmh=speed_kmh))
+    sim.run()  # warm-up: compiles numba kernels, fills caches
+    start = time.perf_counter()
+    result = sim.run()
+    wall = time.perf_counter() - start
+    simulated = float(result.trace["t_s"][-1])
+    rtf = simulated / wall
+    m = result.metrics
+    entry = Entry(
+        f"{scenario_name}: {controller_name} on {vehicle_name} at {speed_kmh:g} km/h, whole run",
+        m.step_time_median_us,
+        m.step_time_p99_us,
+        rtf,
+        wall,
+        simulated,
+        note=f"{result.status.value}; max |CTE| {m.max_abs_cte_m:.3f} m",
+    )
+    if goal_rtf is not None:
+        entry.goal, entry.goal_met = f"real-time factor >= {goal_rtf:g}", rtf >= goal_rtf
+    return entry
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--out", type=Path, default=Path(__file__).parent / "results" / "latest.json")
+    parser.add_argument("--track", type=Path, default=None, help="Zandvoort CSV (default: env or ../shared)")
+    parser.add_argument("--check", action="store_true", help="exit 1 if a goal is missed")
+    args = parser.parse_args(argv)
+    track = args.track or (Path(os.environ[ZANDVOORT_ENV]) if os.environ.get(ZANDVOORT_ENV) else DEFAULT_TRACK)
+    options = ScenarioOptions(track_file=track if track.is_file() else None)
+    scenarios = ["dlc", "figure8", "fig17"] + (["zandvoort"] if options.track_file else [])
+
+    entries = [bench_tracker("figure8", options)]
+    if options.track_file:
+        entries.append(bench_tracker("zandvoort", options))
+    entries.append(bench_plant("kinematic-bicycle"))
+    for name in scenarios:
+        entries.append(bench_run(name, "pure-pursuit", "kinematic-bicycle", options))
+
+    print(f"{'benchmark':<78} {'median us':>10} {'p99 us':>10} {'RTF':>8}  goal")
+    for e in entries:
+
+        def f(v: float | None, spec: str) -> str:
+            return format(v, spec) if v is not None else "-"
+
+        goal = "" if e.goal is None else f"{e.goal}: {'met' if e.goal_met else 'MISSED'}"
+        print(f"{e.name:<78} {f(e.median_us, '10.1f')} {f(e.p99_us, '10.1f')} {f(e.real_time_factor, '8.1f')}  {goal}")
+    document = {
+        "machine": {"python": sys.version.split()[0], "platform": platform.platform(), "cpus": os.cpu_count()},
+        "created_unix_s": time.time(),
+        "entries": [asdict(e) for e in entries],
+    }
+    args.out.parent.mkdir(parents=True, exist_ok=True)
+    args.out.write_text(json.dumps(document, indent=2) + "\n")
+    print(f"wrote {args.out}")
+    missed = [e.name for e in entries if e.goal_met is False]
+    return 1 if (args.check and missed) else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
