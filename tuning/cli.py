@@ -22,7 +22,9 @@ def _parser() -> argparse.ArgumentParser:
         "generate-data",
         help="drive a plant open loop with a steering profile and write a CSV log (the fit-lag input format)",
     )
-    gen.add_argument("--vehicle", required=True, help="vehicle model (see `workbench vehicles`)")
+    gen.add_argument("--vehicle", help="vehicle model (see `workbench vehicles`)")
+    gen.add_argument("--vehicle-file", type=Path, help="a vehicle TOML file instead of a named preset")
+    gen.add_argument("--payload-kg", type=float, help="payload of vehicles that carry one (tractor-semitrailer)")
     gen.add_argument("--maneuver", required=True, choices=Maneuver.KINDS, help="steering-wheel profile")
     gen.add_argument("--speed", type=float, required=True, metavar="KMH", help="held speed, km/h")
     gen.add_argument("--amplitude-deg", type=float, default=90.0, help="steering-wheel amplitude (default 90 deg)")
@@ -35,7 +37,9 @@ def _parser() -> argparse.ArgumentParser:
 def main(argv: Sequence[str] | None = None) -> int:
     args = _parser().parse_args(argv)
     try:
-        vehicle = make_vehicle(args.vehicle)
+        if args.vehicle is None and args.vehicle_file is None:
+            raise WorkbenchInputError("give --vehicle NAME or --vehicle-file FILE")
+        vehicle = make_vehicle(args.vehicle, payload_kg=args.payload_kg, vehicle_file=args.vehicle_file)
         maneuver = Maneuver(args.maneuver, amplitude_deg=args.amplitude_deg, duration_s=args.duration_s)
         log = generate_open_loop_log(vehicle, maneuver, args.speed, sample_rate_hz=args.sample_rate_hz)
     except WorkbenchInputError as exc:

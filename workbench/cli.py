@@ -12,7 +12,7 @@ from controllers import CONTROLLERS, make_controller
 from workbench.errors import WorkbenchInputError
 from workbench.scenarios import ScenarioOptions, describe_scenarios, make_scenario
 from workbench.simulator import Simulation, SimulationConfig
-from workbench.vehicles import VEHICLES, make_vehicle
+from workbench.vehicles import VEHICLES, list_presets, make_vehicle, preset_text
 
 EXIT_INPUT_ERROR = 2
 EXIT_RUN_FAILED = 1
@@ -26,13 +26,16 @@ def _parser() -> argparse.ArgumentParser:
 
     scen = sub.add_parser("scenarios", help="list the named scenarios")
     scen.add_argument("--track", type=Path, help="Zandvoort track CSV (TUMFTM racetrack-database format)")
-    sub.add_parser("vehicles", help="list the vehicle models")
+    veh = sub.add_parser("vehicles", help="list the vehicle models and presets")
+    veh.add_argument("--show", metavar="NAME", help="print a preset's TOML (copy, edit, pass with --vehicle-file)")
     sub.add_parser("controllers", help="list the controllers")
 
     run = sub.add_parser("run", help="simulate one controller on one vehicle along one scenario")
     run.add_argument("scenario", help="a scenario name (see `workbench scenarios`) or a waypoint CSV file")
     run.add_argument("--controller", default="pure-pursuit", help="controller name (default: pure-pursuit)")
-    run.add_argument("--vehicle", default="kinematic-bicycle", help="vehicle model (default: kinematic-bicycle)")
+    run.add_argument("--vehicle", default=None, help="vehicle model (default: kinematic-bicycle)")
+    run.add_argument("--vehicle-file", type=Path, help="a vehicle TOML file (see `workbench vehicles --show`)")
+    run.add_argument("--payload-kg", type=float, help="payload of vehicles that carry one (tractor-semitrailer)")
     run.add_argument("--speed", type=float, default=30.0, metavar="KMH", help="target speed, km/h (default 30)")
     run.add_argument("--out", type=Path, required=True, metavar="DIR", help="output directory")
     run.add_argument("--track", type=Path, help="track CSV for the zandvoort scenario")
@@ -45,7 +48,8 @@ def _parser() -> argparse.ArgumentParser:
 
 
 def _run(args: argparse.Namespace) -> int:
-    vehicle = make_vehicle(args.vehicle)
+    name = args.vehicle if args.vehicle or args.vehicle_file else "kinematic-bicycle"
+    vehicle = make_vehicle(name, payload_kg=args.payload_kg, vehicle_file=args.vehicle_file)
     controller = make_controller(args.controller, vehicle.geometry)
     scenario = make_scenario(
         args.scenario, ScenarioOptions(vehicle_width_m=vehicle.geometry.width_m, track_file=args.track)
@@ -86,8 +90,11 @@ def main(argv: Sequence[str] | None = None) -> int:
             for name, description in describe_scenarios(ScenarioOptions(track_file=args.track)):
                 print(f"{name:<12} {description}")
         elif args.command == "vehicles":
-            for name, factory in VEHICLES.items():
-                print(f"{name:<22} {factory().describe()}")
+            if args.show:
+                print(preset_text(args.show), end="")
+            else:
+                for name, description in list_presets().items():
+                    print(f"{name:<20} {description}\n{'':<20} {VEHICLES[name]().describe()}")
         elif args.command == "controllers":
             for name, cls in CONTROLLERS.items():
                 print(f"{name:<14} {cls.summary()}")

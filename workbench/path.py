@@ -169,6 +169,19 @@ class ReferencePath:
             name=name or waypoints.source,
         )
 
+    @classmethod
+    def from_xy(
+        cls,
+        x_m: np.ndarray,
+        y_m: np.ndarray,
+        speed_mps: np.ndarray | None = None,
+        closed: bool = False,
+        name: str = "path",
+        spacing_m: float = DEFAULT_SAMPLE_SPACING_M,
+    ) -> ReferencePath:
+        """A path from numpy arrays of waypoints (m), optionally with speeds (m/s); see `from_waypoints`."""
+        return cls.from_waypoints(Waypoints(x_m, y_m, speed_mps, closed, source=name), spacing_m, name)
+
     # ------------------------------------------------------------------ evaluation
     def wrap_s(self, s_m: float | np.ndarray) -> float | np.ndarray:
         """Map an arc length into [0, length]: modulo the length on a closed loop, clipped on an open path."""

@@ -3,8 +3,8 @@
 from __future__ import annotations
 
 import json
-import shutil
 import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -86,8 +86,50 @@ def test_waypoint_csv_runs_as_a_scenario(tmp_path: Path) -> None:
     assert json.loads((tmp_path / "o" / "metrics.json").read_text())["completed"] is True
 
 
-@pytest.mark.skipif(shutil.which("workbench") is None, reason="console script not installed (pip install -e .)")
-def test_console_script_is_installed() -> None:
-    done = subprocess.run(["workbench", "scenarios"], capture_output=True, text=True, check=False, timeout=120)
+SCRIPTS = Path(sys.executable).parent
+
+
+@pytest.mark.parametrize(
+    ("script", "args", "needle"), [("workbench", ["scenarios"], "fig17"), ("tuning", ["--help"], "generate-data")]
+)
+def test_console_scripts_are_installed(script: str, args: list[str], needle: str) -> None:
+    exe = SCRIPTS / script
+    if not exe.exists():
+        pytest.skip(f"{exe} not installed: run `pip install -e .` first")
+    done = subprocess.run([str(exe), *args], capture_output=True, text=True, check=False, timeout=120)
     assert done.returncode == 0, done.stderr
-    assert "fig17" in done.stdout
+    assert needle in done.stdout
+
+
+def test_vehicles_lists_presets_and_shows_toml(capsys) -> None:
+    assert main(["vehicles"]) == 0
+    out = capsys.readouterr().out
+    for name in ("kinematic-bicycle", "dynamic-bicycle", "tractor-semitrailer", "commonroad-mb"):
+        assert name in out
+    assert main(["vehicles", "--show", "tractor-semitrailer"]) == 0
+    assert "payload_kg" in capsys.readouterr().out
+
+
+def test_truck_run_with_payload_fills_the_vehicle_metrics(tmp_path: Path) -> None:
+    out = tmp_path / "truck"
+    args = [
+        "run",
+        "fig17",
+        "--vehicle",
+        "tractor-semitrailer",
+        "--payload-kg",
+        "17000",
+        "--out",
+        str(out),
+        "--no-plots",
+    ]
+    assert main(args) == 0
+    metrics = json.loads((out / "metrics.json").read_text())
+    assert metrics["completed"] is True
+    assert 0 < metrics["max_ltr"] < 1  # 0.3 g speed profile: far from wheel lift-off
+    assert 0 < metrics["max_offtracking_m"] < 3
+
+
+def test_payload_on_a_car_is_rejected(tmp_path: Path, capsys) -> None:
+    assert main(["run", "dlc", "--vehicle", "kinematic-bicycle", "--payload-kg", "500", "--out", str(tmp_path)]) == 2
+    assert "payload" in capsys.readouterr().err
