@@ -70,17 +70,22 @@ def first_beyond(
     i0w = i0 % n_seg if closed else min(i0, n_seg - 1)
     sx = x[i0w] + frac0 * (x[i0w + 1] - x[i0w])
     sy = y[i0w] + frac0 * (y[i0w + 1] - y[i0w])
-    d_prev = math.hypot(sx - px, sy - py)
-    if d_prev >= distance:
+    if math.hypot(sx - px, sy - py) >= distance:
         return start
-    idx_prev = start
+    ax, ay, index_a = sx, sy, start
     last = i0 + n_seg if closed else n_seg
     for j in range(i0 + 1, last + 1):
         i = j % n_seg if closed else j
-        d = math.hypot(x[i] - px, y[i] - py)
-        if d >= distance:
-            frac = (distance - d_prev) / (d - d_prev) if d > d_prev else 1.0
-            index = idx_prev + frac * (j - idx_prev)
+        bx, by = x[i], y[i]
+        if math.hypot(bx - px, by - py) >= distance:
+            # The circle of radius `distance` crosses segment A-B: solve |A + u (B - A) - P| = distance for u.
+            dx, dy = bx - ax, by - ay
+            ex, ey = ax - px, ay - py
+            qa = dx * dx + dy * dy
+            qb = 2.0 * (ex * dx + ey * dy)
+            qc = ex * ex + ey * ey - distance * distance
+            u = (-qb + math.sqrt(max(qb * qb - 4.0 * qa * qc, 0.0))) / (2.0 * qa) if qa > 0.0 else 1.0
+            index = index_a + min(max(u, 0.0), 1.0) * (j - index_a)
             return index % n_seg if closed else index
-        d_prev, idx_prev = d, float(j)
+        ax, ay, index_a = bx, by, float(j)
     return -1.0

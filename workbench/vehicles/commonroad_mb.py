@@ -1,0 +1,133 @@
+"""CommonRoad's multi-body car model (`vehiclemodels.vehicle_dynamics_mb`) as a plant: a third-party check.
+
+The 29-state MB model (sprung mass with roll and pitch, two unsprung axles, four wheel speeds, magic-formula
+combined-slip tyres; Althoff & Wuersching, "CommonRoad: Vehicle Models", 2020) is integrated as published, with
+fixed-step RK4 of its pure-Python derivative function, so it is slow: ~38 us per derivative evaluation, ~3 ms per
+20-substep advance, i.e. a 518 s lap at 1 kHz takes ~80 s (6x faster than real time, ~180x slower than the
+compiled models). Its inputs are the front road-wheel angle *rate* and the acceleration;
+this adapter closes the same first-order, rate-limited steering actuator as the other models around it, and
+converts its CG reference point to the rear-axle centre: p_rear = p_cg - b (cos yaw, sin yaw).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any, ClassVar
+
+import numpy as np
+
+from workbench.errors import WorkbenchInputError, require_in_range
+from workbench.vehicles.base import VehicleGeometry, VehicleModel
+
+#: CommonRoad's names of the MB states, in order (x/y are the CG; vx/vy of the sprung mass, body frame).
+_MB_STATES: tuple[str, ...] = (
+    "x_cg_m", "y_cg_m", "road_wheel_angle_rad", "vx_mps", "yaw_rad", "yaw_rate_rad_s", "roll_rad",
+    "roll_rate_rad_s", "pitch_rad", "pitch_rate_rad_s", "vy_mps", "z_m", "vz_mps", "roll_front_rad",
+    "roll_rate_front_rad_s", "vy_front_mps", "z_front_m", "vz_front_mps", "roll_rear_rad", "roll_rate_rear_rad_s",
+    "vy_rear_mps", "z_rear_m", "vz_rear_mps", "omega_lf_rad_s", "omega_rf_rad_s", "omega_lr_rad_s",
+    "omega_rr_rad_s", "delta_y_front_m", "delta_y_rear_m",
+)
+
+
+@dataclass(frozen=True)
+class CommonRoadMBParams:
+    """Which CommonRoad vehicle, plus the steering system and envelope CommonRoad does not model."""
+
+    vehicle_id: int = 2  # CommonRoad parameters_vehicle2: BMW 320i (1: Ford Escort, 3: VW Vanagon)
+    steering_ratio: float = 15.0  # assumed: typical passenger-car rack (14-16:1); CommonRoad gives none
+    steering_time_constant_s: float = 0.05  # assumed: electric power-steering position loop
+    max_accel_mps2: float = 3.0  # assumed comfort limit (CommonRoad's 11.5 m/s^2 is the tyre limit)
+    max_decel_mps2: float = 8.0  # assumed: about 0.8 g braking
+    max_step_s: float = 0.001  # assumed: RK4 step bound; 5 ms fails at low speed (stiff wheel spin), 2 ms held
+
+    def __post_init__(self) -> None:
+        if isinstance(self.vehicle_id, bool) or self.vehicle_id not in (1, 2, 3):
+            raise WorkbenchInputError(f"vehicle_id must be 1, 2 or 3 (CommonRoad cars); got {self.vehicle_id!r}")
+        require_in_range("steering_ratio", self.steering_ratio, 1.0, 60.0)
+        require_in_range("steering_time_constant_s", self.steering_time_constant_s, 1e-3, 2.0, "s")
+        require_in_range("max_accel_mps2", self.max_accel_mps2, 0.01, 11.5, "m/s^2")
+        require_in_range("max_decel_mps2", self.max_decel_mps2, 0.01, 11.5, "m/s^2")
+        require_in_range("max_step_s", self.max_step_s, 1e-5, 0.01, "s")
+
+
+def _commonroad_parameters(vehicle_id: int) -> Any:
+    from vehiclemodels.parameters_vehicle1 import parameters_vehicle1
+    from vehiclemodels.parameters_vehicle2 import parameters_vehicle2
+    from vehiclemodels.parameters_vehicle3 import parameters_vehicle3
+
+    return {1: parameters_vehicle1, 2: parameters_vehicle2, 3: parameters_vehicle3}[vehicle_id]()
+
+
+class CommonRoadMB(VehicleModel):
+    name: ClassVar[str] = "commonroad-mb"
+    state_names: ClassVar[tuple[str, ...]] = _MB_STATES
+    extra_output_names: ClassVar[tuple[str, ...]] = ("roll_rad", "path_curvature_1pm")
+
+    def __init__(self, params: CommonRoadMBParams | None = None) -> None:
+        from vehiclemodels.init_mb import init_mb
+        from vehiclemodels.vehicle_dynamics_mb import vehicle_dynamics_mb
+
+        self.params = p = params or CommonRoadMBParams()
+        self._f, self._init = vehicle_dynamics_mb, init_mb
+        self._cr = cr = _commonroad_parameters(p.vehicle_id)
+        self._b = float(cr.b)
+        self._geometry = VehicleGeometry(
+            wheelbase_m=float(cr.a + cr.b),
+            steering_ratio=p.steering_ratio,
+            max_road_wheel_angle_rad=float(cr.steering.max),
+            max_steer_wheel_rate_rad_s=float(cr.steering.v_max) * p.steering_ratio,
+            width_m=float(cr.w),
+        )
+
+    @property
+    def geometry(self) -> VehicleGeometry:
+        return self._geometry
+
+    def initial_state(self, x_m: float, y_m: float, yaw_rad: float, speed_mps: float) -> np.ndarray:
+        xc, yc = x_m + self._b * math.cos(yaw_rad), y_m + self._b * math.sin(yaw_rad)
+        return np.array(self._init([xc, yc, 0.0, speed_mps, yaw_rad, 0.0, 0.0], self._cr), dtype=float)
+
+    def _inputs(self, steer_wheel_cmd_rad: float, accel_cmd_mps2: float) -> tuple[float, float]:
+        p, lim = self.params, self._geometry.max_road_wheel_angle_rad
+        delta_cmd = min(max(steer_wheel_cmd_rad / p.steering_ratio, -lim), lim)
+        return delta_cmd, min(max(accel_cmd_mps2, -p.max_decel_mps2), p.max_accel_mps2)
+
+    def _rhs(self, x: np.ndarray, delta_cmd: float, accel: float) -> np.ndarray:
+        """MB derivative; NaN where CommonRoad's code breaks down (e.g. a wheel stops rolling in a spin:
+        division by zero), so the simulator reports the state as diverged instead of a stray exception."""
+        steer_rate = (delta_cmd - x[2]) / self.params.steering_time_constant_s
+        try:
+            return np.array(self._f(x.tolist(), [steer_rate, accel], self._cr), dtype=float)
+        except (ZeroDivisionError, OverflowError, ValueError):
+            return np.full(len(_MB_STATES), np.nan)
+
+    def advance(
+        self, state: np.ndarray, steer_wheel_cmd_rad: float, accel_cmd_mps2: float, dt_s: float, substeps: int
+    ) -> np.ndarray:
+        delta_cmd, accel = self._inputs(steer_wheel_cmd_rad, accel_cmd_mps2)
+        n = max(substeps, math.ceil(dt_s / self.params.max_step_s - 1e-9))
+        h = dt_s / n
+        s = np.array(state, dtype=float)
+        for _ in range(n):
+            k1 = self._rhs(s, delta_cmd, accel)
+            k2 = self._rhs(s + 0.5 * h * k1, delta_cmd, accel)
+            k3 = self._rhs(s + 0.5 * h * k2, delta_cmd, accel)
+            k4 = self._rhs(s + h * k3, delta_cmd, accel)
+            s = s + h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+            s[23:27] = np.maximum(s[23:27], 0.0)  # CommonRoad forbids negative wheel spin
+        return s
+
+    def outputs(self, state: np.ndarray, steer_wheel_cmd_rad: float, accel_cmd_mps2: float) -> np.ndarray:
+        delta_cmd, accel = self._inputs(steer_wheel_cmd_rad, accel_cmd_mps2)
+        x = np.asarray(state, dtype=float)
+        d = self._rhs(x, delta_cmd, accel)
+        b, yaw, u, r = self._b, x[4], x[3], x[5]
+        vref = x[10] - b * r
+        ax_ref, ay_ref = d[3] - vref * r, d[10] - b * d[5] + u * r
+        speed = math.hypot(u, vref)
+        kappa = (u * ay_ref - vref * ax_ref) / speed**3 if speed > 1e-3 else math.tan(x[2]) / self.geometry.wheelbase_m
+        return np.array([
+            x[0] - b * math.cos(yaw), x[1] - b * math.sin(yaw), yaw, u, vref, r,
+            x[2] * self.params.steering_ratio, x[2], ay_ref, x[6], kappa,
+        ])
