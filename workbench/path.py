@@ -35,6 +35,10 @@ _REPARAMETERISATIONS = 2
 #: A fit whose arc length over some waypoint interval exceeds this multiple of the chord is rejected as
 #: oscillating (a smooth curve turning by 90 degrees between two waypoints has a ratio of 1.11).
 _MAX_ARC_TO_CHORD = 1.5
+#: Each re-parameterisation must shrink the mismatch between the parameter and the arc length by this factor
+#: (it shrinks 50-1000x on well-behaved data), unless the mismatch is already below _MISMATCH_FLOOR.
+_MIN_CONTRACTION = 0.5
+_MISMATCH_FLOOR = 1e-6
 
 
 def _cumulative_arc_length(spline_x: BSpline, spline_y: BSpline, t: np.ndarray) -> np.ndarray:
@@ -53,30 +57,36 @@ def _arc_length_spline(x: np.ndarray, y: np.ndarray, closed: bool) -> tuple[BSpl
     the curvature within 0.7% of its maximum (0.002% in the interior of a closed circle), where a chord-length
     cubic spline errs by 2-4% (measured in tests/workbench/test_path.py).
 
-    A quintic through very unevenly spaced waypoints (say a 8 m step after 1 m steps) can oscillate, and the
-    re-parameterisation then diverges; a fit is therefore rejected when its arc length over an interval exceeds
-    `_MAX_ARC_TO_CHORD` times the chord: the re-parameterisation stops at the last good fit, and a quintic that
-    oscillates from the start is replaced by a cubic.
+    A quintic through very unevenly spaced waypoints (say a 5-8 m step among 1 m steps) can oscillate, and the
+    re-parameterisation then diverges instead of converging. A fit is rejected when its arc length over an
+    interval exceeds `_MAX_ARC_TO_CHORD` times the chord, or when re-parameterising did not shrink the mismatch
+    between parameter and arc length by `_MIN_CONTRACTION`. A rejected quintic is replaced by a cubic (with
+    natural end conditions on an open path: a not-a-knot cubic still bulges by metres into a long last interval),
+    and the cubic keeps its last accepted fit.
     """
     chord = np.hypot(np.diff(x), np.diff(y))
     t_chord = np.concatenate(([0.0], np.cumsum(chord)))
     bc = "periodic" if closed else None
     degree = _SPLINE_DEGREE if x.size > _SPLINE_DEGREE + (1 if closed else 0) else 3 if x.size > 3 else 2
     while True:
-        t, good = t_chord, None
+        t, accepted, mismatch_before = t_chord, None, math.inf
         for _ in range(_REPARAMETERISATIONS + 1):
             spline_x = make_interp_spline(t, x, k=degree, bc_type=bc)
             spline_y = make_interp_spline(t, y, k=degree, bc_type=bc)
             arc = _cumulative_arc_length(spline_x, spline_y, t)
-            if not np.all(np.diff(arc) <= _MAX_ARC_TO_CHORD * chord):
+            mismatch = float(np.max(np.abs(np.diff(arc) / np.diff(t) - 1.0)))
+            contracting = mismatch <= max(_MIN_CONTRACTION * mismatch_before, _MISMATCH_FLOOR)
+            if not (contracting and np.all(np.diff(arc) <= _MAX_ARC_TO_CHORD * chord)):
                 break
-            good = (spline_x, spline_y, t)
-            t = arc
-        if good is not None:
-            return good
-        if degree <= 3:  # even the chord-length cubic oscillates: nothing better to offer
+            accepted, mismatch_before, t = (spline_x, spline_y, t), mismatch, arc
+        else:
+            return accepted
+        if degree > 3:  # the quintic is unstable on these waypoints: a cubic, natural at the ends of an open path
+            degree, bc = 3, bc or "natural"
+        elif accepted is not None:
+            return accepted
+        else:  # even the chord-length cubic oscillates: nothing better to offer
             return spline_x, spline_y, t_chord
-        degree = 3
 
 
 def wrap_angle(angle_rad: float | np.ndarray) -> float | np.ndarray:
