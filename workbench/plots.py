@@ -34,7 +34,13 @@ def trajectory(result: SimulationResult, ax: Axes | None = None) -> Axes:
     ax.plot(path.x_m, path.y_m, "k--", lw=1.0, label="reference")
     ax.plot(result.trace["x_m"], result.trace["y_m"], lw=1.5, label=f"{_label(result)} (rear axle)")
     if "trailer_x_m" in result.trace:
-        ax.plot(result.trace["trailer_x_m"], result.trace["trailer_y_m"], lw=1.0, color="tab:green", label="trailer rear axle")
+        ax.plot(
+            result.trace["trailer_x_m"],
+            result.trace["trailer_y_m"],
+            lw=1.0,
+            color="tab:green",
+            label="trailer rear axle",
+        )
     cones = result.scenario.cones_xy
     if cones is not None:
         ax.plot(cones[:, 0], cones[:, 1], "^", color="tab:red", ms=5, label="cones")

@@ -22,11 +22,35 @@ from workbench.vehicles.base import VehicleGeometry, VehicleModel
 
 #: CommonRoad's names of the MB states, in order (x/y are the CG; vx/vy of the sprung mass, body frame).
 _MB_STATES: tuple[str, ...] = (
-    "x_cg_m", "y_cg_m", "road_wheel_angle_rad", "vx_mps", "yaw_rad", "yaw_rate_rad_s", "roll_rad",
-    "roll_rate_rad_s", "pitch_rad", "pitch_rate_rad_s", "vy_mps", "z_m", "vz_mps", "roll_front_rad",
-    "roll_rate_front_rad_s", "vy_front_mps", "z_front_m", "vz_front_mps", "roll_rear_rad", "roll_rate_rear_rad_s",
-    "vy_rear_mps", "z_rear_m", "vz_rear_mps", "omega_lf_rad_s", "omega_rf_rad_s", "omega_lr_rad_s",
-    "omega_rr_rad_s", "delta_y_front_m", "delta_y_rear_m",
+    "x_cg_m",
+    "y_cg_m",
+    "road_wheel_angle_rad",
+    "vx_mps",
+    "yaw_rad",
+    "yaw_rate_rad_s",
+    "roll_rad",
+    "roll_rate_rad_s",
+    "pitch_rad",
+    "pitch_rate_rad_s",
+    "vy_mps",
+    "z_m",
+    "vz_mps",
+    "roll_front_rad",
+    "roll_rate_front_rad_s",
+    "vy_front_mps",
+    "z_front_m",
+    "vz_front_mps",
+    "roll_rear_rad",
+    "roll_rate_rear_rad_s",
+    "vy_rear_mps",
+    "z_rear_m",
+    "vz_rear_mps",
+    "omega_lf_rad_s",
+    "omega_rf_rad_s",
+    "omega_lr_rad_s",
+    "omega_rr_rad_s",
+    "delta_y_front_m",
+    "delta_y_rear_m",
 )
 
 
@@ -127,7 +151,18 @@ class CommonRoadMB(VehicleModel):
         ax_ref, ay_ref = d[3] - vref * r, d[10] - b * d[5] + u * r
         speed = math.hypot(u, vref)
         kappa = (u * ay_ref - vref * ax_ref) / speed**3 if speed > 1e-3 else math.tan(x[2]) / self.geometry.wheelbase_m
-        return np.array([
-            x[0] - b * math.cos(yaw), x[1] - b * math.sin(yaw), yaw, u, vref, r,
-            x[2] * self.params.steering_ratio, x[2], ay_ref, x[6], kappa,
-        ])
+        return np.array(
+            [
+                x[0] - b * math.cos(yaw),
+                x[1] - b * math.sin(yaw),
+                yaw,
+                u,
+                vref,
+                r,
+                x[2] * self.params.steering_ratio,
+                x[2],
+                ay_ref,
+                x[6],
+                kappa,
+            ]
+        )

@@ -188,8 +188,15 @@ def _outputs(s, p, delta_cmd, accel, ratio):  # pragma: no cover - compiled
 class DynamicBicycle(VehicleModel):
     name: ClassVar[str] = "dynamic-bicycle"
     state_names: ClassVar[tuple[str, ...]] = (
-        "x_m", "y_m", "yaw_rad", "vx_mps", "vy_cg_mps", "yaw_rate_rad_s", "road_wheel_angle_rad",
-        "fy_front_N", "fy_rear_N",
+        "x_m",
+        "y_m",
+        "yaw_rad",
+        "vx_mps",
+        "vy_cg_mps",
+        "yaw_rate_rad_s",
+        "road_wheel_angle_rad",
+        "fy_front_N",
+        "fy_rear_N",
     )
     extra_output_names: ClassVar[tuple[str, ...]] = ("fy_front_N", "fy_rear_N", "path_curvature_1pm")
 
@@ -197,7 +204,12 @@ class DynamicBicycle(VehicleModel):
         self.params = p = params or DynamicBicycleParams()
         arr = np.zeros(P_N)
         arr[P_A], arr[P_B], arr[P_M], arr[P_I], arr[P_H] = (
-            p.cg_to_front_axle_m, p.cg_to_rear_axle_m, p.mass_kg, p.yaw_inertia_kgm2, p.cg_height_m)
+            p.cg_to_front_axle_m,
+            p.cg_to_rear_axle_m,
+            p.mass_kg,
+            p.yaw_inertia_kgm2,
+            p.cg_height_m,
+        )
         arr[P_TAU], arr[P_RATE] = p.steering_time_constant_s, p.max_road_wheel_rate_rad_s
         arr[P_SIGMA] = p.relaxation_length_m
         arr[P_VLO], arr[P_VHI] = p.kinematic_blend_low_mps, p.kinematic_blend_high_mps

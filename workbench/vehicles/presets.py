@@ -62,9 +62,7 @@ def preset_text(name: str) -> str:
 def _check_keys(kind: str, got: dict[str, Any], allowed: tuple[str, ...], source: str, required: bool) -> None:
     for key in got:
         if key not in allowed:
-            raise WorkbenchInputError(
-                f"{source}: unknown {kind} key {key!r}; allowed keys: {', '.join(allowed)}"
-            )
+            raise WorkbenchInputError(f"{source}: unknown {kind} key {key!r}; allowed keys: {', '.join(allowed)}")
     if required:
         for key in allowed:
             if key not in got:
@@ -96,9 +94,7 @@ def params_from_toml(text: str, source: str) -> tuple[str, Any]:
     _check_keys("[model]", model, _MODEL_KEYS, source, required=False)
     kind = model.get("type")
     if kind not in MODEL_TYPES:
-        raise WorkbenchInputError(
-            f"{source}: [model] type must be one of {', '.join(MODEL_TYPES)}; got {kind!r}"
-        )
+        raise WorkbenchInputError(f"{source}: [model] type must be one of {', '.join(MODEL_TYPES)}; got {kind!r}")
     params_cls = MODEL_TYPES[kind][1]
     fields = {f.name: f for f in dataclasses.fields(params_cls)}
     _check_keys("[parameters]", given, tuple(fields), source, required=True)
@@ -130,9 +126,7 @@ def load_vehicle(name_or_file: str, payload_kg: float | None = None) -> VehicleM
     if payload_kg is not None:
         if "payload_kg" not in {f.name for f in dataclasses.fields(params)}:
             carriers = [k for k, (_, cls) in MODEL_TYPES.items() if "payload_kg" in cls.__dataclass_fields__]
-            raise WorkbenchInputError(
-                f"vehicle {kind!r} has no payload; a payload applies to: {', '.join(carriers)}"
-            )
+            raise WorkbenchInputError(f"vehicle {kind!r} has no payload; a payload applies to: {', '.join(carriers)}")
         if isinstance(payload_kg, bool) or not isinstance(payload_kg, int | float):
             raise WorkbenchInputError(f"payload_kg must be a number; got {payload_kg!r}")
         params = dataclasses.replace(params, payload_kg=float(payload_kg))

@@ -165,9 +165,38 @@ _RANGES: tuple[tuple[str, float, float, str], ...] = (
 )
 
 # Indices into the derived-parameter array handed to the compiled code.
-(P_A, P_B, P_C, P_L1, P_LT, P_E, P_M1, P_M2, P_I1, P_I2, P_TAU, P_RATE, P_SIGMA, P_VLO, P_VHI,
- P_DF, P_DD, P_DT, P_BF, P_BD, P_BT, P_SHAPE, P_HOFF,
- P_KF1, P_KF2, P_KD1, P_KD2, P_KT1, P_KT2, P_N) = range(30)
+(
+    P_A,
+    P_B,
+    P_C,
+    P_L1,
+    P_LT,
+    P_E,
+    P_M1,
+    P_M2,
+    P_I1,
+    P_I2,
+    P_TAU,
+    P_RATE,
+    P_SIGMA,
+    P_VLO,
+    P_VHI,
+    P_DF,
+    P_DD,
+    P_DT,
+    P_BF,
+    P_BD,
+    P_BT,
+    P_SHAPE,
+    P_HOFF,
+    P_KF1,
+    P_KF2,
+    P_KD1,
+    P_KD2,
+    P_KT1,
+    P_KT2,
+    P_N,
+) = range(30)
 
 
 @dataclass(frozen=True)
@@ -190,22 +219,34 @@ def derive(p: TractorSemitrailerParams) -> Derived:
     """Masses, CGs, inertias, static axle-group loads and the quasi-static LTR coefficients."""
     l1, lt, hoff = p.cg_to_front_axle_m + p.cg_to_drive_axle_m, p.hitch_to_trailer_axle_m, p.hitch_ahead_of_drive_m
     # tractor: x forward from the sprung CG
-    parts1 = ((p.tractor_sprung_mass_kg, 0.0), (p.front_unsprung_mass_kg, p.cg_to_front_axle_m),
-              (p.drive_unsprung_mass_kg, -p.cg_to_drive_axle_m))
+    parts1 = (
+        (p.tractor_sprung_mass_kg, 0.0),
+        (p.front_unsprung_mass_kg, p.cg_to_front_axle_m),
+        (p.drive_unsprung_mass_kg, -p.cg_to_drive_axle_m),
+    )
     m1 = sum(m for m, _ in parts1)
     x1 = sum(m * x for m, x in parts1) / m1
     i1 = p.tractor_yaw_inertia_kgm2 + sum(m * (x - x1) ** 2 for m, x in parts1)
     # trailer: x backward from the hitch
-    parts2 = ((p.trailer_sprung_mass_kg, p.hitch_to_trailer_cg_m), (p.trailer_unsprung_mass_kg, lt),
-              (p.payload_kg, p.payload_cg_from_hitch_m))
+    parts2 = (
+        (p.trailer_sprung_mass_kg, p.hitch_to_trailer_cg_m),
+        (p.trailer_unsprung_mass_kg, lt),
+        (p.payload_kg, p.payload_cg_from_hitch_m),
+    )
     m2 = sum(m for m, _ in parts2)
     e = sum(m * x for m, x in parts2) / m2
-    i2 = (p.trailer_yaw_inertia_kgm2 + p.payload_kg * p.payload_length_m**2 / 12.0
-          + sum(m * (x - e) ** 2 for m, x in parts2))
+    i2 = (
+        p.trailer_yaw_inertia_kgm2
+        + p.payload_kg * p.payload_length_m**2 / 12.0
+        + sum(m * (x - e) ** 2 for m, x in parts2)
+    )
     a, b = p.cg_to_front_axle_m - x1, p.cg_to_drive_axle_m + x1
     king = m2 * G_MPS2 * (lt - e) / lt
-    loads = (m1 * G_MPS2 * b / l1 + king * hoff / l1, m1 * G_MPS2 * a / l1 + king * (l1 - hoff) / l1,
-             m2 * G_MPS2 * e / lt)
+    loads = (
+        m1 * G_MPS2 * b / l1 + king * hoff / l1,
+        m1 * G_MPS2 * a / l1 + king * (l1 - hoff) / l1,
+        m2 * G_MPS2 * e / lt,
+    )
     for group, load in zip(("front", "drive", "trailer"), loads, strict=True):
         if load < 0.05 * (m1 + m2) * G_MPS2:
             raise WorkbenchInputError(
@@ -219,8 +260,10 @@ def derive(p: TractorSemitrailerParams) -> Derived:
     k1, k5 = p.tractor_roll_stiffness_nm_per_rad, p.fifth_wheel_roll_stiffness_nm_per_rad
     k2 = p.trailer_roll_stiffness_nm_per_rad + k1 * k5 / (k1 + k5)
     heff = []
-    for name, ms, hs, k in (("tractor_roll_stiffness_nm_per_rad", ms1, p.tractor_cg_height_m, k1),
-                            ("trailer_roll_stiffness_nm_per_rad", ms2, hs2, k2)):
+    for name, ms, hs, k in (
+        ("tractor_roll_stiffness_nm_per_rad", ms1, p.tractor_cg_height_m, k1),
+        ("trailer_roll_stiffness_nm_per_rad", ms2, hs2, k2),
+    ):
         arm = max(hs - p.roll_axis_height_m, 0.0)
         if k <= 1.2 * ms * G_MPS2 * arm:
             raise WorkbenchInputError(
@@ -372,12 +415,29 @@ def _outputs(s, p, delta_cmd, accel, ratio):  # pragma: no cover - compiled
 class TractorSemitrailer(VehicleModel):
     name: ClassVar[str] = "tractor-semitrailer"
     state_names: ClassVar[tuple[str, ...]] = (
-        "x_m", "y_m", "yaw_rad", "vx_mps", "vy_cg_mps", "yaw_rate_rad_s", "trailer_yaw_rad",
-        "trailer_yaw_rate_rad_s", "road_wheel_angle_rad", "fy_front_N", "fy_drive_N", "fy_trailer_N",
+        "x_m",
+        "y_m",
+        "yaw_rad",
+        "vx_mps",
+        "vy_cg_mps",
+        "yaw_rate_rad_s",
+        "trailer_yaw_rad",
+        "trailer_yaw_rate_rad_s",
+        "road_wheel_angle_rad",
+        "fy_front_N",
+        "fy_drive_N",
+        "fy_trailer_N",
     )
     extra_output_names: ClassVar[tuple[str, ...]] = (
-        "ltr", "ltr_front", "ltr_drive", "ltr_trailer", "trailer_x_m", "trailer_y_m", "trailer_yaw_rad",
-        "articulation_rad", "path_curvature_1pm",
+        "ltr",
+        "ltr_front",
+        "ltr_drive",
+        "ltr_trailer",
+        "trailer_x_m",
+        "trailer_y_m",
+        "trailer_yaw_rad",
+        "articulation_rad",
+        "path_curvature_1pm",
     )
 
     def __init__(self, params: TractorSemitrailerParams | None = None) -> None:

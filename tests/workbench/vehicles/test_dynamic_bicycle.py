@@ -75,8 +75,12 @@ def test_low_speed_path_follows_commonroad_ks(speed_mps: float, delta: float, to
     from vehiclemodels.vehicle_dynamics_ks import vehicle_dynamics_ks
 
     p, h = parameters_vehicle2(), 0.005
-    ks = _rk4_trace(lambda x: np.array(vehicle_dynamics_ks(list(x), [0.0, 0.0], p)),
-                    [0.0, 0.0, delta, speed_mps, 0.0], 40.0 / speed_mps, h)
+    ks = _rk4_trace(
+        lambda x: np.array(vehicle_dynamics_ks(list(x), [0.0, 0.0], p)),
+        [0.0, 0.0, delta, speed_mps, 0.0],
+        40.0 / speed_mps,
+        h,
+    )
     ours = _ours_constant_steer(speed_mps, delta, 40.0 / speed_mps, h)
     err = np.hypot(ours[:, OUT["x_m"]] - ks[:, 0], ours[:, OUT["y_m"]] - ks[:, 1])
     assert err.max() < tolerance_m

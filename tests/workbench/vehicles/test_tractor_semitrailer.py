@@ -53,10 +53,16 @@ def truck_lag_s(payload_kg: float, speed_kmh: float) -> float:
 def kinematic_lag_s(speed_kmh: float) -> float:
     """The same step on a kinematic bicycle with the truck's wheelbase and steering system."""
     g = TRUCK.geometry
-    model = KinematicBicycle(KinematicBicycleParams(
-        wheelbase_m=g.wheelbase_m, width_m=g.width_m, steering_ratio=g.steering_ratio,
-        max_road_wheel_angle_rad=g.max_road_wheel_angle_rad, max_road_wheel_rate_rad_s=PRESET.max_road_wheel_rate_rad_s,
-        steering_time_constant_s=PRESET.steering_time_constant_s))
+    model = KinematicBicycle(
+        KinematicBicycleParams(
+            wheelbase_m=g.wheelbase_m,
+            width_m=g.width_m,
+            steering_ratio=g.steering_ratio,
+            max_road_wheel_angle_rad=g.max_road_wheel_angle_rad,
+            max_road_wheel_rate_rad_s=PRESET.max_road_wheel_rate_rad_s,
+            steering_time_constant_s=PRESET.steering_time_constant_s,
+        )
+    )
     v = kmh(speed_kmh)
     t, out = step_response(model, v, g.steer_wheel_for_curvature(1.0 / v**2), 3.0)
     return time_to_63(t, out[:, 5] / v)
@@ -202,8 +208,10 @@ def test_low_speed_path_follows_commonroad_kst(speed_mps: float, tolerance_m: fl
     lt = PRESET.hitch_to_trailer_axle_m
     trailer_yaw = kst[:, 4] + kst[:, 5]  # CommonRoad's hitch angle is trailer minus tractor yaw
     tractor_err = np.hypot(ours[:, OUT["x_m"]] - kst[:, 0], ours[:, OUT["y_m"]] - kst[:, 1])
-    trailer_err = np.hypot(ours[:, OUT["trailer_x_m"]] - (kst[:, 0] - lt * np.cos(trailer_yaw)),
-                           ours[:, OUT["trailer_y_m"]] - (kst[:, 1] - lt * np.sin(trailer_yaw)))
+    trailer_err = np.hypot(
+        ours[:, OUT["trailer_x_m"]] - (kst[:, 0] - lt * np.cos(trailer_yaw)),
+        ours[:, OUT["trailer_y_m"]] - (kst[:, 1] - lt * np.sin(trailer_yaw)),
+    )
     assert tractor_err.max() < tolerance_m
     assert trailer_err.max() < tolerance_m
     np.testing.assert_allclose(ours[:, OUT["articulation_rad"]], -kst[:, 5], atol=tolerance_m / lt)
@@ -216,8 +224,7 @@ def test_dynamic_regime_steady_turn_matches_commonroad_kst() -> None:
     kst = kst_trace(v, delta, 60.0, h)
     ours = truck_constant_steer(v, delta, 60.0, h)
     assert ours[-1, OUT["articulation_rad"]] == pytest.approx(-kst[-1, 5], rel=0.01)
-    assert ours[-1, OUT["yaw_rate_rad_s"]] == pytest.approx(v * math.tan(delta) / TRUCK.geometry.wheelbase_m,
-                                                             rel=0.015)
+    assert ours[-1, OUT["yaw_rate_rad_s"]] == pytest.approx(v * math.tan(delta) / TRUCK.geometry.wheelbase_m, rel=0.015)
 
 
 # --- well-posedness, symmetry ---------------------------------------------------------------------------------
@@ -300,11 +307,25 @@ def test_hitch_ahead_of_the_front_axle_and_a_roll_unstable_trailer_are_rejected(
     with pytest.raises(WorkbenchInputError, match="hitch_ahead_of_drive_m must leave the fifth wheel"):
         TractorSemitrailer(replace(PRESET, cg_to_front_axle_m=0.5, cg_to_drive_axle_m=2.0, hitch_ahead_of_drive_m=2.5))
     with pytest.raises(WorkbenchInputError, match=r"the front axle group would carry -?[0-9]+ kg, under 5%"):
-        TractorSemitrailer(replace(PRESET, hitch_ahead_of_drive_m=-1.0, payload_kg=40000.0,
-                                   payload_cg_from_hitch_m=1.0, cg_to_front_axle_m=4.0, cg_to_drive_axle_m=1.0))
+        TractorSemitrailer(
+            replace(
+                PRESET,
+                hitch_ahead_of_drive_m=-1.0,
+                payload_kg=40000.0,
+                payload_cg_from_hitch_m=1.0,
+                cg_to_front_axle_m=4.0,
+                cg_to_drive_axle_m=1.0,
+            )
+        )
     with pytest.raises(WorkbenchInputError, match="trailer_roll_stiffness_nm_per_rad too low"):
-        TractorSemitrailer(replace(PRESET, trailer_roll_stiffness_nm_per_rad=1e4,
-                                   fifth_wheel_roll_stiffness_nm_per_rad=1e4, payload_cg_height_m=4.0))
+        TractorSemitrailer(
+            replace(
+                PRESET,
+                trailer_roll_stiffness_nm_per_rad=1e4,
+                fifth_wheel_roll_stiffness_nm_per_rad=1e4,
+                payload_cg_height_m=4.0,
+            )
+        )
 
 
 # --- cost -----------------------------------------------------------------------------------------------------
