@@ -8,12 +8,14 @@ from __future__ import annotations
 
 from controllers.base import Controller, Measurement
 from controllers.pure_pursuit import PurePursuit, PurePursuitConfig
+from controllers.stanley import Stanley, StanleyConfig
 from workbench.errors import WorkbenchInputError
 from workbench.vehicles.base import VehicleGeometry
 
 #: name -> controller class, in the order `workbench controllers` lists them.
 CONTROLLERS: dict[str, type[Controller]] = {
     PurePursuit.name: PurePursuit,
+    Stanley.name: Stanley,
 }
 
 
@@ -26,4 +28,13 @@ def make_controller(name: str, geometry: VehicleGeometry, config: object | None 
     return cls(geometry, config)
 
 
-__all__ = ["CONTROLLERS", "Controller", "Measurement", "PurePursuit", "PurePursuitConfig", "make_controller"]
+__all__ = [
+    "CONTROLLERS",
+    "Controller",
+    "Measurement",
+    "PurePursuit",
+    "PurePursuitConfig",
+    "Stanley",
+    "StanleyConfig",
+    "make_controller",
+]

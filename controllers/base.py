@@ -1,9 +1,10 @@
 """The one small interface every lateral controller implements.
 
-A controller is built once for a vehicle (its geometry and limits) and a frozen config, `reset` for a path, then
-stepped at the controller rate with what GPS/IMU and the steering sensor give. It returns a steering-wheel angle
-command. Whatever it wants logged about its last step (lookahead, solver status, ...) it exposes as `diagnostics`,
-which the simulator records as `ctrl_<name>` columns. Controllers contain no plotting and no I/O.
+A controller is built once for a vehicle (its geometry and limits) and a frozen config, `reset` for a path and
+its sample time, then stepped at that rate with what GPS/IMU and the steering sensor give. It returns a
+steering-wheel angle command. Whatever it wants logged about its last step (lookahead, solver status, ...) it
+exposes as `diagnostics`, which the simulator records as `ctrl_<name>` columns. Controllers contain no plotting
+and no I/O.
 """
 
 from __future__ import annotations
@@ -64,8 +65,8 @@ class Controller(ABC):
         return doc.strip().splitlines()[0]
 
     @abstractmethod
-    def reset(self, path: ReferencePath) -> None:
-        """Forget all state; the next step is the first on `path`."""
+    def reset(self, path: ReferencePath, sample_time_s: float) -> None:
+        """Forget all state; the next step is the first on `path`; steps come every `sample_time_s` seconds."""
 
     @abstractmethod
     def step(self, measurement: Measurement, path: ReferencePath) -> float:

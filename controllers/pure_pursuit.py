@@ -40,7 +40,7 @@ class PurePursuit(Controller):
     name: ClassVar[str] = "pure-pursuit"
     config_type: ClassVar[type] = PurePursuitConfig
 
-    def reset(self, path: ReferencePath) -> None:
+    def reset(self, path: ReferencePath, sample_time_s: float) -> None:
         self._tracker: PathTracker = path.tracker(0.0)
         self._diag = {"lookahead_m": 0.0, "target_s_m": 0.0, "curvature_cmd_1pm": 0.0}
 

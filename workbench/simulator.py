@@ -131,7 +131,7 @@ class Simulation:
         x0, y0, yaw0 = self.scenario.initial_pose()
         state = vehicle.initial_state(x0, y0, yaw0, float(path.speed_mps[0]))
         tracker = path.tracker(0.0)
-        controller.reset(path)
+        controller.reset(path, dt)
         speed_controller = PISpeedController(PISpeedGains())
 
         log = _TraceLog(vehicle.output_names, max_steps)

@@ -47,7 +47,7 @@ SITUATIONS = {
 def test_command_is_finite_and_within_the_steering_limit(name: str, situation: str) -> None:
     vehicle = KinematicBicycle()
     controller = make_controller(name, vehicle.geometry)
-    controller.reset(PATH)
+    controller.reset(PATH, 0.02)
     command = controller.step(SITUATIONS[situation], PATH)
     assert math.isfinite(command)
     assert abs(command) <= vehicle.geometry.max_steer_wheel_angle_rad + 1e-12
@@ -58,9 +58,9 @@ def test_command_is_finite_and_within_the_steering_limit(name: str, situation: s
 def test_turns_toward_the_path(name: str) -> None:
     vehicle = KinematicBicycle()
     controller = make_controller(name, vehicle.geometry)
-    controller.reset(PATH)
+    controller.reset(PATH, 0.02)
     left_of_path = controller.step(_measure(5.0, 1.0, 0.0, 8.0), PATH)
-    controller.reset(PATH)
+    controller.reset(PATH, 0.02)
     right_of_path = controller.step(_measure(5.0, -1.0, 0.0, 8.0), PATH)
     assert left_of_path < 0 < right_of_path
 

@@ -98,7 +98,7 @@ class _Failing(Controller):
         super().__init__(geometry, {})
         self.mode, self.after = mode, after
 
-    def reset(self, path: ReferencePath) -> None:
+    def reset(self, path: ReferencePath, sample_time_s: float) -> None:
         self.n = 0
 
     def step(self, measurement: Measurement, path: ReferencePath) -> float:

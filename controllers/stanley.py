@@ -1,0 +1,62 @@
+"""Stanley (Thrun et al. 2006, the DARPA Grand Challenge winner): heading error plus a cross-track term at the
+front axle, phi = (psi_path - psi) + atan(k e / (k_soft + v)), with e the front axle's signed CTE.
+
+The front-axle position is the measured rear-axle position moved one wheelbase along the heading. A path-curvature
+feedforward, atan(L kappa), is optional (off by default, as in the original law).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import ClassVar
+
+from controllers.base import Controller, Measurement
+from workbench.errors import require_positive
+from workbench.path import PathTracker, ReferencePath, wrap_angle
+
+
+@dataclass(frozen=True)
+class StanleyConfig:
+    """gain_per_s: k, cross-track gain (1/s); softening_mps: k_soft, keeps the law finite at low speed (m/s);
+    curvature_feedforward: add atan(L kappa_path) at the front axle's foot point."""
+
+    gain_per_s: float = 1.5
+    softening_mps: float = 1.0
+    curvature_feedforward: bool = False
+
+    def __post_init__(self) -> None:
+        require_positive("gain_per_s", self.gain_per_s)
+        require_positive("softening_mps", self.softening_mps)
+
+
+class Stanley(Controller):
+    name: ClassVar[str] = "stanley"
+    config_type: ClassVar[type] = StanleyConfig
+
+    def reset(self, path: ReferencePath, sample_time_s: float) -> None:
+        self._tracker: PathTracker = path.tracker(0.0)
+        self._diag = {"front_cte_m": 0.0, "heading_term_rad": 0.0, "cross_track_term_rad": 0.0}
+
+    def step(self, measurement: Measurement, path: ReferencePath) -> float:
+        cfg, m, wheelbase = self.config, measurement, self.geometry.wheelbase_m
+        front_x = m.x_m + wheelbase * math.cos(m.yaw_rad)
+        front_y = m.y_m + wheelbase * math.sin(m.yaw_rad)
+        foot = self._tracker.update(front_x, front_y)
+        heading_term = wrap_angle(foot.heading_rad - m.yaw_rad)
+        cross_track_term = math.atan2(-cfg.gain_per_s * foot.cte_m, cfg.softening_mps + m.speed_mps)
+        road_wheel = heading_term + cross_track_term
+        if cfg.curvature_feedforward:
+            road_wheel += math.atan(wheelbase * foot.curvature_1pm)
+        self._diag = {
+            "front_cte_m": foot.cte_m,
+            "heading_term_rad": heading_term,
+            "cross_track_term_rad": cross_track_term,
+        }
+        limit = self.geometry.max_road_wheel_angle_rad
+        return self.saturate(min(max(road_wheel, -limit), limit) * self.geometry.steering_ratio)
+
+    @property
+    def diagnostics(self) -> Mapping[str, float]:
+        return self._diag
