@@ -1,0 +1,429 @@
+"""The per-step hyper-clothoid of the clothoid controller (paper, section 2, Eq. 3): one clothoid segment from the
+vehicle's rear-axle pose to a target point, solved exactly by a compiled Newton iteration.
+
+The curve. A clothoid's curvature is linear in arc length, kappa(s) = kappa0 + kdot s, so its heading is
+theta(s) = theta0 + kappa0 s + kdot s^2 / 2 and its points are (x0, y0) + int_0^s (cos theta, sin theta). The
+hyper-clothoid starts at the rear axle (x0, y0) with the vehicle's heading theta0 and current curvature kappa0
+(Eq. 3's x(0), y(0), psi(0), kappa(0)); its two unknowns, the curvature rate kdot (1/m^2) and the length L (m), are
+chosen so that its end point reaches the target (x1, y1). kdot is saturated at +-kdot_max; a saturated clothoid
+cannot reach the target, so its length is the one that brings the end point closest to it, and the residual is
+left for the controller to check against Eq. 3's tolerances delta_x, delta_y (`ClothoidFit.end_error_m`).
+
+The method. Everything runs in the start frame (the target rotated by -theta0: the start is the origin, heading 0).
+The end point F(kdot, L) is integrated by Gauss-Legendre quadrature. The heading turns by at most max(|kappa0|,
+|kappa0 + kdot L|)·L across [0, L] (|theta'| is linear in s), and that bound picks the rule: 4 to 12 nodes on one
+panel, each rule used only up to the turn at which its measured error stays below 1e-14 of the panel length (the
+integrand is entire, so the error falls super-exponentially with the turn), and 4-rad panels of the 12-node rule
+beyond. End points are therefore exact to rounding (~1e-13 m over 60 m; exact up to 256 rad of turning, finite
+beyond). The Jacobian comes from the same nodes: dF/dL = (cos theta(L), sin theta(L)) and dF/dkdot = int_0^L (s^2/2)
+(-sin theta, cos theta) ds. Newton starts from a small-angle solution (the end point of a gently turning curve lies
+at the bearing of its mean heading, kappa0 L / 2 + kdot L^2 / 6, and at distance L (1 - var theta / 2)) and is
+damped: a step changes the end heading by at most 1.5 rad, keeps L > 0, rejects clothoids turning more than 64 rad,
+and backtracks until |F - target| falls (Armijo). Targets ahead take 2-4 evaluations (1-3 for a vehicle near its
+path; at most 13 seen for bearings up to 100 deg). It has converged below 1e-12 max(1 m, distance) of residual, and
+fails (unless already below 1e-10 max(1 m, distance)) after 30 iterations, a line search that cannot descend, or 3
+steps in a row that each cut the residual by less than 10%: the sign of sliding into a local minimum of |F - target|
+that is not zero, i.e. no clothoid through the target exists (typically kappa0 turning away from a target at a wide
+bearing; pyclothoids finds none either, and no solution that pyclothoids finds is lost to this rule). When the
+solution needs |kdot| > kdot_max, kdot is clipped to +-kdot_max (the solution's sign) and L found by a 1-D Newton
+descent from the distance to a local minimum of the distance: h(L) = (F - T)·t(L) = 0 (half the derivative of |F -
+T|^2), h' = 1 + kappa(L) (F - T)·n(L), downhill steps where that is not positive, with the same turn cap and
+backtracking.
+
+Status codes (the fifth value `fit_kernel` returns, and `ClothoidFit.status`):
+    FIT_OK = 0          converged: the end point is on the target and |kdot| <= kdot_max.
+    FIT_SATURATED = 1   kdot = +-kdot_max exactly; L > 0 a local minimiser of the end point's distance to the target.
+    FIT_UNREACHABLE = 2 the target is behind or beside the start (bearing |phi| > 100 deg in the start frame), at
+                        the start (closer than 1 um), or no clothoid reaches it (see above), or the saturated
+                        search failed. The fallback is finite and bounded: kdot = sign(phi) kdot_max (turn towards
+                        the target as hard as allowed), L = distance, and that clothoid's end point (the start
+                        point when it would turn more than 256 rad). Non-finite inputs, or coordinates whose
+                        difference overflows, give kdot = L = 0 and the start point.
+
+Why not pyclothoids at run time. `pyclothoids.Clothoid.Forward(x0, y0, th0, k0, x1, y1)` (Bertolazzi & Frego's
+Clothoids library) solves the same boundary problem exactly (no rate limit), and the tests use it as the reference:
+the two agree to ~1e-10 relative in kdot and ~1e-11 in L. But it cannot be called from a compiled search (the
+adaptive lookahead fits up to ~6 clothoids per controller step inside numba code), costs ~6-7 us per call from
+Python (measured on this workbench) against ~1-1.5 us here, and for targets behind or beside the start (and for the
+targets ahead that no clothoid reaches: ~17% of random ones within 60 deg, 3-30 m, |kappa0| <= 0.1) returns
+degenerate answers: length 0 m with a meaningless dk, or long loops (a 120 m clothoid for a target 10 m behind).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numba import njit
+
+from workbench.errors import WorkbenchInputError
+
+FIT_OK = 0
+FIT_SATURATED = 1
+FIT_UNREACHABLE = 2
+
+#: Targets at a bearing beyond this (in the start frame) are behind or beside the vehicle: no useful clothoid.
+MAX_BEARING_RAD = math.radians(100.0)
+#: Targets closer than this to the start are "at the start".
+MIN_DISTANCE_M = 1e-6
+#: Cap on panels per integral, so absurd inputs (kdot_max L^2 ~ 1e18) still cost bounded time (768 nodes); the
+#: quadrature is exact up to a turn of 4 rad x MAX_PANELS = 256 rad (~40 full turns), and finite beyond.
+MAX_PANELS = 64
+#: Candidate clothoids turning more than this (the bound max |theta'| L; ~10 full turns) are rejected by both
+#: searches: no vehicle follows them, and they would make each evaluation expensive.
+MAX_FIT_TURN_RAD = 64.0
+#: Newton: stop below TIGHT_TOL * max(1, d); accept as converged below ACCEPT_TOL * max(1, d).
+TIGHT_TOL = 1e-12
+ACCEPT_TOL = 1e-10
+MAX_NEWTON_ITERATIONS = 30
+MAX_LINE_SEARCH_HALVINGS = 10
+#: Newton gives up after STALL_STEPS steps in a row that each cut the residual by less than 1 - STALL_RATIO: it is
+#: sliding into a local minimum of |F - target| > 0 (no clothoid reaches the target; converging fits never do this).
+STALL_RATIO = 0.9
+STALL_STEPS = 3
+#: Largest change of the end heading one Newton step may make (rad), so it stays on the branch it starts on.
+MAX_STEP_TURN_RAD = 1.5
+
+
+def _gauss_legendre_rules(sizes: tuple[int, ...]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Nodes and weights on [0, 1] of the Gauss-Legendre rules of these sizes, concatenated, and their offsets."""
+    nodes, weights = zip(*(np.polynomial.legendre.leggauss(m) for m in sizes), strict=True)
+    offsets = np.concatenate(([0], np.cumsum(sizes))).astype(np.int64)
+    return 0.5 * (np.concatenate(nodes) + 1.0), 0.5 * np.concatenate(weights), offsets
+
+
+#: Quadrature rules (node counts) and the largest heading change (rad) each integrates across one panel to a
+#: relative error below ~1e-14 (measured for every heading whose rate |theta'| stays under turn / panel length).
+#: The integrand exp(i theta(s)) is entire, so a rule's error falls super-exponentially as the turn shrinks.
+RULE_SIZES = (4, 5, 6, 8, 10, 12)
+RULE_MAX_TURN_RAD = (0.01, 0.05, 0.2, 1.0, 2.5, 4.0)
+GL_NODES, GL_WEIGHTS, GL_OFFSETS = _gauss_legendre_rules(RULE_SIZES)
+_RULE_TURNS = np.array(RULE_MAX_TURN_RAD)
+#: Integrals turning up to this much are exact (MAX_PANELS panels of the largest rule); beyond, merely finite.
+EXACT_TURN_RAD = RULE_MAX_TURN_RAD[-1] * MAX_PANELS
+_N_RULES = len(RULE_SIZES)
+
+
+@njit(cache=True)
+def _integrate(
+    kappa0: float, kdot: float, a: float, b: float, with_jacobian: bool
+) -> tuple[float, float, float, float]:  # pragma: no cover - compiled
+    """int_a^b (cos, sin) theta(s) ds and, if asked, int_a^b (s^2 / 2) (-sin, cos) theta(s) ds (start frame).
+
+    The heading turns at most `turn` = max |theta'| (b - a) across [a, b] (|theta'| is linear in s): the smallest
+    rule that is exact for that turn, on one panel; beyond the largest rule's turn, panels of it."""
+    rate = max(abs(kappa0 + kdot * a), abs(kappa0 + kdot * b))
+    turn = rate * (b - a)
+    rule = 0
+    while rule < _N_RULES - 1 and not turn <= _RULE_TURNS[rule]:
+        rule += 1
+    n_p = 1
+    if not turn <= _RULE_TURNS[rule]:
+        limit = _RULE_TURNS[rule] * MAX_PANELS
+        n_p = math.ceil(turn / _RULE_TURNS[rule]) if turn < limit else MAX_PANELS  # also catches inf / NaN
+    lo = GL_OFFSETS[rule]
+    hi = GL_OFFSETS[rule + 1]
+    h = (b - a) / n_p
+    fx = 0.0
+    fy = 0.0
+    gx = 0.0
+    gy = 0.0
+    for p in range(n_p):
+        a_p = a + p * h
+        for j in range(lo, hi):
+            s = a_p + h * GL_NODES[j]
+            th = s * (kappa0 + 0.5 * kdot * s)
+            c = math.cos(th)
+            sn = math.sin(th)
+            w = GL_WEIGHTS[j]
+            fx += w * c
+            fy += w * sn
+            if with_jacobian:
+                q = w * 0.5 * s * s
+                gx -= q * sn
+                gy += q * c
+    return fx * h, fy * h, gx * h, gy * h
+
+
+@njit(cache=True)
+def _turn_bound(kappa0: float, kdot: float, length: float) -> float:  # pragma: no cover - compiled
+    """max |theta'| L over [0, L]: a bound on how far the heading turns (rad)."""
+    return max(abs(kappa0), abs(kappa0 + kdot * length)) * length
+
+
+@njit(cache=True)
+def _newton(
+    kappa0: float, u: float, v: float, d: float, kdot: float, length: float
+) -> tuple[float, float, float, float, bool]:  # pragma: no cover - compiled
+    """Damped Newton for F(kdot, L) = (u, v): (kdot, L, Fx, Fy, converged)."""
+    scale = max(1.0, d)
+    if not _turn_bound(kappa0, kdot, length) <= MAX_FIT_TURN_RAD:
+        return kdot, length, 0.0, 0.0, False
+    fx, fy, gx, gy = _integrate(kappa0, kdot, 0.0, length, True)
+    rx, ry = fx - u, fy - v
+    r = math.hypot(rx, ry)
+    stall = 0
+    for _ in range(MAX_NEWTON_ITERATIONS):
+        if r <= TIGHT_TOL * scale:
+            return kdot, length, fx, fy, True
+        th = length * (kappa0 + 0.5 * kdot * length)
+        c = math.cos(th)
+        sn = math.sin(th)
+        # J = [[gx, c], [gy, sn]] acting on (d kdot, d L); solve J step = -r.
+        det = gx * sn - gy * c
+        if det == 0.0 or not math.isfinite(det):
+            break
+        dk = (-rx * sn + ry * c) / det
+        dl = (-gx * ry + gy * rx) / det
+        if not (math.isfinite(dk) and math.isfinite(dl)):
+            break
+        alpha = 1.0
+        if length + dl <= 0.0:  # keep L > 0: at most halve it
+            alpha = 0.5 * length / -dl
+        kappa_end = abs(kappa0 + kdot * length)
+        turn = abs(dk) * 0.5 * length * length + kappa_end * abs(dl)
+        if alpha * turn > MAX_STEP_TURN_RAD:
+            alpha = MAX_STEP_TURN_RAD / turn
+        accepted = False
+        for _ in range(MAX_LINE_SEARCH_HALVINGS):
+            k_t = kdot + alpha * dk
+            l_t = length + alpha * dl
+            if not _turn_bound(kappa0, k_t, l_t) <= MAX_FIT_TURN_RAD:
+                alpha *= 0.5
+                continue
+            fx_t, fy_t, gx_t, gy_t = _integrate(kappa0, k_t, 0.0, l_t, True)
+            rx_t, ry_t = fx_t - u, fy_t - v
+            r_t = math.hypot(rx_t, ry_t)
+            if r_t <= (1.0 - 1e-4 * alpha) * r:
+                stall = stall + 1 if r_t > STALL_RATIO * r else 0
+                kdot, length = k_t, l_t
+                fx, fy, gx, gy = fx_t, fy_t, gx_t, gy_t
+                rx, ry, r = rx_t, ry_t, r_t
+                accepted = True
+                break
+            if r <= ACCEPT_TOL * scale:  # at the rounding floor already: no need to search further
+                break
+            alpha *= 0.5
+        if not accepted or stall >= STALL_STEPS:
+            break
+    return kdot, length, fx, fy, r <= ACCEPT_TOL * scale and length > 0.0
+
+
+@njit(cache=True)
+def _closest_length(
+    kappa0: float, kdot: float, u: float, v: float, d: float, length: float
+) -> tuple[float, float, float, bool]:  # pragma: no cover - compiled
+    """With kdot fixed, a local minimiser L > 0 of |F(L) - (u, v)|, reached by descending from `length`:
+    (L, Fx, Fy, converged)."""
+    scale = max(1.0, d)
+    if not _turn_bound(kappa0, kdot, length) <= MAX_FIT_TURN_RAD:
+        return length, 0.0, 0.0, False
+    fx, fy, _, _ = _integrate(kappa0, kdot, 0.0, length, False)
+    ex, ey = fx - u, fy - v
+    e2 = ex * ex + ey * ey
+    for _ in range(MAX_NEWTON_ITERATIONS):
+        th = length * (kappa0 + 0.5 * kdot * length)
+        c = math.cos(th)
+        sn = math.sin(th)
+        h = ex * c + ey * sn  # (F - T) . t(L): half the derivative of the squared distance
+        hp = 1.0 + (kappa0 + kdot * length) * (-ex * sn + ey * c)
+        if abs(h) <= TIGHT_TOL * scale:
+            return length, fx, fy, hp > 0.0
+        dl = -h / max(hp, 1e-3)  # Newton where convex; else downhill, as far as the turn cap below allows
+        alpha = 1.0
+        if length + dl <= 0.0:
+            alpha = 0.5 * length / -dl
+        # The longest move x along the curve that turns it by at most MAX_STEP_TURN_RAD: |kappa| x + |kdot| x^2 / 2.
+        kappa_abs = abs(kappa0 + kdot * length)
+        denominator = kappa_abs + math.sqrt(kappa_abs**2 + 2.0 * abs(kdot) * MAX_STEP_TURN_RAD)
+        if denominator > 0.0:  # (a straight line never turns)
+            alpha = min(alpha, 2.0 * MAX_STEP_TURN_RAD / denominator / abs(dl))
+        accepted = False
+        for _ in range(MAX_LINE_SEARCH_HALVINGS):
+            l_t = length + alpha * dl
+            if not _turn_bound(kappa0, kdot, l_t) <= MAX_FIT_TURN_RAD:
+                alpha *= 0.5
+                continue
+            fx_t, fy_t, _, _ = _integrate(kappa0, kdot, 0.0, l_t, False)
+            ex_t, ey_t = fx_t - u, fy_t - v
+            e2_t = ex_t * ex_t + ey_t * ey_t
+            th_t = l_t * (kappa0 + 0.5 * kdot * l_t)
+            h_t = ex_t * math.cos(th_t) + ey_t * math.sin(th_t)
+            # Armijo on the squared distance (h dl < 0) or, where convex, a halving of the stationarity residual
+            # (near the minimum the distance's decrease, ~h^2, drowns in its rounding).
+            if e2_t <= e2 + 1e-4 * alpha * 2.0 * h * dl or (hp > 0.0 and abs(h_t) <= 0.5 * abs(h)):
+                length, fx, fy, ex, ey, e2 = l_t, fx_t, fy_t, ex_t, ey_t, e2_t
+                accepted = True
+                break
+            alpha *= 0.5
+        if not accepted:
+            # Rounding stalls the descent at a minimum: accept a stationary point that is small relative to d.
+            return length, fx, fy, abs(h) <= ACCEPT_TOL * scale and hp > 0.0
+    th = length * (kappa0 + 0.5 * kdot * length)
+    h = ex * math.cos(th) + ey * math.sin(th)
+    return length, fx, fy, abs(h) <= ACCEPT_TOL * scale
+
+
+@njit(cache=True)
+def _initial_guess(kappa0: float, d: float, phi: float) -> tuple[float, float]:  # pragma: no cover - compiled
+    """Small-angle (kdot, L) for a target at distance d and bearing phi: the end point of a gently turning curve
+    lies at the bearing of its mean heading, kappa0 L / 2 + kdot L^2 / 6, and at the distance
+    L (1 - var(theta) / 2), var over s uniform on [0, L]; two rounds of that fixed point."""
+    length = d
+    for _ in range(2):
+        a = kappa0
+        b = 3.0 * (phi - 0.5 * kappa0 * length) / (length * length)  # kdot / 2
+        var = a * a * length**2 / 12.0 + a * b * length**3 / 6.0 + b * b * 4.0 * length**4 / 45.0
+        length = d / max(1.0 - 0.5 * var, 0.5)
+    return 6.0 * (phi - 0.5 * kappa0 * length) / (length * length), length
+
+
+@njit(cache=True)
+def fit_kernel(
+    x0: float, y0: float, theta0: float, kappa0: float, x1: float, y1: float, kdot_max: float
+) -> tuple[float, float, float, float, int]:  # pragma: no cover - compiled
+    """The hyper-clothoid from (x0, y0, theta0, kappa0) to (x1, y1) with |kdot| <= kdot_max.
+
+    Returns (kdot 1/m^2, length m, end_x m, end_y m, status FIT_OK / FIT_SATURATED / FIT_UNREACHABLE); finite for
+    any finite input (non-finite inputs give status FIT_UNREACHABLE and kdot = length = 0)."""
+    if not (
+        math.isfinite(x0) and math.isfinite(y0) and math.isfinite(theta0) and math.isfinite(kappa0)
+        and math.isfinite(x1) and math.isfinite(y1) and math.isfinite(kdot_max)
+    ):  # fmt: skip
+        return 0.0, 0.0, x0, y0, FIT_UNREACHABLE
+    kdot_max = max(kdot_max, 0.0)
+    c0 = math.cos(theta0)
+    s0 = math.sin(theta0)
+    dx = x1 - x0
+    dy = y1 - y0
+    u = c0 * dx + s0 * dy  # target in the start frame
+    v = -s0 * dx + c0 * dy
+    d = math.hypot(u, v)
+    if not math.isfinite(d):  # the coordinates' difference overflows (|x1 - x0| > 1.8e308): nothing to fit
+        return 0.0, 0.0, x0, y0, FIT_UNREACHABLE
+    phi = math.atan2(v, u)
+    sign_phi = 1.0 if phi > 0.0 else (-1.0 if phi < 0.0 else 0.0)
+
+    status = FIT_UNREACHABLE
+    kdot = sign_phi * kdot_max
+    length = d
+    fx = 0.0
+    fy = 0.0
+    if d >= MIN_DISTANCE_M and abs(phi) <= MAX_BEARING_RAD:
+        k_guess, l_guess = _initial_guess(kappa0, d, phi)
+        k_n, l_n, fx_n, fy_n, ok = _newton(kappa0, u, v, d, k_guess, l_guess)
+        if ok and abs(k_n) <= kdot_max:
+            kdot, length, fx, fy, status = k_n, l_n, fx_n, fy_n, FIT_OK
+        elif ok:  # the exact solution needs more than kdot_max: clip it, get as close as the clipped rate allows
+            k_s = kdot_max if k_n > 0.0 else -kdot_max
+            l_s, fx_s, fy_s, ok_s = _closest_length(kappa0, k_s, u, v, d, d)
+            if ok_s and l_s > 0.0:
+                kdot, length, fx, fy, status = k_s, l_s, fx_s, fy_s, FIT_SATURATED
+    # The fallback's own end point, where the quadrature is exact; for absurd clothoids (turning more than
+    # EXACT_TURN_RAD, ~40 full turns) the start stands in for it, so coordinates near the float limit cannot overflow.
+    if status == FIT_UNREACHABLE and length > 0.0 and _turn_bound(kappa0, kdot, length) <= EXACT_TURN_RAD:
+        fx, fy, _, _ = _integrate(kappa0, kdot, 0.0, length, False)
+    return kdot, length, x0 + c0 * fx - s0 * fy, y0 + s0 * fx + c0 * fy, status
+
+
+@njit(cache=True)
+def sample_kernel(
+    x0: float,
+    y0: float,
+    theta0: float,
+    kappa0: float,
+    kdot: float,
+    length: float,
+    n: int,
+    out_x: np.ndarray,
+    out_y: np.ndarray,
+) -> None:  # pragma: no cover - compiled
+    """Write n points of the clothoid, evenly spaced in arc length from s = 0 to s = length inclusive, into
+    out_x[:n], out_y[:n]: each interval integrated by the same panelled quadrature, accumulated."""
+    if n <= 0:
+        return
+    out_x[0] = x0
+    out_y[0] = y0
+    if n == 1:
+        return
+    c0 = math.cos(theta0)
+    s0 = math.sin(theta0)
+    h = length / (n - 1)
+    fx = 0.0
+    fy = 0.0
+    for k in range(n - 1):
+        a = k * h
+        b = length if k == n - 2 else (k + 1) * h
+        ix, iy, _, _ = _integrate(kappa0, kdot, a, b, False)
+        fx += ix
+        fy += iy
+        out_x[k + 1] = x0 + c0 * fx - s0 * fy
+        out_y[k + 1] = y0 + s0 * fx + c0 * fy
+
+
+@dataclass(frozen=True, slots=True)
+class ClothoidFit:
+    """One hyper-clothoid: curvature rate (1/m^2), length (m), end point (m) and status (FIT_* code)."""
+
+    curvature_rate_1pm2: float
+    length_m: float
+    end_x_m: float
+    end_y_m: float
+    status: int
+
+    @property
+    def saturated(self) -> bool:
+        """kdot was clipped to +-kdot_max: the end point misses the target by `end_error_m`."""
+        return self.status == FIT_SATURATED
+
+    @property
+    def reachable(self) -> bool:
+        """The target is ahead enough for a clothoid (status FIT_OK or FIT_SATURATED)."""
+        return self.status != FIT_UNREACHABLE
+
+    def end_error_m(self, x1: float, y1: float) -> float:
+        """Distance (m) from the clothoid's end point to (x1, y1)."""
+        return math.hypot(self.end_x_m - x1, self.end_y_m - y1)
+
+
+def _finite(name: str, value: object) -> float:
+    try:
+        number = float(value)  # type: ignore[arg-type]
+    except (TypeError, ValueError):
+        raise WorkbenchInputError(f"{name} must be a finite number; got {value!r}") from None
+    if isinstance(value, bool) or not math.isfinite(number):
+        raise WorkbenchInputError(f"{name} must be a finite number; got {value!r}")
+    return number
+
+
+def fit_hyper_clothoid(
+    x0: float, y0: float, theta0: float, kappa0: float, x1: float, y1: float, max_curvature_rate_1pm2: float
+) -> ClothoidFit:
+    """Fit the hyper-clothoid from the pose (x0, y0, theta0 rad) with curvature kappa0 (1/m) to the target (x1, y1)
+    under |kdot| <= max_curvature_rate_1pm2; see the module docstring."""
+    args = {"x0": x0, "y0": y0, "theta0": theta0, "kappa0": kappa0, "x1": x1, "y1": y1}
+    values = [_finite(name, value) for name, value in args.items()]
+    rate = _finite("max_curvature_rate_1pm2", max_curvature_rate_1pm2)
+    if rate <= 0.0:
+        raise WorkbenchInputError(
+            f"max_curvature_rate_1pm2 must be a finite number > 0; got {max_curvature_rate_1pm2!r}"
+        )
+    kdot, length, ex, ey, status = fit_kernel(*values, rate)
+    return ClothoidFit(float(kdot), float(length), float(ex), float(ey), int(status))
+
+
+def clothoid_points(
+    x0: float, y0: float, theta0: float, kappa0: float, kdot: float, length: float, n: int
+) -> tuple[np.ndarray, np.ndarray]:
+    """n points (x, y) of the clothoid, evenly spaced in arc length over [0, length], both ends included."""
+    args = {"x0": x0, "y0": y0, "theta0": theta0, "kappa0": kappa0, "kdot": kdot, "length": length}
+    values = [_finite(name, value) for name, value in args.items()]
+    if values[-1] < 0.0:
+        raise WorkbenchInputError(f"length must be >= 0 m; got {length!r}")
+    if isinstance(n, bool) or not isinstance(n, int | np.integer) or n < 1:
+        raise WorkbenchInputError(f"n must be an integer >= 1; got {n!r}")
+    x = np.empty(int(n))
+    y = np.empty(int(n))
+    sample_kernel(*values, int(n), x, y)
+    return x, y

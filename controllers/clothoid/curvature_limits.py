@@ -1,0 +1,133 @@
+"""Speed-dependent curvature and curvature-rate limits of the clothoid controller's integrator (paper, section 4).
+
+The controller integrates dkappa/dt = kappa' V (Figure 2) and saturates both the rate and the curvature. The
+limits come from a table, one row per speed, linearly interpolated (clamped beyond the ends):
+
+    speed_kmh,max_curvature_1pm,max_curvature_rate_1pm_s
+    10,0.15,0.20
+    ...
+
+`tuning rollover-limits` writes this file from step-steer tests (the curvature at which LTR reaches 1, Figure 6);
+the third column is optional. Until a vehicle has been tuned, `CurvatureLimits.default_for` gives a documented
+default from the vehicle's geometry: the curvature at the steering lock, a lateral-acceleration bound a/v^2, and
+the curvature rate the steering-wheel rate limit allows at small angles, (rate / steering ratio) / wheelbase.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from workbench.errors import WorkbenchInputError, require_positive
+from workbench.vehicles.base import VehicleGeometry
+
+REQUIRED_COLUMNS = ("speed_kmh", "max_curvature_1pm")
+RATE_COLUMN = "max_curvature_rate_1pm_s"
+#: Lateral acceleration bound (g) of the default limits: above the paper's 0.3 g speed-planning bound and below
+#: the loaded truck preset's static rollover threshold (0.45 g) and dynamic thresholds ~25% lower (SAE 2003-01-3385).
+DEFAULT_LIMIT_LATERAL_ACCEL_G = 0.4
+G_MPS2 = 9.80665
+
+
+@dataclass(frozen=True)
+class CurvatureLimits:
+    """Tables of the curvature limit (1/m) and curvature-rate limit (1/(m s)) against speed (km/h)."""
+
+    speeds_kmh: tuple[float, ...]
+    max_curvature_1pm: tuple[float, ...]
+    max_curvature_rate_1pm_s: tuple[float, ...]
+    source: str = "table"
+
+    def __post_init__(self) -> None:
+        n = len(self.speeds_kmh)
+        if n == 0 or len(self.max_curvature_1pm) != n or len(self.max_curvature_rate_1pm_s) != n:
+            raise WorkbenchInputError(
+                f"{self.source}: the limit table needs one curvature and one rate per speed; got {n} speeds, "
+                f"{len(self.max_curvature_1pm)} curvatures, {len(self.max_curvature_rate_1pm_s)} rates"
+            )
+        for name, values in (
+            ("speed_kmh", self.speeds_kmh),
+            ("max_curvature_1pm", self.max_curvature_1pm),
+            ("max_curvature_rate_1pm_s", self.max_curvature_rate_1pm_s),
+        ):
+            for i, value in enumerate(values):
+                if not (math.isfinite(value) and (value > 0 or (name == "speed_kmh" and value == 0))):
+                    raise WorkbenchInputError(f"{self.source}: {name} must be finite and > 0; row {i} has {value!r}")
+        if any(b <= a for a, b in itertools.pairwise(self.speeds_kmh)):
+            raise WorkbenchInputError(f"{self.source}: speed_kmh must increase strictly; got {list(self.speeds_kmh)}")
+
+    def at_speed(self, speed_mps: float) -> tuple[float, float]:
+        """(max curvature 1/m, max curvature rate 1/(m s)) at this speed, interpolated."""
+        v = speed_mps * 3.6
+        return (
+            float(np.interp(v, self.speeds_kmh, self.max_curvature_1pm)),
+            float(np.interp(v, self.speeds_kmh, self.max_curvature_rate_1pm_s)),
+        )
+
+    @classmethod
+    def default_for(
+        cls, geometry: VehicleGeometry, max_lateral_accel_g: float = DEFAULT_LIMIT_LATERAL_ACCEL_G
+    ) -> CurvatureLimits:
+        """Limits from the vehicle's geometry (see the module docstring), tabulated from 0 to 150 km/h."""
+        require_positive("max_lateral_accel_g", max_lateral_accel_g)
+        speeds = np.arange(0.0, 151.0, 5.0)
+        lock = math.tan(geometry.max_road_wheel_angle_rad) / geometry.wheelbase_m
+        v = np.maximum(speeds / 3.6, 1e-6)
+        kappa = np.minimum(lock, max_lateral_accel_g * G_MPS2 / v**2)
+        rate = geometry.max_steer_wheel_rate_rad_s / geometry.steering_ratio / geometry.wheelbase_m
+        return cls(
+            tuple(speeds.tolist()),
+            tuple(kappa.tolist()),
+            tuple([rate] * speeds.size),
+            source=f"default limits (steering lock, {max_lateral_accel_g:g} g, steering-rate limit)",
+        )
+
+    @classmethod
+    def read_csv(cls, path: str | Path, geometry: VehicleGeometry | None = None) -> CurvatureLimits:
+        """Read a limits table; without a rate column, the rate comes from `default_for(geometry)`."""
+        path = Path(path)
+        if not path.is_file():
+            raise WorkbenchInputError(f"curvature limits file {str(path)!r} does not exist")
+        try:
+            table = pd.read_csv(path, comment="#")
+        except (ValueError, UnicodeDecodeError) as exc:
+            raise WorkbenchInputError(f"{path.name}: not a readable CSV file ({exc})") from None
+        table.columns = [str(c).strip().lower() for c in table.columns]
+        missing = [c for c in REQUIRED_COLUMNS if c not in table.columns]
+        if missing:
+            raise WorkbenchInputError(
+                f"{path.name}: missing column(s) {', '.join(missing)}; found {', '.join(table.columns)}; "
+                f"expected {', '.join(REQUIRED_COLUMNS)}[, {RATE_COLUMN}]"
+            )
+        numeric = table.apply(pd.to_numeric, errors="coerce")
+        if numeric.isna().to_numpy().any():
+            row, col = np.argwhere(numeric.isna().to_numpy())[0]
+            raise WorkbenchInputError(
+                f"{path.name}: row {row + 1} column {table.columns[col]} is {table.iat[row, col]!r}, not a number"
+            )
+        if RATE_COLUMN in numeric.columns:
+            rates = numeric[RATE_COLUMN].tolist()
+        else:
+            if geometry is None:
+                raise WorkbenchInputError(f"{path.name}: no {RATE_COLUMN} column and no vehicle to derive it from")
+            rates = [cls.default_for(geometry).max_curvature_rate_1pm_s[0]] * len(numeric)
+        return cls(
+            tuple(numeric["speed_kmh"].tolist()),
+            tuple(numeric["max_curvature_1pm"].tolist()),
+            tuple(rates),
+            source=path.name,
+        )
+
+    def write_csv(self, path: str | Path) -> None:
+        pd.DataFrame(
+            {
+                "speed_kmh": self.speeds_kmh,
+                "max_curvature_1pm": self.max_curvature_1pm,
+                RATE_COLUMN: self.max_curvature_rate_1pm_s,
+            }
+        ).to_csv(path, index=False, float_format="%.9g")

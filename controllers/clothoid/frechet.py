@@ -1,0 +1,182 @@
+"""Discrete Fréchet distance between two polylines: the dissimilarity score of the adaptive lookahead (paper,
+section 3, Eq. 4 and Appendix A; Eiter & Mannila 1994).
+
+Definition. The Fréchet distance of Eq. 4 is FD(P, Q) = inf over monotone reparametrisations (gamma, delta) of
+max_t d(P(gamma(t)), Q(delta(t))): the shortest leash that lets a walker on P and one on Q go from start to end
+without ever stepping back. Its discrete form, the one Appendix A computes, restricts both walkers to the given
+vertices P_0..P_{n-1} and Q_0..Q_{m-1}: a coupling is a sequence of index pairs (0, 0) = (i_0, j_0), ...,
+(i_K, j_K) = (n-1, m-1) where each step advances i, j or both by one, and
+
+    d_F(P, Q) = min over couplings of max_k |P_{i_k} - Q_{j_k}|      (Euclidean norm).
+
+It obeys the recursion of Appendix A's matrix, filled row by row from the top-left corner:
+
+    c(0, 0) = |P_0 - Q_0|,
+    c(i, j) = max(|P_i - Q_j|, min(c(i-1, j), c(i, j-1), c(i-1, j-1)))   (absent neighbours count as +inf),
+
+and d_F = c(n-1, m-1), the bottom-right corner.
+
+Sampling. This is the coupling distance over the vertices as given, so it depends on how the curves are sampled:
+it is always >= the continuous Fréchet distance of the two polylines (a discrete coupling is one of the
+continuous ones) and exceeds it by at most the longest edge of either curve (Eiter & Mannila), so it converges as
+the sampling is refined. It is also at least the distance between the start points and between the end points,
+and at most the largest vertex-to-vertex distance. The controller samples the clothoid and the reference path at
+the same number of points, where the lock-step coupling max_i |P_i - Q_i| bounds it from above.
+
+Cost. O(n m) time and O(min(n, m)) memory: one rolling row over the shorter curve, no recursion, no allocation
+but that row. The hot loop compares squared distances (one sqrt at the end; sqrt is monotone, so the min/max
+recursion picks the same cells); when the squared result leaves the range where squaring is exact to rounding
+(distances below 1e-140 or above 1e140 m, where squares underflow or overflow) it is recomputed with hypot.
+About 1.7 us at 30x30 (see `frechet_kernel`).
+
+`discrete_frechet` is the checked public entry point; `frechet_kernel` and `frechet_with_early_exit` are the
+compiled kernels for callers inside numba code (the lookahead search), which must pass finite float64 arrays.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from workbench.errors import WorkbenchInputError
+
+# Squared distances within [_SQ_LOW, _SQ_HIGH] are normal floats whose square root is as accurate as hypot's;
+# outside it (distances < 1e-140 or > 1e140) squaring may have underflowed or overflowed somewhere.
+_SQ_LOW = 1e-280
+_SQ_HIGH = 1e280
+
+
+@njit(cache=True)
+def _coupling_dp(
+    ax: np.ndarray, ay: np.ndarray, bx: np.ndarray, by: np.ndarray, squared: bool, limit: float
+) -> float:  # pragma: no cover - compiled
+    """The DP's bottom-right cell with the rolling row over B (the caller passes the shorter curve as B).
+
+    Cells hold squared distances if `squared`, else distances. Returns -1.0 as soon as the smallest cell of a
+    row exceeds `limit` (compared as a distance: sqrt of the cell if squared): every coupling crosses every row
+    and the cells never decrease along it, so the final value exceeds `limit` too.
+    """
+    n, m = ax.size, bx.size
+    row = np.empty(m)
+    # Row 0: Q's walker advances while P's waits at P_0.
+    x0, y0 = ax[0], ay[0]
+    acc = 0.0
+    for j in range(m):
+        dx, dy = x0 - bx[j], y0 - by[j]
+        d = dx * dx + dy * dy if squared else math.hypot(dx, dy)
+        if d > acc:
+            acc = d
+        row[j] = acc
+    row_min = row[0]  # row 0 is non-decreasing
+    if (math.sqrt(row_min) if squared else row_min) > limit:
+        return -1.0
+    for i in range(1, n):
+        xi, yi = ax[i], ay[i]
+        dx, dy = xi - bx[0], yi - by[0]
+        d = dx * dx + dy * dy if squared else math.hypot(dx, dy)
+        diag = row[0]
+        left = d if d > diag else diag
+        row[0] = left
+        row_min = left
+        for j in range(1, m):
+            up = row[j]
+            best = diag if diag < up else up
+            if left < best:
+                best = left
+            dx, dy = xi - bx[j], yi - by[j]
+            d = dx * dx + dy * dy if squared else math.hypot(dx, dy)
+            v = d if d > best else best
+            row[j] = v
+            if v < row_min:
+                row_min = v
+            diag = up
+            left = v
+        if (math.sqrt(row_min) if squared else row_min) > limit:
+            return -1.0
+    return row[m - 1]
+
+
+@njit(cache=True)
+def _frechet_limited(
+    px: np.ndarray, py: np.ndarray, qx: np.ndarray, qy: np.ndarray, limit: float
+) -> float:  # pragma: no cover - compiled
+    """The discrete Fréchet distance, or -1.0 once it is known to exceed `limit` (pass inf for no early exit)."""
+    if px.size == 0 or qx.size == 0:
+        return np.nan
+    swap = qx.size > px.size
+    # Squared arithmetic is safe for the early exit only while limit**2 is a normal float: otherwise work in
+    # distances throughout.
+    if _SQ_LOW <= limit * limit <= _SQ_HIGH or limit == np.inf:
+        r2 = _coupling_dp(qx, qy, px, py, True, limit) if swap else _coupling_dp(px, py, qx, qy, True, limit)
+        if r2 < 0.0:
+            return -1.0
+        if _SQ_LOW <= r2 <= _SQ_HIGH:
+            return math.sqrt(r2)
+    return _coupling_dp(qx, qy, px, py, False, limit) if swap else _coupling_dp(px, py, qx, qy, False, limit)
+
+
+@njit(cache=True)
+def frechet_kernel(px: np.ndarray, py: np.ndarray, qx: np.ndarray, qy: np.ndarray) -> float:  # pragma: no cover
+    """Discrete Fréchet distance between P = (px, py) and Q = (qx, qy): finite float64 1-D arrays of lengths
+    n, m >= 1 (NaN if either is empty; no other checks). O(n m) time, one row of min(n, m) floats.
+
+    Measured from Python (numba 0.68, one core): 1.1 us at 20x20, 1.7 us at 30x30, 2.6 us at 40x40, 13 us at
+    100x100, i.e. ~1.3 ns per cell (the row's min/max chain) plus ~0.4 us for the call itself.
+    """
+    return _frechet_limited(px, py, qx, qy, np.inf)
+
+
+@njit(cache=True)
+def frechet_with_early_exit(
+    px: np.ndarray, py: np.ndarray, qx: np.ndarray, qy: np.ndarray, threshold: float
+) -> bool:  # pragma: no cover - compiled
+    """Whether frechet_kernel(px, py, qx, qy) <= threshold, stopping at the first DP row whose every cell
+    exceeds the threshold. For thresholds in [1e-140, 1e140] m it runs the very arithmetic of the full computation,
+    so the answer is exactly `frechet_kernel(...) <= threshold`; False for a NaN or negative threshold or an
+    empty curve.
+    """
+    if not threshold >= 0.0:
+        return False
+    d = _frechet_limited(px, py, qx, qy, threshold)
+    return d >= 0.0 and d <= threshold
+
+
+def _as_curve(name: str, curve: object) -> np.ndarray:
+    """`curve` as a float (n, 2) array with n >= 1 and finite entries, else WorkbenchInputError naming `name`."""
+    try:
+        arr = np.asarray(curve, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise WorkbenchInputError(f"curve {name} must be an array of (x, y) points of shape (n, 2); {exc}") from None
+    if arr.size == 0:
+        raise WorkbenchInputError(f"curve {name} is empty (shape {arr.shape}); it needs at least 1 (x, y) point")
+    if arr.ndim != 2 or arr.shape[1] != 2:
+        raise WorkbenchInputError(f"curve {name} must have shape (n, 2) (one (x, y) row per point); got {arr.shape}")
+    bad = ~np.isfinite(arr)
+    if bad.any():
+        point, coord = (int(k) for k in np.argwhere(bad)[0])
+        raise WorkbenchInputError(
+            f"curve {name} must be finite numbers; point {point} has {'xy'[coord]} = {float(arr[point, coord])!r}"
+        )
+    return arr
+
+
+def discrete_frechet(P: object, Q: object) -> float:
+    """Discrete Fréchet distance (m) between polylines P, shape (n, 2), and Q, shape (m, 2), n, m >= 1.
+
+    The coupling distance over the given vertices (see the module docstring): symmetric, zero for identical
+    curves, between max(|P_0 - Q_0|, |P_n-1 - Q_m-1|) and max_ij |P_i - Q_j|, and an upper bound of the
+    continuous Fréchet distance. Raises WorkbenchInputError for a curve of the wrong shape, without points or
+    with a non-finite entry.
+    """
+    p = _as_curve("P", P)
+    q = _as_curve("Q", Q)
+    return float(
+        frechet_kernel(
+            np.ascontiguousarray(p[:, 0]),
+            np.ascontiguousarray(p[:, 1]),
+            np.ascontiguousarray(q[:, 0]),
+            np.ascontiguousarray(q[:, 1]),
+        )
+    )
