@@ -7,6 +7,7 @@ registered name and `CONTROLLERS` lists them.
 from __future__ import annotations
 
 from controllers.base import Controller, Measurement
+from controllers.clothoid import ClothoidConfig, ClothoidController
 from controllers.pure_pursuit import PurePursuit, PurePursuitConfig
 from controllers.stanley import Stanley, StanleyConfig
 from workbench.errors import WorkbenchInputError
@@ -14,6 +15,7 @@ from workbench.vehicles.base import VehicleGeometry
 
 #: name -> controller class, in the order `workbench controllers` lists them.
 CONTROLLERS: dict[str, type[Controller]] = {
+    ClothoidController.name: ClothoidController,
     PurePursuit.name: PurePursuit,
     Stanley.name: Stanley,
 }
@@ -30,6 +32,8 @@ def make_controller(name: str, geometry: VehicleGeometry, config: object | None 
 
 __all__ = [
     "CONTROLLERS",
+    "ClothoidConfig",
+    "ClothoidController",
     "Controller",
     "Measurement",
     "PurePursuit",

@@ -9,6 +9,7 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from controllers import CONTROLLERS, make_controller
+from controllers.config_file import config_template, read_controller_config
 from workbench.errors import WorkbenchInputError
 from workbench.scenarios import ScenarioOptions, describe_scenarios, make_scenario
 from workbench.simulator import Simulation, SimulationConfig
@@ -28,11 +29,25 @@ def _parser() -> argparse.ArgumentParser:
     scen.add_argument("--track", type=Path, help="Zandvoort track CSV (TUMFTM racetrack-database format)")
     veh = sub.add_parser("vehicles", help="list the vehicle models and presets")
     veh.add_argument("--show", metavar="NAME", help="print a preset's TOML (copy, edit, pass with --vehicle-file)")
-    sub.add_parser("controllers", help="list the controllers")
+    ctl = sub.add_parser("controllers", help="list the controllers")
+    ctl.add_argument("--show", metavar="NAME", help="print a controller's options as TOML (for --controller-config)")
 
     run = sub.add_parser("run", help="simulate one controller on one vehicle along one scenario")
     run.add_argument("scenario", help="a scenario name (see `workbench scenarios`) or a waypoint CSV file")
     run.add_argument("--controller", default="pure-pursuit", help="controller name (default: pure-pursuit)")
+    run.add_argument(
+        "--controller-config",
+        type=Path,
+        metavar="FILE.toml",
+        help="controller options: a TOML file with a [<controller name>] table (see `workbench controllers --show`)",
+    )
+    run.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help="a controller option, over the config file (repeatable), e.g. --set frechet_threshold_m=0.3",
+    )
     run.add_argument("--vehicle", default=None, help="vehicle model (default: kinematic-bicycle)")
     run.add_argument("--vehicle-file", type=Path, help="a vehicle TOML file (see `workbench vehicles --show`)")
     run.add_argument("--payload-kg", type=float, help="payload of vehicles that carry one (tractor-semitrailer)")
@@ -50,7 +65,12 @@ def _parser() -> argparse.ArgumentParser:
 def _run(args: argparse.Namespace) -> int:
     name = args.vehicle if args.vehicle or args.vehicle_file else "kinematic-bicycle"
     vehicle = make_vehicle(name, payload_kg=args.payload_kg, vehicle_file=args.vehicle_file)
-    controller = make_controller(args.controller, vehicle.geometry)
+    if args.controller not in CONTROLLERS:
+        make_controller(args.controller, vehicle.geometry)  # raises the unknown-name error
+    options = read_controller_config(
+        args.controller_config, args.controller, CONTROLLERS[args.controller].config_type, args.set
+    )
+    controller = make_controller(args.controller, vehicle.geometry, options)
     scenario = make_scenario(
         args.scenario, ScenarioOptions(vehicle_width_m=vehicle.geometry.width_m, track_file=args.track)
     )
@@ -96,6 +116,13 @@ def main(argv: Sequence[str] | None = None) -> int:
                 for name, description in list_presets().items():
                     print(f"{name:<20} {description}\n{'':<20} {VEHICLES[name]().describe()}")
         elif args.command == "controllers":
+            if args.show:
+                if args.show not in CONTROLLERS:
+                    raise WorkbenchInputError(
+                        f"unknown controller {args.show!r}; choose one of {', '.join(CONTROLLERS)}"
+                    )
+                print(config_template(args.show, CONTROLLERS[args.show].config_type), end="")
+                return 0
             for name, cls in CONTROLLERS.items():
                 print(f"{name:<14} {cls.summary()}")
         else:

@@ -1,4 +1,26 @@
-"""The clothoid-based lateral controller of Shaju, Southward & Ahmadian (2024): per-step hyper-clothoid,
-Fréchet-distance adaptive lookahead, curvature limits and lead filter. Its modules arrive with issue 4; until then
-this package is empty and no controller is registered under "clothoid".
+"""The clothoid-based lateral controller of Shaju, Southward & Ahmadian (2024): per-step hyper-clothoid
+(`clothoid_fit`), Fréchet-distance adaptive lookahead (`frechet`, `lookahead`), curvature limits
+(`curvature_limits`) and lead filter (`lead_filter`, `filter_file`), put together in `controller`.
 """
+
+from controllers.clothoid.clothoid_fit import ClothoidFit, fit_hyper_clothoid
+from controllers.clothoid.controller import ClothoidConfig, ClothoidController
+from controllers.clothoid.curvature_limits import CurvatureLimits
+from controllers.clothoid.filter_file import DEFAULT_FILTER, FilterSchedule, read_filter_file, write_filter_file
+from controllers.clothoid.frechet import discrete_frechet
+from controllers.clothoid.lead_filter import DiscreteLeadFilter, LeadFilterParams
+
+__all__ = [
+    "DEFAULT_FILTER",
+    "ClothoidConfig",
+    "ClothoidController",
+    "ClothoidFit",
+    "CurvatureLimits",
+    "DiscreteLeadFilter",
+    "FilterSchedule",
+    "LeadFilterParams",
+    "discrete_frechet",
+    "fit_hyper_clothoid",
+    "read_filter_file",
+    "write_filter_file",
+]

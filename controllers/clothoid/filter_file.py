@@ -238,11 +238,11 @@ def write_filter_file(
     plant: Mapping[str, float] | None = None,
     speed_kmh: float | None = None,
     extra: Mapping[str, Any] | None = None,
-) -> None:
-    """Write a lead-filter file (JSON, or TOML for a .toml name). source: how the filter was designed (free text);
-    plant: the Eq. 5 lag {"omega_n_rad_s", "zeta"} it was designed for; speed_kmh: the design speed (km/h); extra:
-    design metadata (e.g. bandwidths), stored under "design". For a schedule, the top-level filter is the one at
-    speed_kmh (by default the first speed of the schedule)."""
+) -> Path:
+    """Write a lead-filter file and return its path (JSON, or TOML for a .toml name). source: how the filter was
+    designed (free text); plant: the Eq. 5 lag {"omega_n_rad_s", "zeta"} it was designed for; speed_kmh: the
+    design speed (km/h); extra: design metadata (e.g. bandwidths), stored under "design". For a schedule, the
+    top-level filter is the one at speed_kmh (by default the first speed of the schedule)."""
     path = Path(path)
     suffix = _suffix(path)
     if not isinstance(source, str):
@@ -282,3 +282,4 @@ def write_filter_file(
         path.write_text(text, encoding="utf-8")
     except OSError as exc:
         raise WorkbenchInputError(f"lead filter file {path}: cannot be written: {exc}") from None
+    return path

@@ -204,6 +204,12 @@ class DiscreteLeadFilter:
         u0 = float(u0)
         self._x = (u0, u0, u0)
 
+    def continue_from(self, other: DiscreteLeadFilter) -> DiscreteLeadFilter:
+        """Take over the state of `other` (a filter of other parameters: a speed schedule moving on). The states
+        are the same physical signals (the lag chain), so the switch is bumpless at steady state."""
+        self._x = other._x
+        return self
+
     def step(self, u: float) -> float:
         """Advance one sample with input u; return the output y[k] = C x[k] + D u[k]."""
         b1, a21, b2, a31, a32, b3, c1, c2, d = self._coeffs

@@ -133,3 +133,18 @@ def test_truck_run_with_payload_fills_the_vehicle_metrics(tmp_path: Path) -> Non
 def test_payload_on_a_car_is_rejected(tmp_path: Path, capsys) -> None:
     assert main(["run", "dlc", "--vehicle", "kinematic-bicycle", "--payload-kg", "500", "--out", str(tmp_path)]) == 2
     assert "payload" in capsys.readouterr().err
+
+
+def test_clothoid_options_from_a_config_file_and_set(tmp_path: Path, capsys) -> None:
+    assert main(["controllers", "--show", "clothoid"]) == 0
+    template = capsys.readouterr().out
+    assert "[clothoid]" in template and "frechet_threshold_m" in template
+    config = tmp_path / "clothoid.toml"
+    config.write_text(template.replace('lookahead_mode = "adaptive"', 'lookahead_mode = "fixed"'))
+    out = tmp_path / "run"
+    args = ["run", "fig17", "--controller", "clothoid", "--controller-config", str(config), "--out", str(out)]
+    assert main([*args, "--set", "fixed_lookahead_m=7", "--no-plots"]) == 0
+    trace = pd.read_parquet(out / "trace.parquet")
+    assert (trace["ctrl_lookahead_m"] == 7.0).all()
+    assert main([*args, "--set", "fixed_lookahead_m=-7"]) == 2
+    assert "fixed_lookahead_m must be in [0.5, 200.0] m; got -7.0" in capsys.readouterr().err

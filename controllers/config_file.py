@@ -1,0 +1,150 @@
+"""Controller options from a TOML file and `key=value` overrides, checked against the controller's config dataclass.
+
+A config file holds one table per controller name, so one file can configure several controllers:
+
+    [clothoid]
+    lookahead_mode = "adaptive"
+    frechet_threshold_m = 0.5
+    filter_file = "lead.json"      # relative paths are taken relative to the config file
+
+    [pure-pursuit]
+    lookahead_gain_s = 0.8
+
+Overrides (`--set frechet_threshold_m=0.3` on the command line) apply on top. Keys are the config dataclass's field
+names; a key that is not one, or a value of the wrong type, is an error that lists what is allowed. Fields may be
+float, int, bool, str, Path or `Path | None` (written "none" to clear).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import tomllib
+import types
+import typing
+from collections.abc import Iterable, Mapping
+from pathlib import Path
+from typing import Any
+
+from workbench.errors import WorkbenchInputError
+
+_TRUE = ("true", "yes", "on", "1")
+_FALSE = ("false", "no", "off", "0")
+
+
+def _field_types(config_type: type) -> dict[str, Any]:
+    hints = typing.get_type_hints(config_type)
+    return {f.name: hints[f.name] for f in dataclasses.fields(config_type) if f.init}
+
+
+def _coerce(name: str, value: Any, annotation: Any, base_dir: Path | None) -> Any:
+    """`value` (from TOML, or a string from the command line) as the type `annotation` of field `name`."""
+    optional = False
+    if isinstance(annotation, types.UnionType) or typing.get_origin(annotation) is typing.Union:
+        members = [a for a in typing.get_args(annotation) if a is not type(None)]
+        optional = len(members) < len(typing.get_args(annotation))
+        annotation = members[0] if len(members) == 1 else annotation
+    if optional and (value is None or (isinstance(value, str) and value.lower() in ("none", ""))):
+        return None
+    text = value if isinstance(value, str) else None
+    try:
+        if annotation is bool:
+            if isinstance(value, bool):
+                return value
+            if text is not None and text.lower() in _TRUE + _FALSE:
+                return text.lower() in _TRUE
+        elif annotation is int:
+            if isinstance(value, int) and not isinstance(value, bool):
+                return value
+            if text is not None:
+                return int(text)
+        elif annotation is float:
+            if isinstance(value, int | float) and not isinstance(value, bool):
+                return float(value)
+            if text is not None:
+                return float(text)
+        elif annotation is str:
+            if text is not None:
+                return text
+        elif annotation is Path:
+            if text is not None:
+                path = Path(text).expanduser()
+                return path if path.is_absolute() or base_dir is None else base_dir / path
+        else:
+            raise WorkbenchInputError(f"option {name!r} has type {annotation!r}, which cannot be set from a file")
+    except ValueError:
+        pass
+    kind = getattr(annotation, "__name__", str(annotation)) + (" or none" if optional else "")
+    raise WorkbenchInputError(f"option {name!r} must be a {kind}; got {value!r}")
+
+
+def build_config(
+    config_type: type,
+    values: Mapping[str, Any] | None = None,
+    overrides: Iterable[str] = (),
+    base_dir: Path | None = None,
+) -> Any:
+    """An instance of `config_type` from `values` (a TOML table) and `key=value` overrides; its defaults otherwise."""
+    fields = _field_types(config_type)
+    merged: dict[str, Any] = {}
+    items = list((values or {}).items())
+    for override in overrides:
+        key, sep, text = override.partition("=")
+        if not sep:
+            raise WorkbenchInputError(f"an option override must look like key=value; got {override!r}")
+        items.append((key.strip(), text.strip()))
+    for key, value in items:
+        if key not in fields:
+            raise WorkbenchInputError(
+                f"unknown option {key!r} for {config_type.__name__}; allowed: {', '.join(fields)}"
+            )
+        merged[key] = _coerce(key, value, fields[key], base_dir)
+    return config_type(**merged)
+
+
+def read_controller_config(
+    path: str | Path | None, controller_name: str, config_type: type, overrides: Iterable[str] = ()
+) -> Any:
+    """The config of `controller_name` from the table of that name in the TOML file at `path` (None: no file),
+    with `overrides` applied on top."""
+    table: Mapping[str, Any] = {}
+    base_dir = None
+    if path is not None:
+        path = Path(path)
+        try:
+            document = tomllib.loads(path.read_text())
+        except FileNotFoundError:
+            raise WorkbenchInputError(f"controller config file {str(path)!r} does not exist") from None
+        except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
+            raise WorkbenchInputError(f"controller config file {str(path)!r} is not valid TOML: {exc}") from None
+        table = document.get(controller_name, {})
+        if not isinstance(table, dict):
+            raise WorkbenchInputError(
+                f"controller config file {str(path)!r}: [{controller_name}] must be a table; got {table!r}"
+            )
+        base_dir = path.resolve().parent
+    try:
+        return build_config(config_type, table, overrides, base_dir)
+    except WorkbenchInputError as exc:
+        where = f"controller config file {str(path)!r}, [{controller_name}]: " if path is not None else ""
+        raise WorkbenchInputError(f"{where}{exc}") from None
+
+
+def config_template(controller_name: str, config_type: type) -> str:
+    """A TOML table of the controller's options at their defaults, to copy and edit (`workbench controllers
+    --show NAME`). Options whose default is None are written commented out."""
+    defaults = config_type()
+    lines = [f"# {config_type.__name__}: options and defaults; see its docstring for units and meaning.", ""]
+    lines.append(f"[{controller_name}]")
+    for f in dataclasses.fields(config_type):
+        if not f.init:
+            continue
+        value = getattr(defaults, f.name)
+        if value is None:
+            lines.append(f'# {f.name} = "..."')
+        elif isinstance(value, bool):
+            lines.append(f"{f.name} = {'true' if value else 'false'}")
+        elif isinstance(value, str | Path):
+            lines.append(f'{f.name} = "{value}"')
+        else:
+            lines.append(f"{f.name} = {value!r}")
+    return "\n".join(lines) + "\n"
