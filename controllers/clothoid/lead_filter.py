@@ -170,12 +170,6 @@ class DiscreteLeadFilter:
                 f"the lead filter discretised at dt_s = {dt_s!r} s is unstable: pole magnitudes "
                 f"{np.abs(self.poles).round(9).tolist()} (all must be < 1)"
             )
-        self.state_space: tuple[tuple[tuple[float, ...], ...], tuple[float, ...], tuple[float, ...], float] = (
-            tuple(tuple(float(v) for v in row) for row in a),
-            tuple(float(v) for v in b[:, 0]),
-            tuple(float(v) for v in c[0]),
-            float(d[0, 0]),
-        )
         # Steady state x = (u, u, u) and DC gain 1 mean each row of [A B] and [C D] sums to 1, and A is lower
         # triangular; step() uses that form (differences to x_i), exact at steady state and free of cancellation.
         rows = [(*a[i, :i], b[i, 0]) for i in range(3)]
@@ -187,12 +181,26 @@ class DiscreteLeadFilter:
             )
         self._coeffs = tuple(float(v) for v in (*rows[0], *rows[1], *rows[2], c[0, 0], c[0, 1], d[0, 0]))
         self._x = (0.0, 0.0, 0.0)
+        # The realisation step() implements: each diagonal entry of A and the last weight of C are what makes its
+        # row sum to 1, so the steady state and the DC gain of 1 are exact, not subject to cont2discrete's rounding.
+        b1, a21, b2, a31, a32, b3, c1, c2, d0 = self._coeffs
+        self.state_space: tuple[tuple[tuple[float, ...], ...], tuple[float, ...], tuple[float, ...], float] = (
+            ((1.0 - b1, 0.0, 0.0), (a21, 1.0 - a21 - b2, 0.0), (a31, a32, 1.0 - a31 - a32 - b3)),
+            (b1, b2, b3),
+            (c1, c2, 1.0 - c1 - c2 - d0),
+            d0,
+        )
 
     @property
     def dc_gain(self) -> float:
-        """Steady-state gain of the discrete filter, C (I - A)^-1 B + D (1 up to rounding)."""
-        a, b, c, d = self.state_space
-        return float(np.asarray(c) @ np.linalg.solve(np.eye(3) - np.asarray(a), np.asarray(b)) + d)
+        """Steady-state gain of the filter step() implements, C (I - A)^-1 B + D (1 up to rounding).
+
+        I - A is formed from the difference-form coefficients directly: 1 - A_ii would lose the digits of the
+        poles' distance from 1 (about wp dt), which the output weights (about (wp / wz)^2) then amplify."""
+        b1, a21, b2, a31, a32, b3, c1, c2, d = self._coeffs
+        i_minus_a = np.array([[b1, 0.0, 0.0], [-a21, a21 + b2, 0.0], [-a31, -a32, a31 + a32 + b3]])
+        x1, x2, x3 = np.linalg.solve(i_minus_a, np.array([b1, b2, b3]))
+        return float(x3 + c1 * (x1 - x3) + c2 * (x2 - x3) + d * (1.0 - x3))
 
     @property
     def state(self) -> tuple[float, float, float]:
