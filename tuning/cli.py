@@ -1,56 +1,363 @@
-"""The `tuning` command line: tools that turn vehicle logs into the parameter files the controllers read."""
+"""The `tuning` command line: tools that turn vehicle logs into the parameter files the controllers read.
+
+    tuning generate-data    drive a plant open loop with a steering profile, write a vehicle log (CSV)
+    tuning fit-lag          fit the lag of Eq. 5 to vehicle logs, write lag.json (steering-lag/1)
+    tuning design-lead      design the lead filter of Eq. 6 for a lag, write lead.json/.toml (lead-filter/1)
+    tuning rollover-limits  step-steer series: curvature at LTR = 1 per speed, write limits.csv
+    tuning schedule         lag and lead filter at each speed, write a scheduled lead-filter file
+
+Exit codes: 0 done; 2 bad input (one line on stderr naming the value and what is allowed).
+"""
 
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 from collections.abc import Sequence
 from pathlib import Path
 
+from controllers.clothoid.filter_file import write_filter_file
 from tuning.data_generation import generate_open_loop_log
+from tuning.lag_fit import CURVATURE_SOURCES, LagFitOptions, SteeringGeometry, fit_lag
+from tuning.lead_design import DEFAULT_MAX_CASCADE_PEAK_DB, DEFAULT_MAX_LEAD_GAIN, design_lead, validate
+from tuning.log_file import read_log
 from tuning.maneuvers import Maneuver
+from tuning.rollover import rollover_limits, table, to_curvature_limits
+from tuning.schedule import (
+    DEFAULT_LAT_ACCEL_G,
+    compare_closed_loop,
+    fixed_and_scheduled_filters,
+    identify_schedule,
+    steer_amplitude_deg,
+)
+from tuning.speeds import parse_speeds
 from workbench.errors import WorkbenchInputError
 from workbench.vehicles import make_vehicle
+from workbench.vehicles.base import VehicleModel
+from workbench.vehicles.steering_lag import read_lag_file, write_lag_file
 
 EXIT_INPUT_ERROR = 2
+FORMATS = ("json", "toml")
+
+
+def _vehicle_options(parser: argparse.ArgumentParser, required: bool = True) -> None:
+    what = "" if required else " (or --wheelbase-m and --steering-ratio)"
+    parser.add_argument("--vehicle", help=f"vehicle model (see `workbench vehicles`){what}")
+    parser.add_argument("--vehicle-file", type=Path, help="a vehicle TOML file instead of a named preset")
+    parser.add_argument("--payload-kg", type=float, help="payload of vehicles that carry one (tractor-semitrailer)")
+
+
+def _geometry_options(parser: argparse.ArgumentParser) -> None:
+    _vehicle_options(parser, required=False)
+    parser.add_argument("--wheelbase-m", type=float, help="wheelbase of a vehicle without a model here (m)")
+    parser.add_argument("--steering-ratio", type=float, help="its steering ratio (steering wheel / road wheel)")
+
+
+def _format_option(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--format", choices=FORMATS, help="file format (default: by the --out suffix, .json or .toml)")
+
+
+def _design_options(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--max-lead-gain",
+        type=float,
+        default=DEFAULT_MAX_LEAD_GAIN,
+        help=f"bound on the peak gain of the lead filter, which bounds how much it raises the steering rate "
+        f"(linear; default {DEFAULT_MAX_LEAD_GAIN:g} = {20 * math.log10(DEFAULT_MAX_LEAD_GAIN):.0f} dB)",
+    )
+    parser.add_argument(
+        "--max-cascade-peak-db",
+        type=float,
+        default=DEFAULT_MAX_CASCADE_PEAK_DB,
+        help=f"bound on the resonance of lead x lag (dB; default {DEFAULT_MAX_CASCADE_PEAK_DB:g})",
+    )
 
 
 def _parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="tuning", description="Identify vehicle lag and tune controller filters.")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+
     gen = sub.add_parser(
         "generate-data",
         help="drive a plant open loop with a steering profile and write a CSV log (the fit-lag input format)",
     )
-    gen.add_argument("--vehicle", help="vehicle model (see `workbench vehicles`)")
-    gen.add_argument("--vehicle-file", type=Path, help="a vehicle TOML file instead of a named preset")
-    gen.add_argument("--payload-kg", type=float, help="payload of vehicles that carry one (tractor-semitrailer)")
+    _vehicle_options(gen)
     gen.add_argument("--maneuver", required=True, choices=Maneuver.KINDS, help="steering-wheel profile")
     gen.add_argument("--speed", type=float, required=True, metavar="KMH", help="held speed, km/h")
-    gen.add_argument("--amplitude-deg", type=float, default=90.0, help="steering-wheel amplitude (default 90 deg)")
+    size = gen.add_mutually_exclusive_group()
+    size.add_argument("--amplitude-deg", type=float, help="steering-wheel amplitude (default 90 deg)")
+    size.add_argument(
+        "--lat-accel-g", type=float, help="size the amplitude for this kinematic lateral acceleration (g) instead"
+    )
     gen.add_argument("--duration-s", type=float, default=20.0, help="log length (default 20 s)")
     gen.add_argument("--sample-rate-hz", type=float, default=100.0, help="log sample rate (default 100 Hz)")
     gen.add_argument("--out", type=Path, required=True, metavar="FILE.csv", help="output CSV")
+
+    fit = sub.add_parser("fit-lag", help="fit the steering lag of Eq. 5 to vehicle logs; write lag.json")
+    fit.add_argument("logs", type=Path, nargs="+", metavar="FILE.csv", help="vehicle logs at one speed")
+    fit.add_argument("--out", type=Path, required=True, metavar="lag.json", help="output steering-lag file")
+    fit.add_argument("--plot", type=Path, metavar="FILE.png", help="Figure 8: kinematic, actual, with lag")
+    _geometry_options(fit)
+    fit.add_argument(
+        "--curvature-from",
+        choices=CURVATURE_SOURCES,
+        default="auto",
+        help="realised curvature: of the rear-axle path x, y (auto when present) or yaw rate / speed",
+    )
+    fit.add_argument("--smooth-s", type=float, default=0.3, help="window of the path derivatives (default 0.3 s)")
+    fit.add_argument("--delay", action="store_true", help="also fit a pure time delay")
+    fit.add_argument("--unit-gain", action="store_true", help="fix the steady-state gain at 1 (Eq. 5 strictly)")
+    fit.add_argument(
+        "--max-speed-variation",
+        type=float,
+        default=0.15,
+        help="largest (max - min) / mean speed over the logs (default 0.15)",
+    )
+
+    lead = sub.add_parser("design-lead", help="design the lead filter of Eq. 6 for a lag; write lead.json/.toml")
+    lead.add_argument("--lag", type=Path, required=True, metavar="lag.json", help="steering-lag file (fit-lag)")
+    lead.add_argument("--out", type=Path, required=True, metavar="lead.json", help="output lead-filter file")
+    _format_option(lead)
+    lead.add_argument("--plot", type=Path, metavar="FILE.png", help="Figure 10: Bode of plant, filter, cascade")
+    _design_options(lead)
+    lead.add_argument(
+        "--phase-at-rad-s", type=float, help="report the phases at this frequency (default: the plant's bandwidth)"
+    )
+    lead.add_argument(
+        "--validate", type=Path, nargs="+", metavar="FILE.csv", help="vehicle logs for Figure 9 (time domain)"
+    )
+    lead.add_argument(
+        "--validate-plot", type=Path, metavar="FILE.png", help="where Figure 9 goes (default: beside --out)"
+    )
+    _geometry_options(lead)
+
+    roll = sub.add_parser("rollover-limits", help="curvature at LTR = 1 per speed (Figure 6); write limits.csv")
+    _vehicle_options(roll)
+    roll.add_argument("--speeds", required=True, metavar="10,20,...,100", help="speeds, km/h")
+    roll.add_argument("--out", type=Path, required=True, metavar="limits.csv", help="output curvature-limits CSV")
+    roll.add_argument("--plot", type=Path, metavar="FILE.png", help="Figure 6")
+
+    sched = sub.add_parser("schedule", help="lag and lead filter at each speed; write a scheduled lead-filter file")
+    _vehicle_options(sched)
+    sched.add_argument("--speeds", required=True, metavar="20,30,...,90", help="speeds, km/h")
+    sched.add_argument("--out", type=Path, required=True, metavar="schedule.json", help="output lead-filter file")
+    _format_option(sched)
+    sched.add_argument(
+        "--lat-accel-g",
+        type=float,
+        default=DEFAULT_LAT_ACCEL_G,
+        help=f"kinematic lateral acceleration of the identification maneuvers (default {DEFAULT_LAT_ACCEL_G:g} g)",
+    )
+    sched.add_argument(
+        "--nominal-speed", type=float, metavar="KMH", help="speed of the top-level filter (default: the first)"
+    )
+    _design_options(sched)
+    sched.add_argument("--plot", type=Path, metavar="FILE.png", help="lag and filter against speed")
+    sched.add_argument(
+        "--compare",
+        metavar="60,80",
+        help="then run the clothoid controller on --compare-scenario at these speeds with the schedule, the fixed "
+        "filter of --nominal-speed and no filter, and print the tracking",
+    )
+    sched.add_argument("--compare-scenario", default="dlc", help="scenario of --compare (default dlc)")
     return parser
+
+
+def _vehicle(args: argparse.Namespace) -> VehicleModel:
+    if args.vehicle is None and args.vehicle_file is None:
+        raise WorkbenchInputError("give --vehicle NAME or --vehicle-file FILE")
+    return make_vehicle(args.vehicle, payload_kg=args.payload_kg, vehicle_file=args.vehicle_file)
+
+
+def _geometry(args: argparse.Namespace):
+    """The vehicle's geometry, or --wheelbase-m and --steering-ratio for a vehicle without a model here."""
+    manual = (args.wheelbase_m, args.steering_ratio)
+    if any(v is not None for v in manual):
+        if args.vehicle is not None or args.vehicle_file is not None:
+            raise WorkbenchInputError("give either --vehicle/--vehicle-file or --wheelbase-m and --steering-ratio")
+        if any(v is None for v in manual):
+            raise WorkbenchInputError("--wheelbase-m and --steering-ratio go together; give both")
+        return SteeringGeometry(args.wheelbase_m, args.steering_ratio)
+    if args.vehicle is None and args.vehicle_file is None:
+        raise WorkbenchInputError(
+            "the kinematic curvature needs the vehicle: give --vehicle NAME, --vehicle-file FILE, or "
+            "--wheelbase-m and --steering-ratio"
+        )
+    return _vehicle(args).geometry
+
+
+def _filter_path(args: argparse.Namespace) -> Path:
+    suffix = args.out.suffix.lower().lstrip(".")
+    if args.format is not None and suffix != args.format:
+        raise WorkbenchInputError(f"--out {str(args.out)!r} must end in .{args.format} for --format {args.format}")
+    if suffix not in FORMATS:
+        raise WorkbenchInputError(f"--out {str(args.out)!r} must end in .json or .toml; got {suffix or 'no suffix'!r}")
+    return args.out
+
+
+def _prepare(path: Path) -> Path:
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise WorkbenchInputError(f"cannot create the directory of {str(path)!r}: {exc}") from None
+    return path
+
+
+def _generate_data(args: argparse.Namespace) -> int:
+    vehicle = _vehicle(args)
+    amplitude = args.amplitude_deg if args.amplitude_deg is not None else 90.0
+    if args.lat_accel_g is not None:
+        if not (isinstance(args.lat_accel_g, float) and 0.0 < args.lat_accel_g <= 1.0):
+            raise WorkbenchInputError(f"--lat-accel-g must be in (0, 1] g; got {args.lat_accel_g!r}")
+        if not args.speed > 0:
+            raise WorkbenchInputError(f"speed_kmh must be > 0; got {args.speed!r}")
+        amplitude = steer_amplitude_deg(vehicle, args.speed, args.lat_accel_g)
+    maneuver = Maneuver(args.maneuver, amplitude_deg=amplitude, duration_s=args.duration_s)
+    log = generate_open_loop_log(vehicle, maneuver, args.speed, sample_rate_hz=args.sample_rate_hz)
+    _prepare(args.out)
+    log.to_csv(args.out, index=False, float_format="%.9g")
+    print(
+        f"wrote {len(log)} rows ({log['t_s'].iloc[-1]:.1f} s of {args.maneuver}, amplitude {amplitude:.1f} deg, at "
+        f"{args.speed:g} km/h) to {args.out}"
+    )
+    return 0
+
+
+def _fit_lag(args: argparse.Namespace) -> int:
+    geometry = _geometry(args)
+    options = LagFitOptions(
+        curvature_from=args.curvature_from,
+        smooth_s=args.smooth_s,
+        fit_delay=args.delay,
+        unit_gain=args.unit_gain,
+        max_speed_variation=args.max_speed_variation,
+    )
+    logs = [read_log(path) for path in args.logs]
+    fit = fit_lag(logs, geometry, options)
+    write_lag_file(fit.lag, _prepare(args.out))
+    print(fit.summary())
+    for log in fit.logs:
+        print(f"  {log.name}: NRMSE {log.nrmse:.4f} (curvature from {log.curvature_from})")
+    print(f"wrote {args.out}")
+    if args.plot:
+        from tuning.plots import lag_fit_figure
+
+        print(f"wrote {lag_fit_figure(fit, args.plot)}")
+    return 0
+
+
+def _design_lead(args: argparse.Namespace) -> int:
+    out = _filter_path(args)
+    lag = read_lag_file(args.lag)
+    design = design_lead(
+        lag,
+        max_lead_gain=args.max_lead_gain,
+        max_cascade_peak_db=args.max_cascade_peak_db,
+        phase_frequency_rad_s=args.phase_at_rad_s,
+    )
+    metadata = design.metadata()
+    traces = []
+    if args.validate:
+        geometry = _geometry(args)
+        traces = [validate(design, read_log(path), geometry) for path in args.validate]
+        metadata["validation"] = [
+            {"log": t.name, "nrmse_lagged": t.nrmse_lagged, "nrmse_compensated": t.nrmse_compensated} for t in traces
+        ]
+    speed = design.speed_kmh
+    write_filter_file(
+        _prepare(out),
+        design.params,
+        source=f"tuning design-lead from {args.lag.name}" + (f" ({lag.source})" if lag.source else ""),
+        plant={"omega_n_rad_s": lag.omega_n_rad_s, "zeta": lag.zeta},
+        speed_kmh=speed,
+        extra=metadata,
+    )
+    print(design.summary())
+    for t in traces:
+        print(
+            f"  {t.name}: RMS error against the kinematic curvature, over its range: lagged {t.nrmse_lagged:.4f}, "
+            f"compensated {t.nrmse_compensated:.4f}"
+        )
+    print(f"wrote {out}")
+    if args.plot or traces:
+        from tuning.plots import bode_figure, validation_figure
+
+        if args.plot:
+            print(f"wrote {bode_figure(design, args.plot)}")
+        if traces:
+            target = args.validate_plot or out.with_name(f"{out.stem}_validation.png")
+            print(f"wrote {validation_figure(traces, target)}")
+    return 0
+
+
+def _rollover_limits(args: argparse.Namespace) -> int:
+    vehicle = _vehicle(args)
+    speeds = parse_speeds(args.speeds)
+    limits = rollover_limits(vehicle, speeds)
+    to_curvature_limits(limits, vehicle).write_csv(_prepare(args.out))
+    print(table(limits))
+    print(f"wrote {args.out}")
+    if args.plot:
+        from tuning.plots import rollover_figure
+
+        print(f"wrote {rollover_figure(limits, args.plot, vehicle.name)}")
+    return 0
+
+
+def _schedule(args: argparse.Namespace) -> int:
+    out = _filter_path(args)
+    vehicle = _vehicle(args)
+    speeds = parse_speeds(args.speeds)
+    result = identify_schedule(
+        vehicle,
+        speeds,
+        lat_accel_g=args.lat_accel_g,
+        max_lead_gain=args.max_lead_gain,
+        max_cascade_peak_db=args.max_cascade_peak_db,
+    )
+    compare_speeds = parse_speeds(args.compare) if args.compare else None
+    if compare_speeds and args.nominal_speed not in speeds:
+        raise WorkbenchInputError(
+            f"--compare needs --nominal-speed, one of the --speeds {speeds}, for the fixed filter to compare with"
+        )
+    result.write(_prepare(out), nominal_speed_kmh=args.nominal_speed)
+    print(result.table())
+    print(f"wrote {out}")
+    if args.plot:
+        from tuning.plots import schedule_figure
+
+        print(f"wrote {schedule_figure(result, args.plot)}")
+    if compare_speeds:
+        files: dict[str, Path | None] = dict(fixed_and_scheduled_filters(vehicle, result, args.nominal_speed))
+        files["no filter"] = None
+        rows = compare_closed_loop(lambda: _vehicle(args), files, compare_speeds, args.compare_scenario)
+        print(f"clothoid controller on {args.compare_scenario} ({vehicle.name}):")
+        print("speed_kmh  filter            completed  max_abs_cte_m  rms_cte_m  max_steer_rate_deg_s")
+        for row in rows:
+            print(
+                f"{row.speed_kmh:9.1f}  {row.filter:16s}  {row.completed!s:9s}  {row.max_abs_cte_m:13.3f}  "
+                f"{row.rms_cte_m:9.3f}  {row.max_abs_steer_rate_deg_s:20.0f}"
+            )
+    return 0
+
+
+COMMANDS = {
+    "generate-data": _generate_data,
+    "fit-lag": _fit_lag,
+    "design-lead": _design_lead,
+    "rollover-limits": _rollover_limits,
+    "schedule": _schedule,
+}
 
 
 def main(argv: Sequence[str] | None = None) -> int:
     args = _parser().parse_args(argv)
     try:
-        if args.vehicle is None and args.vehicle_file is None:
-            raise WorkbenchInputError("give --vehicle NAME or --vehicle-file FILE")
-        vehicle = make_vehicle(args.vehicle, payload_kg=args.payload_kg, vehicle_file=args.vehicle_file)
-        maneuver = Maneuver(args.maneuver, amplitude_deg=args.amplitude_deg, duration_s=args.duration_s)
-        log = generate_open_loop_log(vehicle, maneuver, args.speed, sample_rate_hz=args.sample_rate_hz)
+        return COMMANDS[args.command](args)
     except WorkbenchInputError as exc:
         print(f"tuning: error: {exc}", file=sys.stderr)
         return EXIT_INPUT_ERROR
-    args.out.parent.mkdir(parents=True, exist_ok=True)
-    log.to_csv(args.out, index=False, float_format="%.9g")
-    print(
-        f"wrote {len(log)} rows ({log['t_s'].iloc[-1]:.1f} s of {args.maneuver} at {args.speed:g} km/h) to {args.out}"
-    )
-    return 0
 
 
 if __name__ == "__main__":

@@ -1,8 +1,8 @@
 """Drive a plant open loop with a steering-wheel profile at a held speed and log what a vehicle log would hold.
 
-The log's columns are the format `tuning fit-lag` reads, and the format a user's own vehicle log (GPS/IMU plus
-steering sensor) must be given in: t_s, steer_wheel_deg, speed_mps, x_m, y_m, yaw_rad, yaw_rate_rad_s, with x, y
-the rear-axle centre in a local east/north frame.
+The log's columns are the format `tuning fit-lag` reads (`tuning/log_file.py`), and the format a user's own
+vehicle log (GPS/IMU plus steering sensor) must be given in: t_s, steer_wheel_deg, speed_mps, x_m, y_m, yaw_rad,
+yaw_rate_rad_s, with x, y the rear-axle centre (the plant's reference point) in a local east/north frame.
 """
 
 from __future__ import annotations
@@ -12,12 +12,13 @@ import math
 import numpy as np
 import pandas as pd
 
+from tuning.log_file import LOG_COLUMNS
 from tuning.maneuvers import Maneuver
 from workbench.errors import require_in_range
 from workbench.speed_control import PISpeedController
 from workbench.vehicles.base import VehicleModel
 
-LOG_COLUMNS = ("t_s", "steer_wheel_deg", "speed_mps", "x_m", "y_m", "yaw_rad", "yaw_rate_rad_s")
+__all__ = ["LOG_COLUMNS", "generate_open_loop_log"]
 
 
 def generate_open_loop_log(

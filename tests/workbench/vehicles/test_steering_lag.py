@@ -18,13 +18,14 @@ from workbench.vehicles.steering_lag import SteeringLag, read_lag_file, write_la
     wn=st.floats(0.05, 200.0),
     zeta=st.floats(0.05, 10.0),
     delay=st.floats(0.0, 2.0),
+    gain=st.floats(0.05, 20.0),
     nrmse=st.one_of(st.just(math.nan), st.floats(0.0, 1.0)),
 )
-def test_round_trip(wn: float, zeta: float, delay: float, nrmse: float, tmp_path_factory) -> None:
-    lag = SteeringLag(wn, zeta, delay, nrmse, (5.0, 9.0), "test")
+def test_round_trip(wn: float, zeta: float, delay: float, gain: float, nrmse: float, tmp_path_factory) -> None:
+    lag = SteeringLag(wn, zeta, delay, steady_state_gain=gain, nrmse=nrmse, speed_range_mps=(5.0, 9.0), source="t")
     back = read_lag_file(write_lag_file(lag, tmp_path_factory.mktemp("lag") / "lag.json"))
-    assert back.omega_n_rad_s == wn and back.zeta == zeta and back.delay_s == delay
-    assert back.speed_range_mps == (5.0, 9.0) and back.source == "test"
+    assert back.omega_n_rad_s == wn and back.zeta == zeta and back.delay_s == delay and back.steady_state_gain == gain
+    assert back.speed_range_mps == (5.0, 9.0) and back.source == "t"
     assert (math.isnan(back.nrmse) and math.isnan(nrmse)) or back.nrmse == nrmse
 
 
@@ -38,6 +39,7 @@ def test_round_trip(wn: float, zeta: float, delay: float, nrmse: float, tmp_path
         ('{"format": "lead-filter/1", "omega_n_rad_s": 4, "zeta": 0.8}', "format must be 'steering-lag/1'"),
         ('{"format": "steering-lag/1", "omega_n_rad_s": -4, "zeta": 0.8}', "omega_n_rad_s must be in"),
         ('{"format": "steering-lag/1", "omega_n_rad_s": 4, "zeta": 0.8, "speed_range_mps": [9]}', "[low, high]"),
+        ('{"format": "steering-lag/1", "omega_n_rad_s": 4, "zeta": 0.8, "steady_state_gain": 0}', "steady_state_gain"),
     ],
 )
 def test_bad_files_get_a_clear_error(content: str, needle: str, tmp_path: Path) -> None:

@@ -108,41 +108,6 @@ def test_steady_state_yaw_rate_matches_the_linear_understeer_formula(speed_kmh: 
     assert 0.095 * G < out[-1, OUT["lat_accel_mps2"]] < 0.105 * G
 
 
-def peak_ltr(speed_mps: float, kinematic_curvature: float) -> tuple[float, float]:
-    """Peak LTR in a 6 s step steer, and the drive-axle path curvature when LTR first reached 1 (nan if never)."""
-    state = TRUCK.initial_state(0.0, 0.0, 0.0, speed_mps)
-    sw = TRUCK.geometry.steer_wheel_for_curvature(kinematic_curvature)
-    peak, at_one = 0.0, math.nan
-    for _ in range(300):
-        state = TRUCK.advance(state, sw, 0.0, 0.02, 20)
-        out = TRUCK.outputs(state, sw, 0.0)
-        if out[OUT["ltr"]] >= 1.0 and math.isnan(at_one):
-            at_one = out[OUT["path_curvature_1pm"]]
-        peak = max(peak, out[OUT["ltr"]])
-    return peak, at_one
-
-
-def rollover_curvature(speed_kmh: float) -> tuple[float, float]:
-    """Bisect the step size: (kinematic curvature of the smallest step that lifts a wheel, path curvature then)."""
-    lo, hi = 0.0, 0.1
-    for _ in range(11):
-        mid = 0.5 * (lo + hi)
-        lo, hi = (lo, mid) if peak_ltr(kmh(speed_kmh), mid)[0] >= 1.0 else (mid, hi)
-    return hi, peak_ltr(kmh(speed_kmh), hi)[1]
-
-
-def test_rollover_curvature_falls_with_speed_figure_6() -> None:
-    # Measured (kinematic input / path curvature at LTR = 1, 1/m): 40 km/h 0.046 / 0.040,
-    # 60 km/h 0.019 / 0.016, 80 km/h 0.0115 / 0.0088; i.e. lift-off at 0.44-0.50 g of path lateral acceleration.
-    limits = {s: rollover_curvature(s) for s in (40.0, 60.0, 80.0)}
-    kin = [limits[s][0] for s in (40.0, 60.0, 80.0)]
-    path = [limits[s][1] for s in (40.0, 60.0, 80.0)]
-    assert kin[0] > kin[1] > kin[2]
-    assert path[0] > path[1] > path[2]
-    for s, k in zip((40.0, 60.0, 80.0), path, strict=True):
-        assert 0.35 * G < k * kmh(s) ** 2 < 0.6 * G
-
-
 def test_static_rollover_threshold_is_that_of_a_loaded_van_semitrailer() -> None:
     # Reference facts: static rollover thresholds >= 0.35 g (PBS); loaded vans typically 0.4-0.5 g.
     assert 0.40 < TRUCK.derived.rollover_threshold_g < 0.50

@@ -1,0 +1,445 @@
+"""Identification of the steering lag of Eq. 5 from vehicle logs (paper, section 5.1, Figure 8).
+
+Input: the kinematic (Ackermann) curvature of the steering wheel, tan(steer_wheel / steering_ratio) / wheelbase
+(the bicycle model's tan(phi) = L / R1), and the realised curvature of the rear-axle path: by default from the
+logged rear-axle positions x, y, as the paper computes it ("the actual curvature computed from the rear axle
+coordinates"), kappa = (x' y'' - y' x'') / (x'^2 + y'^2)^1.5 with the derivatives from a Savitzky-Golay filter
+(cubic, window smooth_s; zero phase, so it adds no lag); or, when the log has no positions or on request, from
+yaw rate / speed. (On the articulated truck the two differ in transients: the rear axle's side-slip builds up
+after the yaw rate, so yaw rate / speed leads the path curvature and gives a faster lag: on the loaded truck at
+60 km/h omega_n 7.4 rad/s, zeta 1.5 against 3.4 rad/s, 1.2 from the path.)
+
+Model: measured = K x G_lag(s) e^(-s delay) kinematic, with G_lag of Eq. 5, simulated at the log's samples
+(exact first-order-hold discretisation, the linear interpolation scipy.signal.lsim uses, run by lfilter) from
+the steady state of the first sample. K, the steady-state gain, is fitted as a nuisance parameter by default:
+a vehicle that understeers reaches less than the kinematic curvature (K < 1, the understeer gradient), which
+Eq. 5 (unit DC gain) cannot express; without K the fit bends omega_n and zeta to mimic the missing gain. K goes
+into the steering-lag file as `steady_state_gain` (the MPC's lag model uses it; the lead filter of Eq. 6 keeps unit
+DC gain and does not); `unit_gain=True` fixes K = 1. The delay is fitted
+only with `fit_delay=True`.
+
+Fit: scipy.optimize.least_squares over (omega_n, zeta[, K][, delay]) jointly over all logs, from the best point
+of a coarse grid of (omega_n, zeta) (K solved linearly there); each log's residuals are scaled by its measured
+curvature range and sample count, so that each log counts equally. NRMSE (reported, and written to the lag file)
+is the root mean square over the logs of RMS(error) / range(measured curvature).
+
+Refused, with a message saying why: a log shorter than min_duration_s or min_samples, steering that hardly
+varies (std under min_steer_std_deg: no excitation), speed under min_speed_mps, speed varying over all logs by
+more than max_speed_variation of its mean (the lag depends on speed: fit each speed separately), and a fit that
+runs to a parameter bound or explains the data poorly (NRMSE over max_nrmse).
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy import linalg, optimize, signal, sparse
+
+from tuning.log_file import VehicleLog
+from tuning.savgol import savgol_matrix
+from workbench.errors import WorkbenchInputError, require_in_range, require_positive
+from workbench.vehicles.base import VehicleGeometry
+from workbench.vehicles.steering_lag import SteeringLag
+
+CURVATURE_SOURCES = ("auto", "path", "yaw-rate")
+#: Bounds of the fitted parameters: those of the steering-lag file, and a steady-state gain in [0.05, 20].
+OMEGA_N_BOUNDS = (0.05, 200.0)
+ZETA_BOUNDS = (0.05, 10.0)
+GAIN_BOUNDS = (0.05, 20.0)
+DELAY_BOUNDS = (0.0, 2.0)
+#: The coarse grid the fit starts from: omega_n (rad/s) and zeta.
+OMEGA_N_GRID = tuple(np.geomspace(0.3, 60.0, 16).tolist())
+ZETA_GRID = (0.3, 0.5, 0.7, 1.0, 1.4, 2.0, 3.0, 5.0)
+
+
+@dataclass(frozen=True)
+class LagFitOptions:
+    """How fit_lag reads and judges the data (defaults in brackets).
+
+    curvature_from: "auto" (path from x, y when the log has them, else yaw rate), "path" or "yaw-rate";
+    smooth_s: window of the Savitzky-Golay derivatives of the path (0.3 s); fit_delay: also fit a pure delay
+    (False); unit_gain: fix the steady-state gain K = 1 (False); min_duration_s (5 s), min_samples (50):
+    the shortest usable log; min_steer_std_deg: the least steering-wheel standard deviation (1 deg);
+    min_speed_mps (2 m/s); max_speed_variation: (max - min) / mean speed over all logs (0.15); max_nrmse: the
+    worst fit accepted (0.25).
+    """
+
+    curvature_from: str = "auto"
+    smooth_s: float = 0.3
+    fit_delay: bool = False
+    unit_gain: bool = False
+    min_duration_s: float = 5.0
+    min_samples: int = 50
+    min_steer_std_deg: float = 1.0
+    min_speed_mps: float = 2.0
+    max_speed_variation: float = 0.15
+    max_nrmse: float = 0.25
+
+    def __post_init__(self) -> None:
+        if self.curvature_from not in CURVATURE_SOURCES:
+            raise WorkbenchInputError(
+                f"curvature_from must be one of {', '.join(CURVATURE_SOURCES)}; got {self.curvature_from!r}"
+            )
+        require_in_range("smooth_s", self.smooth_s, 0.0, 10.0, "s")
+        require_positive("min_duration_s", self.min_duration_s)
+        if isinstance(self.min_samples, bool) or not isinstance(self.min_samples, int) or self.min_samples < 10:
+            raise WorkbenchInputError(f"min_samples must be a whole number >= 10; got {self.min_samples!r}")
+        require_in_range("min_steer_std_deg", self.min_steer_std_deg, 0.0, 360.0, "deg")
+        require_in_range("min_speed_mps", self.min_speed_mps, 0.1, 100.0, "m/s")
+        require_in_range("max_speed_variation", self.max_speed_variation, 0.0, 2.0)
+        require_in_range("max_nrmse", self.max_nrmse, 0.0, 10.0)
+
+
+@dataclass(frozen=True)
+class SteeringGeometry:
+    """What the kinematic curvature needs, for a vehicle without a model here: wheelbase_m (front axle to rear axle,
+    0.5-15 m) and steering_ratio (steering-wheel / road-wheel angle, 1-60). VehicleGeometry has both too."""
+
+    wheelbase_m: float
+    steering_ratio: float
+
+    def __post_init__(self) -> None:
+        require_in_range("wheelbase_m", self.wheelbase_m, 0.5, 15.0, "m")
+        require_in_range("steering_ratio", self.steering_ratio, 1.0, 60.0)
+
+
+@dataclass(frozen=True)
+class FittedLog:
+    """One log's curves (Figure 8): time (s), kinematic, measured and modelled (kinematic with lag) curvature
+    (1/m), and the log's NRMSE."""
+
+    name: str
+    t_s: np.ndarray
+    kinematic_1pm: np.ndarray
+    measured_1pm: np.ndarray
+    modelled_1pm: np.ndarray
+    nrmse: float
+    curvature_from: str
+
+
+@dataclass(frozen=True)
+class LagFit:
+    """The identified lag (with nrmse and speed range), the steady-state gain K, and the curves of each log."""
+
+    lag: SteeringLag
+    logs: tuple[FittedLog, ...] = field(repr=False)
+    options: LagFitOptions = field(repr=False)
+
+    @property
+    def nrmse(self) -> float:
+        return self.lag.nrmse
+
+    @property
+    def gain(self) -> float:
+        """The steady-state gain K (1 with unit_gain)."""
+        return self.lag.steady_state_gain
+
+    def summary(self) -> str:
+        lag, (v0, v1) = self.lag, self.lag.speed_range_mps or (math.nan, math.nan)
+        delay = f", delay {lag.delay_s:.3f} s" if self.options.fit_delay else ""
+        return (
+            f"omega_n {lag.omega_n_rad_s:.3f} rad/s, zeta {lag.zeta:.3f}{delay}, steady-state gain K "
+            f"{self.gain:.3f}, NRMSE {lag.nrmse:.4f} over {len(self.logs)} log(s) at {v0:.2f}-{v1:.2f} m/s "
+            f"({v0 * 3.6:.1f}-{v1 * 3.6:.1f} km/h)"
+        )
+
+
+def kinematic_curvature(steer_wheel_rad: np.ndarray, geometry: VehicleGeometry | SteeringGeometry) -> np.ndarray:
+    """Ackermann curvature (1/m) of a steering-wheel angle (rad): tan(steer_wheel / steering_ratio) / wheelbase."""
+    return np.tan(np.asarray(steer_wheel_rad, dtype=float) / geometry.steering_ratio) / geometry.wheelbase_m
+
+
+def _window(log: VehicleLog, smooth_s: float) -> int:
+    """The Savitzky-Golay window in samples: odd, at least 5, at most the log."""
+    window = max(5, round(smooth_s / log.dt_s) | 1)
+    if window > len(log):
+        raise WorkbenchInputError(
+            f"{log.name}: the smoothing window ({smooth_s:g} s = {window} samples) is longer than the log"
+        )
+    return window
+
+
+@dataclass(frozen=True)
+class _PathDerivatives:
+    """Savitzky-Golay (cubic) first and second time derivatives for one log's length, window and sample time."""
+
+    first: sparse.csr_matrix
+    second: sparse.csr_matrix
+
+    @classmethod
+    def of(cls, log: VehicleLog, window: int) -> _PathDerivatives:
+        return cls(savgol_matrix(len(log), window, 1, log.dt_s), savgol_matrix(len(log), window, 2, log.dt_s))
+
+    def curvature(self, x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(curvature 1/m, speed m/s) of the sampled path x, y."""
+        dx, dy, ddx, ddy = self.first @ x, self.first @ y, self.second @ x, self.second @ y
+        speed = np.hypot(dx, dy)
+        return (dx * ddy - dy * ddx) / np.maximum(speed, 1e-9) ** 3, speed
+
+
+def path_curvature(log: VehicleLog, smooth_s: float = 0.3) -> np.ndarray:
+    """Curvature (1/m) of the logged rear-axle path, from Savitzky-Golay (cubic) time derivatives of x and y."""
+    if not log.has_positions:
+        raise WorkbenchInputError(f"{log.name}: no x_m, y_m columns to compute the path curvature from")
+    kappa, speed = _PathDerivatives.of(log, _window(log, smooth_s)).curvature(log.x_m, log.y_m)
+    if speed.min() <= 1e-6:
+        raise WorkbenchInputError(f"{log.name}: the rear axle stands still; the path curvature is undefined")
+    return kappa
+
+
+def _path_of(kappa: np.ndarray, speed: np.ndarray, dt_s: float, heading0: float) -> tuple[np.ndarray, np.ndarray]:
+    """The path (x, y) driven at `speed` with `kappa` from heading0 (trapezoidal integration)."""
+
+    def integral(rate: np.ndarray) -> np.ndarray:
+        return np.concatenate([[0.0], np.cumsum(0.5 * (rate[1:] + rate[:-1]) * dt_s)])
+
+    heading = heading0 + integral(kappa * speed)
+    return integral(speed * np.cos(heading)), integral(speed * np.sin(heading))
+
+
+def yaw_rate_curvature(log: VehicleLog) -> np.ndarray:
+    """Curvature (1/m) as yaw rate / speed."""
+    if not log.has_yaw_rate:
+        raise WorkbenchInputError(f"{log.name}: no yaw_rate_rad_s column to compute the curvature from")
+    return log.yaw_rate_rad_s / log.speed_mps
+
+
+def realised_curvature(log: VehicleLog, options: LagFitOptions) -> tuple[np.ndarray, str]:
+    """The measured curvature (1/m) of the log and the source used ("path" or "yaw-rate")."""
+    source = options.curvature_from
+    if source == "auto":
+        source = "path" if log.has_positions else "yaw-rate"
+    if source == "path":
+        return path_curvature(log, options.smooth_s), source
+    return yaw_rate_curvature(log), source
+
+
+def simulate_unit_dc(num: np.ndarray, den: np.ndarray, u: np.ndarray, dt_s: float) -> np.ndarray:
+    """A proper transfer function num/den (coefficients in s, highest power first) driven by u sampled every dt_s,
+    from the steady state of u[0]: the exact first-order-hold discretisation (u linear between samples, as in
+    scipy.signal.lsim and python-control's forced_response), run by scipy.signal.lfilter."""
+    u = np.asarray(u, dtype=float)
+    b, a, _ = signal.cont2discrete((np.asarray(num, dtype=float), np.asarray(den, dtype=float)), dt_s, method="foh")
+    b = np.ravel(b)
+    zi = signal.lfilter_zi(b, a) * u[0]
+    return signal.lfilter(b, a, u, zi=zi)[0]
+
+
+def _lag_coefficients(omega_n: float, zeta: float, dt_s: float) -> tuple[np.ndarray, np.ndarray]:
+    """(b, a) of Eq. 5 discretised with a first-order hold at dt_s: scipy's cont2discrete "foh" formulas, written
+    out for the 2-state realisation x1' = x2, x2' = -wn^2 x1 - 2 zeta wn x2 + u, y = wn^2 x1 (the fit calls this
+    thousands of times; cont2discrete on a transfer function takes about five times longer)."""
+    a = np.array([[0.0, 1.0], [-(omega_n**2), -2.0 * zeta * omega_n]])
+    em = np.zeros((4, 4))
+    em[:2, :2] = a * dt_s
+    em[1, 2] = dt_s
+    em[2, 3] = 1.0
+    ms = linalg.expm(em)
+    ad, ms12, ms13 = ms[:2, :2], ms[:2, 2], ms[:2, 3]
+    bd = ms12 - ms13 + ad @ ms13
+    c = np.array([omega_n**2, 0.0])
+    dd = float(c @ ms13)
+    # transfer function C adj(zI - Ad) Bd / det(zI - Ad) + Dd, with adj(zI - Ad) = z I + [[-a22, a12], [a21, -a11]]
+    trace, det = ad[0, 0] + ad[1, 1], ad[0, 0] * ad[1, 1] - ad[0, 1] * ad[1, 0]
+    adj = np.array([[-ad[1, 1], ad[0, 1]], [ad[1, 0], -ad[0, 0]]])
+    den = np.array([1.0, -trace, det])
+    num = dd * den + np.array([0.0, float(c @ bd), float(c @ adj @ bd)])
+    return num, den
+
+
+def simulate_lag(
+    u: np.ndarray, dt_s: float, omega_n: float, zeta: float, gain: float = 1.0, delay_s: float = 0.0
+) -> np.ndarray:
+    """K G_lag(s) e^(-s delay) (Eq. 5) driven by u sampled every dt_s, from the steady state of u[0] (first-order
+    hold, as simulate_unit_dc); the delay shifts u by linear interpolation, holding u[0] before the start."""
+    u = np.asarray(u, dtype=float)
+    if delay_s > 0.0:
+        t = np.arange(u.size) * dt_s
+        u = np.interp(t - delay_s, t, u)
+    b, a = _lag_coefficients(omega_n, zeta, dt_s)
+    return gain * signal.lfilter(b, a, u, zi=signal.lfilter_zi(b, a) * u[0])[0]
+
+
+def _check_log(log: VehicleLog, options: LagFitOptions) -> None:
+    """Refuse a log that cannot identify a lag, saying why."""
+    if len(log) < options.min_samples or log.duration_s < options.min_duration_s:
+        raise WorkbenchInputError(
+            f"{log.name}: too short to identify a lag: {len(log)} samples over {log.duration_s:.3g} s; at least "
+            f"{options.min_samples} samples and {options.min_duration_s:g} s are needed"
+        )
+    steer_std = math.degrees(float(np.std(log.steer_wheel_rad)))
+    if steer_std < options.min_steer_std_deg:
+        raise WorkbenchInputError(
+            f"{log.name}: the steering wheel hardly moves (std {steer_std:.2f} deg, under "
+            f"{options.min_steer_std_deg:g} deg): constant steering does not excite the lag; log steps, a step series "
+            f"or a double lane change"
+        )
+    low = float(log.speed_mps.min())
+    if low < options.min_speed_mps:
+        raise WorkbenchInputError(
+            f"{log.name}: speed falls to {low:.3g} m/s, under {options.min_speed_mps:g} m/s: the curvature is "
+            f"ill-defined near standstill; log at a held speed"
+        )
+
+
+def _check_speeds(logs: Sequence[VehicleLog], options: LagFitOptions) -> tuple[float, float]:
+    low = min(float(log.speed_mps.min()) for log in logs)
+    high = max(float(log.speed_mps.max()) for log in logs)
+    mean = float(np.mean(np.concatenate([log.speed_mps for log in logs])))
+    if (high - low) / mean > options.max_speed_variation:
+        where = "the log" if len(logs) == 1 else "the logs"
+        raise WorkbenchInputError(
+            f"speed varies over {where} from {low:.3g} to {high:.3g} m/s ({low * 3.6:.1f}-{high * 3.6:.1f} km/h), "
+            f"{(high - low) / mean:.0%} of the mean; at most {options.max_speed_variation:.0%} is allowed because "
+            f"the lag depends on speed: fit each speed separately (`tuning schedule` does)"
+        )
+    return low, high
+
+
+@dataclass(frozen=True)
+class _LogData:
+    """One log prepared for the fit: kinematic and measured curvature, and how the measurement was processed, so
+    that the model's curvature can be processed the same way (`as_measured`)."""
+
+    log: VehicleLog
+    kinematic: np.ndarray
+    measured: np.ndarray
+    source: str
+    span: float
+    derivatives: _PathDerivatives | None
+    heading0: float
+
+    @classmethod
+    def of(cls, log: VehicleLog, geometry: VehicleGeometry | SteeringGeometry, options: LagFitOptions) -> _LogData:
+        measured, source = realised_curvature(log, options)
+        span = float(np.ptp(measured))
+        if span <= 0.0:
+            raise WorkbenchInputError(f"{log.name}: the measured curvature is constant; the vehicle did not turn")
+        derivatives, heading0 = None, 0.0
+        if source == "path":
+            derivatives = _PathDerivatives.of(log, _window(log, options.smooth_s))
+            heading0 = math.atan2((derivatives.first @ log.y_m)[0], (derivatives.first @ log.x_m)[0])
+        kinematic = kinematic_curvature(log.steer_wheel_rad, geometry)
+        return cls(log, kinematic, measured, source, span, derivatives, heading0)
+
+    def as_measured(self, kappa: np.ndarray) -> np.ndarray:
+        """A modelled curvature as the measurement would see it: for the path source, the curvature of the path
+        it drives at the logged speed, by the same Savitzky-Golay derivatives (so that their smoothing does not
+        bias the fit); for the yaw rate, itself."""
+        if self.derivatives is None:
+            return kappa
+        x, y = _path_of(kappa, self.log.speed_mps, self.log.dt_s, self.heading0)
+        return self.derivatives.curvature(x, y)[0]
+
+
+def fit_lag(
+    logs: Sequence[VehicleLog],
+    geometry: VehicleGeometry | SteeringGeometry,
+    options: LagFitOptions | None = None,
+    source: str = "",
+) -> LagFit:
+    """Fit Eq. 5 (omega_n, zeta; optionally a delay) to all logs jointly; see the module docstring."""
+    options = options or LagFitOptions()
+    if not logs:
+        raise WorkbenchInputError("fit_lag needs at least one vehicle log")
+    for log in logs:
+        _check_log(log, options)
+    speed_range = _check_speeds(logs, options)
+    data = [_LogData.of(log, geometry, options) for log in logs]
+    names = ["omega_n", "zeta"] + ([] if options.unit_gain else ["gain"]) + (["delay"] if options.fit_delay else [])
+    bounds = dict(omega_n=OMEGA_N_BOUNDS, zeta=ZETA_BOUNDS, gain=GAIN_BOUNDS, delay=DELAY_BOUNDS)
+    lower = np.array([bounds[n][0] for n in names])
+    upper = np.array([bounds[n][1] for n in names])
+
+    def unpack(p: np.ndarray) -> dict[str, float]:
+        values = dict(zip(names, (float(v) for v in p), strict=True))
+        values.setdefault("gain", 1.0)
+        values.setdefault("delay", 0.0)
+        return values
+
+    def residuals(p: np.ndarray) -> np.ndarray:
+        v = unpack(p)
+        parts = [
+            (d.as_measured(simulate_lag(d.kinematic, d.log.dt_s, v["omega_n"], v["zeta"], v["gain"], v["delay"]))
+             - d.measured) / (d.span * math.sqrt(d.measured.size * len(data)))
+            for d in data
+        ]  # fmt: skip
+        return np.concatenate(parts)
+
+    # Start from the best point of a coarse (omega_n, zeta) grid, the gain solved linearly at each (the model is
+    # linear in K), and any delay from 0.05 s.
+    best_start, best_cost = None, math.inf
+    for wn0, zeta0 in itertools.product(OMEGA_N_GRID, ZETA_GRID):
+        delay0 = 0.05 if options.fit_delay else 0.0
+        sims = [d.as_measured(simulate_lag(d.kinematic, d.log.dt_s, wn0, zeta0, 1.0, delay0)) for d in data]
+        weights = [1.0 / (d.span * d.span * d.measured.size) for d in data]
+        num = sum(w * float(np.dot(m, d.measured)) for w, m, d in zip(weights, sims, data, strict=True))
+        den = sum(w * float(np.dot(m, m)) for w, m in zip(weights, sims, strict=True))
+        gain0 = 1.0 if options.unit_gain else float(np.clip(num / den if den > 0 else 1.0, *GAIN_BOUNDS))
+        cost = sum(
+            w * float(np.sum((gain0 * m - d.measured) ** 2)) for w, m, d in zip(weights, sims, data, strict=True)
+        )
+        if cost < best_cost:
+            best_cost, best_start = cost, dict(omega_n=wn0, zeta=zeta0, gain=gain0, delay=delay0)
+    assert best_start is not None
+    x0 = np.clip([best_start[n] for n in names], lower, upper)
+    best = optimize.least_squares(residuals, x0, bounds=(lower, upper), x_scale="jac")
+    fitted = unpack(best.x)
+    at_bound = [n for n, x, lo, hi in zip(names, best.x, lower, upper, strict=True) if n != "delay" and
+                (x <= lo * (1 + 1e-6) or x >= hi * (1 - 1e-6))]  # fmt: skip
+    if at_bound:
+        values = ", ".join(f"{n} = {fitted[n]:.4g}" for n in at_bound)
+        hints = []
+        if fitted["zeta"] >= ZETA_BOUNDS[1] * (1 - 1e-6):
+            hints.append(
+                "a damping at its bound means the response looks first-order"
+                + (", which a delay makes likelier: try without --delay (fit_delay)" if options.fit_delay else "")
+                + (
+                    ", or that a unit gain is forced on an understeering vehicle: drop --unit-gain (unit_gain)"
+                    if options.unit_gain
+                    else ""
+                )
+            )
+        if "gain" in at_bound:
+            hints.append("a gain at its bound means the measured curvature does not scale with the steering: check "
+                         "the wheelbase, the steering ratio and the units of steer_wheel_deg")  # fmt: skip
+        hints.append("give varied steering (steps, a double lane change) at one held speed")
+        raise WorkbenchInputError(
+            f"the fit ran to the bound of {', '.join(at_bound)} ({values}; bounds omega_n {OMEGA_N_BOUNDS}, zeta "
+            f"{ZETA_BOUNDS}, gain {GAIN_BOUNDS}): these data cannot identify a second-order lag; {'; '.join(hints)}"
+        )
+    fitted_logs = []
+    for d in data:
+        model = simulate_lag(
+            d.kinematic, d.log.dt_s, fitted["omega_n"], fitted["zeta"], fitted["gain"], fitted["delay"]
+        )
+        nrmse = float(np.sqrt(np.mean((d.as_measured(model) - d.measured) ** 2)) / d.span)
+        fitted_logs.append(
+            FittedLog(d.log.name, d.log.t_s - d.log.t_s[0], d.kinematic, d.measured, model, nrmse, d.source)
+        )
+    nrmse = float(np.sqrt(np.mean([f.nrmse**2 for f in fitted_logs])))
+    if nrmse > options.max_nrmse:
+        raise WorkbenchInputError(
+            f"a second-order lag explains these data poorly (NRMSE {nrmse:.3g} over {options.max_nrmse:g}; "
+            f"omega_n {fitted['omega_n']:.3g} rad/s, zeta {fitted['zeta']:.3g}): check the wheelbase and steering "
+            f"ratio, the units of the columns, and that x_m, y_m are the rear-axle centre"
+        )
+    sources = sorted({f.curvature_from for f in fitted_logs})
+    gain_text = "K fixed at 1" if options.unit_gain else f"steady-state gain K = {fitted['gain']:.4g}"
+    text = source or (
+        f"tuning fit-lag: {', '.join(log.name for log in logs)}; curvature from {' and '.join(sources)}; {gain_text}"
+    )
+    lag = SteeringLag(
+        omega_n_rad_s=fitted["omega_n"],
+        zeta=fitted["zeta"],
+        delay_s=fitted["delay"],
+        steady_state_gain=fitted["gain"],
+        nrmse=nrmse,
+        speed_range_mps=speed_range,
+        source=text,
+    )
+    return LagFit(lag=lag, logs=tuple(fitted_logs), options=options)

@@ -1,0 +1,332 @@
+"""Design of the lead filter of Eq. 6 for an identified lag of Eq. 5, by loop shaping (paper, section 5.2).
+
+    G_lag(s)  = wn^2 / (s^2 + 2 zeta wn s + wn^2)                        (the plant, from `tuning fit-lag`)
+    G_lead(s) = wp^3 (s^2 + 2 psi wz s + wz^2) / (wz^2 (s + wp)^3)       (one complex zero pair, three real poles)
+    T(s)      = G_lead(s) G_lag(s)                                      (the cascade; DC gain 1 by structure)
+
+Two bandwidths are used. The -3 dB bandwidth w_B(G): the first frequency where |G(jw)| falls 3 dB below its DC gain
+(python-control's `bandwidth`). The tracking bandwidth w_T(G): the first frequency where the error |G(jw) - 1|
+reaches 1 - 10^(-3/20) = 0.29, i.e. up to which the lagged curvature follows the kinematic curvature to within
+the error a 3 dB loss alone would give; it counts phase lag as well as lost magnitude, which is what the lead filter
+is for (the compensated curvature should be the kinematic one, Figure 9).
+
+The bounds:
+
+    max_w |G_lead(jw)| <= max_lead_gain           (default 10, i.e. 20 dB)
+    max_w |T(jw)|      <= max_cascade_peak_db     (default 1 dB over the DC gain of 1)
+    1 <= wp / wz <= 100, 0 < psi <= 5             (the ranges of LeadFilterParams)
+
+The first bounds the high-frequency gain and so the steering-rate demand: the filter multiplies the amplitude, and
+so the rate, of every frequency component of the steering command by |G_lead(jw)|, so its peak gain is the most by
+which it can raise the steering rate (and the noise) the controller asks for. (Eq. 6 is strictly proper: |G_lead|
+rises from 1 to its peak near wp and then falls as wp^3 / (wz^2 w); its value at infinity is 0, so the peak is the
+meaningful "high-frequency gain".) The second keeps the cascade free of a resonance (overshoot and ringing).
+
+The design (classical loop shaping with pole-zero cancellation): the zeros cancel the lag's poles (wz = wn,
+psi = zeta), so the cascade is T = wp^3 / (s + wp)^3 (no overshoot, w_B = 0.51 wp), and wp is the largest meeting
+the bounds, found by bisection (both peaks grow with wp at every frequency, and so does w_B): the widest -3 dB and
+tracking bandwidth a cancelling Eq. 6 reaches under the bounds. It needs zeta <= 5 (LeadFilterParams' range of
+psi). With the default bound the cascade's bandwidth is over twice the plant's for zeta >= 0.5 (x2.9 for the
+loaded truck at 30 km/h); a lightly damped lag's resonance widens its own -3 dB bandwidth, so it gains less.
+(A free search over (wz, psi, wp) maximising either bandwidth was tried and rejected: both bandwidths are
+first crossings of a threshold, and their optima sit on a dip or an error hump just short of the threshold, so the
+"optimum" jumps with the frequency grid; cancellation is unique, smooth in the lag and gives no resonance.)
+
+Reported (and written to the filter file's `design` table): both bandwidths of plant and cascade, the peaks, and
+the phase of the plant and of the cascade at a stated frequency (by default the plant's -3 dB bandwidth),
+including any identified delay (which no filter of this form compensates).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import control
+import numpy as np
+
+from controllers.clothoid.lead_filter import OMEGA_RANGE_RAD_S, POLE_RATIO_RANGE, PSI_MAX, LeadFilterParams
+from tuning.lag_fit import (
+    LagFitOptions,
+    SteeringGeometry,
+    kinematic_curvature,
+    realised_curvature,
+    simulate_lag,
+    simulate_unit_dc,
+)
+from tuning.log_file import VehicleLog
+from workbench.errors import WorkbenchInputError, require_in_range
+from workbench.vehicles.base import VehicleGeometry
+from workbench.vehicles.steering_lag import SteeringLag
+
+METHOD = "cancel"
+DEFAULT_MAX_LEAD_GAIN = 10.0
+DEFAULT_MAX_CASCADE_PEAK_DB = 1.0
+#: The -3 dB of the bandwidth, as python-control's `bandwidth` defines it, and the tracking-error threshold.
+BANDWIDTH_GAIN = 10 ** (-3 / 20)
+TRACKING_ERROR = 1.0 - BANDWIDTH_GAIN
+_BISECTIONS = 40
+_OMEGA_DECADES = (-2.0, 3.5)  # frequency grid relative to wn
+_OMEGA_POINTS = 551
+
+
+@dataclass(frozen=True)
+class LeadDesign:
+    """A designed filter and what it achieves. Frequencies in rad/s, phases in degrees (negative: lag)."""
+
+    params: LeadFilterParams
+    lag: SteeringLag
+    method: str
+    max_lead_gain: float
+    max_cascade_peak_db: float
+    lead_peak_gain: float
+    cascade_peak_db: float
+    plant_bandwidth_rad_s: float
+    cascade_bandwidth_rad_s: float
+    plant_tracking_bandwidth_rad_s: float
+    cascade_tracking_bandwidth_rad_s: float
+    phase_frequency_rad_s: float
+    plant_phase_deg: float
+    cascade_phase_deg: float
+
+    @property
+    def bandwidth_ratio(self) -> float:
+        return self.cascade_bandwidth_rad_s / self.plant_bandwidth_rad_s
+
+    @property
+    def speed_kmh(self) -> float | None:
+        """The design speed: the middle of the lag data's speed range (km/h, to 0.1 km/h), when known."""
+        if self.lag.speed_range_mps is None:
+            return None
+        return round(3.6 * 0.5 * (self.lag.speed_range_mps[0] + self.lag.speed_range_mps[1]), 1)
+
+    def transfer_functions(self) -> tuple[control.TransferFunction, control.TransferFunction, control.TransferFunction]:
+        """(plant G_lag, compensator G_lead, cascade G_lead G_lag) as python-control transfer functions (without
+        the lag's delay, if any: `frequency_response` includes it)."""
+        plant = lag_transfer_function(self.lag)
+        lead = self.params.transfer_function()
+        return plant, lead, lead * plant
+
+    def frequency_response(self, omega_rad_s: np.ndarray) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+        """{"plant", "compensator", "cascade"}: (magnitude, phase in degrees) at omega (rad/s), delay included."""
+        out = {}
+        for name, tf in zip(("plant", "compensator", "cascade"), self.transfer_functions(), strict=True):
+            response = np.asarray(control.frequency_response(tf, omega_rad_s).complex).ravel()
+            phase = np.degrees(np.unwrap(np.angle(response)))
+            if name != "compensator":
+                phase = phase - np.degrees(omega_rad_s * self.lag.delay_s)
+            out[name] = (np.abs(response), phase)
+        return out
+
+    def metadata(self) -> dict[str, object]:
+        """The `design` table of the filter file."""
+        criterion = (
+            "zeros on the lag's poles (omega_z = omega_n, psi = zeta); the largest omega_p with peak |G_lead| <= "
+            "max_lead_gain and peak |G_lead G_lag| <= max_cascade_peak_db"
+        )
+        out: dict[str, object] = {
+            "method": self.method,
+            "criterion": criterion,
+            "max_lead_gain": self.max_lead_gain,
+            "max_cascade_peak_db": self.max_cascade_peak_db,
+            "lead_peak_gain": self.lead_peak_gain,
+            "cascade_peak_db": self.cascade_peak_db,
+            "plant_bandwidth_rad_s": self.plant_bandwidth_rad_s,
+            "cascade_bandwidth_rad_s": self.cascade_bandwidth_rad_s,
+            "bandwidth_ratio": self.bandwidth_ratio,
+            "plant_tracking_bandwidth_rad_s": self.plant_tracking_bandwidth_rad_s,
+            "cascade_tracking_bandwidth_rad_s": self.cascade_tracking_bandwidth_rad_s,
+            "phase_frequency_rad_s": self.phase_frequency_rad_s,
+            "plant_phase_deg": self.plant_phase_deg,
+            "cascade_phase_deg": self.cascade_phase_deg,
+        }
+        if self.lag.delay_s > 0:
+            out["plant_delay_s"] = self.lag.delay_s
+        if not math.isnan(self.lag.nrmse):
+            out["lag_nrmse"] = self.lag.nrmse
+        if self.lag.speed_range_mps is not None:
+            out["lag_speed_range_mps"] = list(self.lag.speed_range_mps)
+        return out
+
+    def summary(self) -> str:
+        p = self.params
+        return (
+            f"lead filter ({self.method}): omega_z {p.omega_z_rad_s:.3f} rad/s, psi {p.psi:.3f}, omega_p "
+            f"{p.omega_p_rad_s:.3f} rad/s, DC gain {p.dc_gain:.6g}; peak gain {self.lead_peak_gain:.3g} "
+            f"({20 * math.log10(self.lead_peak_gain):.1f} dB, bound {self.max_lead_gain:g}); -3 dB bandwidth "
+            f"{self.plant_bandwidth_rad_s:.3f} -> {self.cascade_bandwidth_rad_s:.3f} rad/s "
+            f"(x{self.bandwidth_ratio:.2f}); tracking bandwidth {self.plant_tracking_bandwidth_rad_s:.3f} -> "
+            f"{self.cascade_tracking_bandwidth_rad_s:.3f} rad/s; phase at {self.phase_frequency_rad_s:.3f} rad/s "
+            f"{self.plant_phase_deg:.1f} -> {self.cascade_phase_deg:.1f} deg"
+        )
+
+
+def lag_transfer_function(lag: SteeringLag) -> control.TransferFunction:
+    """Eq. 5 (without its delay) as a python-control transfer function."""
+    wn, zeta = lag.omega_n_rad_s, lag.zeta
+    return control.tf([wn**2], [1.0, 2.0 * zeta * wn, wn**2])
+
+
+def _first_crossing(w: np.ndarray, excess: np.ndarray) -> np.ndarray:
+    """First frequency (log-interpolated) where `excess` (..., n), negative at w[0], becomes >= 0; w[-1] if never."""
+    above = excess >= 0.0
+    i = np.where(above.any(axis=-1), np.argmax(above, axis=-1), w.size - 1)
+    i = np.maximum(i, 1)
+    lo = np.take_along_axis(excess, (i - 1)[..., None], axis=-1)[..., 0]
+    hi = np.take_along_axis(excess, i[..., None], axis=-1)[..., 0]
+    frac = np.clip(-lo / np.where(hi - lo == 0.0, 1.0, hi - lo), 0.0, 1.0)
+    logw = np.log(w)
+    return np.exp(logw[i - 1] + frac * (logw[i] - logw[i - 1]))
+
+
+def tracking_bandwidth(omega_rad_s: np.ndarray, response: np.ndarray) -> np.ndarray:
+    """First frequency of the grid omega (increasing, starting well inside the pass band) where |G(jw) - 1| of the
+    complex response (..., n) reaches TRACKING_ERROR (log-interpolated)."""
+    return _first_crossing(omega_rad_s, np.abs(response - 1.0) - TRACKING_ERROR)
+
+
+class _Problem:
+    """The design problem on a frequency grid relative to wn, vectorised over candidate filters."""
+
+    def __init__(self, lag: SteeringLag, max_lead_gain: float, max_cascade_peak_db: float) -> None:
+        wn, zeta = lag.omega_n_rad_s, lag.zeta
+        self.wn = wn
+        self.w = wn * np.logspace(*_OMEGA_DECADES, _OMEGA_POINTS)
+        s = 1j * self.w
+        self.plant = wn**2 / (s * s + 2.0 * zeta * wn * s + wn**2)
+        self.max_lead = max_lead_gain
+        self.max_cascade = 10 ** (max_cascade_peak_db / 20)
+
+    def lead(self, wz: np.ndarray, psi: np.ndarray, wp: np.ndarray) -> np.ndarray:
+        """G_lead(jw) for parameter arrays of shape (m,), as (m, n)."""
+        wz, psi, wp = (np.atleast_1d(np.asarray(v, dtype=float))[:, None] for v in (wz, psi, wp))
+        s = 1j * self.w
+        return wp**3 * (s * s + 2.0 * psi * wz * s + wz**2) / (wz**2 * (s + wp) ** 3)
+
+    def largest_pole(self, wz: float, psi: float) -> float | None:
+        """The largest wp meeting both bounds with wp / wz in [1, 100] and wp <= 1000 rad/s (None if even wp = wz
+        breaks them)."""
+        lo = math.log(POLE_RATIO_RANGE[0])
+        hi = math.log(min(POLE_RATIO_RANGE[1], OMEGA_RANGE_RAD_S[1] / wz)) - 1e-12
+
+        def ok(log_ratio: float) -> bool:
+            wp = wz * math.exp(log_ratio)
+            cascade_peak = float(np.abs(self.lead(wz, psi, wp) * self.plant).max())
+            # the lead's peak refined off the grid (LeadFilterParams.peak_gain), so the bound holds exactly
+            return cascade_peak <= self.max_cascade and LeadFilterParams(wz, psi, wp).peak_gain <= self.max_lead
+
+        if not ok(lo):
+            return None
+        if ok(hi):
+            return wz * math.exp(hi)
+        for _ in range(_BISECTIONS):
+            mid = 0.5 * (lo + hi)
+            lo, hi = (mid, hi) if ok(mid) else (lo, mid)
+        return wz * math.exp(lo)
+
+
+def _cancelling_design(problem: _Problem, lag: SteeringLag) -> tuple[float, float, float]:
+    if lag.zeta > PSI_MAX:
+        raise WorkbenchInputError(
+            f"the lag's zeta = {lag.zeta:.4g} is over {PSI_MAX}, the largest damping of Eq. 6's zeros: a lag this "
+            f"overdamped is nearly first-order; check the fit (a fitted delay trades off with the damping: refit "
+            f"without --delay) or the data"
+        )
+    wp = problem.largest_pole(lag.omega_n_rad_s, lag.zeta)
+    if wp is None:
+        raise WorkbenchInputError("no lead filter meets the bounds; raise max_lead_gain or max_cascade_peak_db")
+    return lag.omega_n_rad_s, lag.zeta, wp
+
+
+def _phase_deg(tf: control.TransferFunction, omega: float) -> float:
+    """Phase (deg) of tf at omega, unwrapped continuously from low frequency (so a cascade lagging by more than
+    180 degrees reads -200, not +160)."""
+    w = omega * np.logspace(-4.0, 0.0, 801)
+    response = np.asarray(control.frequency_response(tf, w).complex).ravel()
+    return float(np.degrees(np.unwrap(np.angle(response))[-1]))
+
+
+def design_lead(
+    lag: SteeringLag,
+    max_lead_gain: float = DEFAULT_MAX_LEAD_GAIN,
+    max_cascade_peak_db: float = DEFAULT_MAX_CASCADE_PEAK_DB,
+    phase_frequency_rad_s: float | None = None,
+) -> LeadDesign:
+    """Design Eq. 6 for `lag` by the criterion of the module docstring. max_lead_gain: bound on the peak of
+    |G_lead| (linear, >= 1); max_cascade_peak_db: bound on the cascade's peak (dB, >= 0); phase_frequency_rad_s:
+    where the phases are reported (rad/s; default: the plant's -3 dB bandwidth)."""
+    require_in_range("max_lead_gain", max_lead_gain, 1.0, 1000.0)
+    require_in_range("max_cascade_peak_db", max_cascade_peak_db, 0.0, 20.0, "dB")
+    if phase_frequency_rad_s is not None:
+        require_in_range("phase_frequency_rad_s", phase_frequency_rad_s, 1e-3, 1e4, "rad/s")
+    problem = _Problem(lag, max_lead_gain, max_cascade_peak_db)
+    wz, psi, wp = _cancelling_design(problem, lag)
+    params = LeadFilterParams(wz, psi, wp)
+    # Report with python-control, independently of the grid the search used.
+    plant = lag_transfer_function(lag)
+    cascade = params.transfer_function() * plant
+    plant_bw = float(control.bandwidth(plant))
+    omega = phase_frequency_rad_s if phase_frequency_rad_s is not None else plant_bw
+    delay_deg = math.degrees(omega * lag.delay_s)
+    fine = lag.omega_n_rad_s * np.logspace(-3.0, 4.0, 7001)
+    plant_response = np.asarray(control.frequency_response(plant, fine).complex).ravel()
+    cascade_response = np.asarray(control.frequency_response(cascade, fine).complex).ravel()
+    return LeadDesign(
+        params=params,
+        lag=lag,
+        method=METHOD,
+        max_lead_gain=float(max_lead_gain),
+        max_cascade_peak_db=float(max_cascade_peak_db),
+        lead_peak_gain=params.peak_gain,
+        cascade_peak_db=float(20 * np.log10(max(np.abs(cascade_response).max(), 1.0))),
+        plant_bandwidth_rad_s=plant_bw,
+        cascade_bandwidth_rad_s=float(control.bandwidth(cascade)),
+        plant_tracking_bandwidth_rad_s=float(tracking_bandwidth(fine, plant_response)),
+        cascade_tracking_bandwidth_rad_s=float(tracking_bandwidth(fine, cascade_response)),
+        phase_frequency_rad_s=float(omega),
+        plant_phase_deg=_phase_deg(plant, omega) - delay_deg,
+        cascade_phase_deg=_phase_deg(cascade, omega) - delay_deg,
+    )
+
+
+@dataclass(frozen=True)
+class ValidationTrace:
+    """Figure 9 for one log: time (s) and curvatures (1/m): kinematic, kinematic with lag (Eq. 5), compensated
+    (Eq. 6 on the steering wheel, then kinematic with lag), and the measured curvature (None if not in the log).
+    The NRMSEs are of the lagged and compensated curvatures against the kinematic one (range of the kinematic)."""
+
+    name: str
+    t_s: np.ndarray
+    kinematic_1pm: np.ndarray
+    lagged_1pm: np.ndarray
+    compensated_1pm: np.ndarray
+    measured_1pm: np.ndarray | None
+    nrmse_lagged: float
+    nrmse_compensated: float
+
+
+def validate(design: LeadDesign, log: VehicleLog, geometry: VehicleGeometry | SteeringGeometry) -> ValidationTrace:
+    """Time-domain check of the design on a log (Figure 9): the compensated curvature should follow the kinematic
+    curvature more closely than the lagged one does."""
+    lag = design.lag
+    kin = kinematic_curvature(log.steer_wheel_rad, geometry)
+    lagged = simulate_lag(kin, log.dt_s, lag.omega_n_rad_s, lag.zeta, 1.0, lag.delay_s)
+    lead = design.params.transfer_function()
+    filtered_wheel = simulate_unit_dc(lead.num[0][0], lead.den[0][0], log.steer_wheel_rad, log.dt_s)
+    compensated = simulate_lag(
+        kinematic_curvature(filtered_wheel, geometry), log.dt_s, lag.omega_n_rad_s, lag.zeta, 1.0, lag.delay_s
+    )
+    measured = None
+    if log.has_positions or log.has_yaw_rate:
+        measured, _ = realised_curvature(log, LagFitOptions())
+    span = float(np.ptp(kin)) or 1.0
+    return ValidationTrace(
+        name=log.name,
+        t_s=log.t_s - log.t_s[0],
+        kinematic_1pm=kin,
+        lagged_1pm=lagged,
+        compensated_1pm=compensated,
+        measured_1pm=measured,
+        nrmse_lagged=float(np.sqrt(np.mean((lagged - kin) ** 2)) / span),
+        nrmse_compensated=float(np.sqrt(np.mean((compensated - kin) ** 2)) / span),
+    )
