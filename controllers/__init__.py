@@ -8,6 +8,7 @@ from __future__ import annotations
 
 from controllers.base import Controller, Measurement
 from controllers.clothoid import ClothoidConfig, ClothoidController
+from controllers.mpc import LMPCConfig, LMPCController, NMPCConfig, NMPCController
 from controllers.pure_pursuit import PurePursuit, PurePursuitConfig
 from controllers.stanley import Stanley, StanleyConfig
 from workbench.errors import WorkbenchInputError
@@ -18,16 +19,21 @@ CONTROLLERS: dict[str, type[Controller]] = {
     ClothoidController.name: ClothoidController,
     PurePursuit.name: PurePursuit,
     Stanley.name: Stanley,
+    NMPCController.name: NMPCController,
+    LMPCController.name: LMPCController,
 }
 
 
-def make_controller(name: str, geometry: VehicleGeometry, config: object | None = None) -> Controller:
-    """Build the controller registered under `name` for a vehicle, with its default config unless one is given."""
+def make_controller(
+    name: str, geometry: VehicleGeometry, config: object | None = None, vehicle: object | None = None
+) -> Controller:
+    """Build the controller registered under `name` for a vehicle, with its default config unless one is given.
+    `vehicle` (the steered `VehicleModel`) gives model-based controllers (the MPCs) their prediction parameters."""
     try:
         cls = CONTROLLERS[name]
     except KeyError:
         raise WorkbenchInputError(f"unknown controller {name!r}; choose one of {', '.join(CONTROLLERS)}") from None
-    return cls(geometry, config)
+    return cls(geometry, config, vehicle=vehicle)
 
 
 __all__ = [
@@ -35,7 +41,11 @@ __all__ = [
     "ClothoidConfig",
     "ClothoidController",
     "Controller",
+    "LMPCConfig",
+    "LMPCController",
     "Measurement",
+    "NMPCConfig",
+    "NMPCController",
     "PurePursuit",
     "PurePursuitConfig",
     "Stanley",

@@ -52,7 +52,10 @@ class Controller(ABC):
     name: ClassVar[str]
     config_type: ClassVar[type]
 
-    def __init__(self, geometry: VehicleGeometry, config: Any | None = None) -> None:
+    def __init__(self, geometry: VehicleGeometry, config: Any | None = None, vehicle: object | None = None) -> None:
+        """`geometry`: the steered vehicle's; `config`: an instance of `config_type` (its defaults when None);
+        `vehicle`: the steered vehicle's model (a `VehicleModel`), for controllers that predict with it (the
+        MPCs); geometric controllers ignore it."""
         self.geometry = geometry
         self.config = config if config is not None else self.config_type()
         if not isinstance(self.config, self.config_type):

@@ -70,7 +70,7 @@ def _run(args: argparse.Namespace) -> int:
     options = read_controller_config(
         args.controller_config, args.controller, CONTROLLERS[args.controller].config_type, args.set
     )
-    controller = make_controller(args.controller, vehicle.geometry, options)
+    controller = make_controller(args.controller, vehicle.geometry, options, vehicle=vehicle)
     scenario = make_scenario(
         args.scenario, ScenarioOptions(vehicle_width_m=vehicle.geometry.width_m, track_file=args.track)
     )

@@ -133,7 +133,9 @@ class ClothoidController(Controller):
     name: ClassVar[str] = "clothoid"
     config_type: ClassVar[type] = ClothoidConfig
 
-    def __init__(self, geometry: VehicleGeometry, config: ClothoidConfig | None = None) -> None:
+    def __init__(
+        self, geometry: VehicleGeometry, config: ClothoidConfig | None = None, vehicle: object | None = None
+    ) -> None:
         super().__init__(geometry, config)
         cfg = self.config
         self.limits = (

@@ -46,7 +46,7 @@ SITUATIONS = {
 @pytest.mark.parametrize("situation", sorted(SITUATIONS))
 def test_command_is_finite_and_within_the_steering_limit(name: str, situation: str) -> None:
     vehicle = KinematicBicycle()
-    controller = make_controller(name, vehicle.geometry)
+    controller = make_controller(name, vehicle.geometry, vehicle=vehicle)
     controller.reset(PATH, 0.02)
     command = controller.step(SITUATIONS[situation], PATH)
     assert math.isfinite(command)
@@ -57,7 +57,7 @@ def test_command_is_finite_and_within_the_steering_limit(name: str, situation: s
 @pytest.mark.parametrize("name", NAMES)
 def test_turns_toward_the_path(name: str) -> None:
     vehicle = KinematicBicycle()
-    controller = make_controller(name, vehicle.geometry)
+    controller = make_controller(name, vehicle.geometry, vehicle=vehicle)
     controller.reset(PATH, 0.02)
     left_of_path = controller.step(_measure(5.0, 1.0, 0.0, 8.0), PATH)
     controller.reset(PATH, 0.02)
@@ -69,7 +69,9 @@ def test_turns_toward_the_path(name: str) -> None:
 def test_completes_the_dlc_closely(name: str) -> None:
     vehicle = KinematicBicycle()
     scenario = make_scenario("dlc")
-    result = Simulation(scenario, vehicle, make_controller(name, vehicle.geometry), SimulationConfig()).run()
+    result = Simulation(
+        scenario, vehicle, make_controller(name, vehicle.geometry, vehicle=vehicle), SimulationConfig()
+    ).run()
     assert result.completed, result.message
     assert result.metrics.max_abs_cte_m < 0.3
     assert np.isfinite(result.to_pandas().select_dtypes("number").to_numpy()).all()

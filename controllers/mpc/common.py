@@ -1,0 +1,364 @@
+"""What the NMPC and the LTV-MPC share: their common options, the prediction model they are built with, and the
+step: project onto the path, estimate the model state, sample the path along the planned progress, solve, and
+fall back to the previous plan when a solve is not accepted.
+
+Each step (section 6.6 of the paper compares the clothoid controller with an MPC; this is that baseline):
+  1. the foot point on the path (the progress-following `PathTracker`), the Frenet errors e_y, e_psi;
+  2. the model's initial state: measured where the sensors give it (lateral velocity, yaw rate, road-wheel angle,
+     path curvature as yaw rate / speed), the commanded angle being the last command sent, and states no sensor
+     gives (the lag's curvature rate, the delay state) taken from the previous plan shifted to now;
+  3. per interval k the path curvature at the planned progress s_k (from the previous plan: the vehicle's own
+     predicted progress, so an offset or a heading error moves the curvature samples as it should) and the speed
+     v_k = measured speed + (planned speed at s_k - planned speed at s_0), at least min_model_speed_mps;
+  4. the solve, warm-started from the previous plan shifted to now;
+  5. the command: the plan's commanded road-wheel angle one controller period ahead (its rate is the input),
+     times the steering ratio, saturated. A solve that is not accepted (failed, iteration limit, late, infeasible,
+     non-finite) is not used: the previous plan, shifted, is replayed (hold of the current command if there is
+     none), and the trace says so (`ctrl_fallback` = 1, `ctrl_solver_status`, `ctrl_plan_age_s`).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from controllers.base import Controller, Measurement
+from controllers.mpc.ocp import TrackingOCP, TrackingWeights
+from controllers.mpc.plan import Plan
+from controllers.mpc.prediction_model import (
+    MODEL_KINDS,
+    PredictionModel,
+    PredictionParams,
+    matching_preset,
+    params_from_geometry,
+    prediction_params_for,
+)
+from controllers.mpc.status import SolveResult, SolveStatus
+from workbench.errors import WorkbenchInputError, require_in_range, require_positive
+from workbench.path import PathTracker, Projection, ReferencePath, wrap_angle
+from workbench.vehicles.base import VehicleGeometry
+from workbench.vehicles.steering_lag import read_lag_file
+
+#: Below this speed (m/s) yaw rate / speed and the course angle are not used (the yaw and the previous plan are).
+MIN_MEASURED_SPEED_MPS = 0.5
+#: Relative mismatch of wheelbase or steering ratio between the prediction vehicle and the steered vehicle that is
+#: rejected as a configuration error (a car's model predicting a truck).
+GEOMETRY_TOLERANCE = 0.02
+#: The objective logged when a solve returned none.
+NO_OBJECTIVE = -1.0
+
+
+@dataclass(frozen=True)
+class MPCConfig:
+    """Options common to both MPCs (SI units in the names).
+
+    vehicle: where the prediction model's parameters come from: "auto" (the steered vehicle's own parameters when
+    the caller passes its model, else the shipped preset whose geometry equals the steered vehicle's, else the
+    geometry alone), "geometry" (kinematic single track from the geometry), or a preset name
+    (`workbench vehicles`); vehicle_file: a vehicle TOML file instead (overrides `vehicle`);
+    lag_file: an identified steering lag ("steering-lag/1" JSON from `tuning fit-lag`) that the prediction then
+    uses, as the clothoid controller's lead filter does; model: "auto" (kinematic-lag with a lag file, else dynamic
+    when mass and tyres are known, else kinematic), "dynamic", "kinematic" or "kinematic-lag"
+    (`prediction_model.py`); horizon_steps: N; step_s: prediction step h (s); weight_cte (1/m^2),
+    weight_heading (1/rad^2), weight_steer_rate (s^2/rad^2, on the road-wheel rate): stage weights;
+    terminal_weight_cte (1/m^2), terminal_weight_heading (1/rad^2): terminal weights; max_lat_accel_mps2: soft
+    limit on the predicted lateral acceleration (m/s^2; 0: none) with weight_lat_accel_slack (s^4/m^2);
+    min_model_speed_mps: the prediction never runs slower than this (m/s); max_solve_time_s: the solver's wall-time
+    budget (s), a solve cut short by it is late and not used (0: the controller's sample time); codegen: compile
+    the model's derivatives with the system C compiler where that pays (cached; ignored without a compiler).
+    """
+
+    vehicle: str = "auto"
+    vehicle_file: Path | None = None
+    lag_file: Path | None = None
+    model: str = "auto"
+    horizon_steps: int = 30
+    step_s: float = 0.05
+    weight_cte: float = 200.0
+    weight_heading: float = 10.0
+    weight_steer_rate: float = 5.0
+    terminal_weight_cte: float = 2000.0
+    terminal_weight_heading: float = 100.0
+    max_lat_accel_mps2: float = 0.0
+    weight_lat_accel_slack: float = 100.0
+    min_model_speed_mps: float = 3.0
+    max_solve_time_s: float = 0.0
+    codegen: bool = True
+
+    def __post_init__(self) -> None:
+        from workbench.vehicles import VEHICLES
+
+        if self.vehicle not in ("auto", "geometry", *VEHICLES):
+            raise WorkbenchInputError(
+                f"vehicle must be 'auto', 'geometry' or a preset name ({', '.join(VEHICLES)}); got {self.vehicle!r}"
+            )
+        allowed = ("auto", *MODEL_KINDS)
+        if self.model not in allowed:
+            raise WorkbenchInputError(f"model must be one of {', '.join(allowed)}; got {self.model!r}")
+        if (
+            isinstance(self.horizon_steps, bool)
+            or not isinstance(self.horizon_steps, int)
+            or not 2 <= self.horizon_steps <= 500
+        ):
+            raise WorkbenchInputError(f"horizon_steps must be a whole number in [2, 500]; got {self.horizon_steps!r}")
+        require_in_range("step_s", self.step_s, 1e-3, 1.0, "s")
+        for name in ("weight_cte", "weight_heading", "terminal_weight_cte", "terminal_weight_heading"):
+            require_in_range(name, getattr(self, name), 0.0, 1e9)
+        require_positive("weight_steer_rate", self.weight_steer_rate)
+        require_in_range("max_lat_accel_mps2", self.max_lat_accel_mps2, 0.0, 50.0, "m/s^2 (0: no limit)")
+        require_in_range("weight_lat_accel_slack", self.weight_lat_accel_slack, 0.0, 1e9)
+        require_in_range("min_model_speed_mps", self.min_model_speed_mps, 0.5, 50.0, "m/s")
+        require_in_range("max_solve_time_s", self.max_solve_time_s, 0.0, 10.0, "s (0: the sample time)")
+        if not isinstance(self.codegen, bool):
+            raise WorkbenchInputError(f"codegen must be true or false; got {self.codegen!r}")
+
+    @property
+    def weights(self) -> TrackingWeights:
+        return TrackingWeights(
+            cte=self.weight_cte,
+            heading=self.weight_heading,
+            steer_rate=self.weight_steer_rate,
+            terminal_cte=self.terminal_weight_cte,
+            terminal_heading=self.terminal_weight_heading,
+            lat_accel_slack=self.weight_lat_accel_slack,
+        )
+
+
+def resolve_prediction_params(geometry: VehicleGeometry, config: MPCConfig, vehicle: object | None) -> PredictionParams:
+    """The prediction parameters for a controller, in this order: the config's vehicle_file; its vehicle when not
+    "auto"; the `vehicle` the caller passes (a VehicleModel, its params, ...: the steered vehicle itself); the
+    shipped preset with the same geometry; the geometry alone. The config's lag file goes on top. The steering
+    limits are always the steered vehicle's (`geometry`)."""
+    from workbench.vehicles import VEHICLES
+
+    if config.vehicle_file is not None:
+        params = prediction_params_for(Path(config.vehicle_file))
+    elif config.vehicle == "auto" and vehicle is not None:
+        params = prediction_params_for(vehicle)
+    elif config.vehicle == "auto":
+        preset = matching_preset(geometry)
+        params = prediction_params_for(preset) if preset else params_from_geometry(geometry)
+    elif config.vehicle == "geometry":
+        params = params_from_geometry(geometry)
+    elif config.vehicle in VEHICLES:
+        params = prediction_params_for(config.vehicle)
+    else:
+        raise WorkbenchInputError(
+            f"vehicle must be 'auto', 'geometry' or one of the presets {', '.join(VEHICLES)}; got {config.vehicle!r}"
+        )
+    for name, mine, theirs in (
+        ("wheelbase_m", params.wheelbase_m, geometry.wheelbase_m),
+        ("steering_ratio", params.steering_ratio, geometry.steering_ratio),
+    ):
+        if abs(mine - theirs) > GEOMETRY_TOLERANCE * theirs:
+            raise WorkbenchInputError(
+                f"the prediction model ({params.source}) has {name} = {mine:g} but the steered vehicle has "
+                f"{theirs:g}; choose the matching vehicle or vehicle_file (or vehicle = 'auto')"
+            )
+    params = PredictionParams(
+        wheelbase_m=params.wheelbase_m,
+        steering_ratio=geometry.steering_ratio,
+        max_road_wheel_angle_rad=geometry.max_road_wheel_angle_rad,
+        max_road_wheel_rate_rad_s=geometry.max_steer_wheel_rate_rad_s / geometry.steering_ratio,
+        steering_time_constant_s=params.steering_time_constant_s,
+        single_track=params.single_track,
+        lag=params.lag,
+        source=params.source,
+    )
+    if config.lag_file is not None:
+        params = params.with_lag(read_lag_file(config.lag_file))
+    return params
+
+
+class MPCController(Controller):
+    """Base of the two MPCs: subclasses build `self.solver` in `_build_solver` and implement `_solve`."""
+
+    def __init__(self, geometry: VehicleGeometry, config: Any | None = None, vehicle: object | None = None) -> None:
+        super().__init__(geometry, config)
+        cfg: MPCConfig = self.config
+        self.prediction = resolve_prediction_params(geometry, cfg, vehicle)
+        kind = cfg.model if cfg.model != "auto" else self._auto_kind()
+        self.model = PredictionModel(self.prediction, kind)
+        self.ocp = TrackingOCP(
+            self.model,
+            cfg.horizon_steps,
+            cfg.step_s,
+            cfg.weights,
+            max_lat_accel_mps2=cfg.max_lat_accel_mps2,
+            min_speed_mps=cfg.min_model_speed_mps,
+        )
+        self._build_solver()
+        self._sample_time_s = 0.02
+        self._reset_state()
+
+    # ------------------------------------------------------------------ subclass hooks
+    def _auto_kind(self) -> str:
+        """The model kind for model = "auto"."""
+        return self.prediction.default_kind()
+
+    def _build_solver(self) -> None:  # pragma: no cover - abstract
+        raise NotImplementedError
+
+    def _set_time_budget(self, seconds: float) -> None:
+        """Give the solver its wall-time limit (s)."""
+
+    def _solve(
+        self,
+        x0: np.ndarray,
+        kappa: np.ndarray,
+        speed: np.ndarray,
+        guess_states: np.ndarray,
+        guess_inputs: np.ndarray,
+        guess_dual: tuple[np.ndarray, ...],
+        first: bool,
+    ) -> SolveResult:  # pragma: no cover - abstract
+        raise NotImplementedError
+
+    def _shift_dual(self, plan: Plan, t_s: float) -> tuple[np.ndarray, ...]:
+        return ()
+
+    # ------------------------------------------------------------------ Controller interface
+    def reset(self, path: ReferencePath, sample_time_s: float) -> None:
+        require_positive("sample_time_s", sample_time_s)
+        self._sample_time_s = float(sample_time_s)
+        self._set_time_budget(self.config.max_solve_time_s or self._sample_time_s)
+        self._reset_state()
+        self._tracker: PathTracker = path.tracker(0.0)
+        self._path = path
+        speed = path.speed_mps if path.speed_mps is not None else np.zeros_like(path.curvature_1pm)
+        self._path_samples = np.column_stack((path.curvature_1pm, speed))
+
+    def _sample_path(self, s_m: np.ndarray) -> np.ndarray:
+        """(curvature, planned speed) of the reset path at arc lengths s_m (wrapped on a loop, clipped at the ends
+        of an open path), linearly interpolated: (len(s_m), 2)."""
+        path, samples = self._path, self._path_samples
+        s_m = np.mod(s_m, path.length_m) if path.closed else np.clip(s_m, 0.0, path.length_m)
+        position = s_m / path.spacing_m
+        i = np.minimum(position.astype(int), samples.shape[0] - 2)
+        frac = (position - i)[:, None]
+        return samples[i] * (1.0 - frac) + samples[i + 1] * frac
+
+    def _reset_state(self) -> None:
+        self._plan: Plan | None = None
+        self._last_command: float | None = None
+        self._failures = 0
+        self._diag = {
+            "solver_status": float(SolveStatus.SOLVED),
+            "solve_time_s": 0.0,
+            "solver_iterations": 0.0,
+            "fallback": 0.0,
+            "plan_age_s": 0.0,
+            "failed_solves": 0.0,
+            "objective": NO_OBJECTIVE,
+            "predicted_cte_end_m": 0.0,
+            "road_wheel_rate_cmd_rad_s": 0.0,
+            "model_speed_mps": 0.0,
+        }
+
+    def step(self, measurement: Measurement, path: ReferencePath) -> float:
+        m, ocp, model = measurement, self.ocp, self.model
+        foot = self._tracker.update(m.x_m, m.y_m)
+        plan = self._plan
+        shifted = plan.shifted(m.t_s) if plan is not None else None
+        x0 = self._initial_state(m, foot, shifted[0][0] if shifted else None)
+        v0 = max(m.vx_mps if model.kind == "dynamic" else m.speed_mps, 0.0)
+        h = ocp.step_s
+        if shifted is not None:
+            progress = shifted[2]
+        else:
+            progress = max(v0, ocp.min_speed_mps) * h * np.arange(ocp.N + 1)
+        s_mid = foot.s_m + 0.5 * (progress[1:] + progress[:-1])
+        sampled = self._sample_path(np.append(s_mid, foot.s_m))
+        kappa = sampled[:-1, 0]
+        if self._path.speed_mps is not None:
+            speed = v0 + sampled[:-1, 1] - sampled[-1, 1]
+        else:
+            speed = np.full(ocp.N, v0)
+        speed = np.maximum(speed, ocp.min_speed_mps)
+        first = shifted is None
+        if first:
+            guess_inputs = np.zeros((ocp.N, ocp.nu))
+            guess_states = ocp.rollout(x0, guess_inputs, kappa, speed)
+            dual: tuple[np.ndarray, ...] = ()
+        else:
+            guess_states, guess_inputs = shifted[0], shifted[1]
+            dual = self._shift_dual(plan, m.t_s)
+        result = self._solve(x0, kappa, speed, guess_states, guess_inputs, dual, first)
+
+        t_next = m.t_s + self._sample_time_s
+        if result.accepted:
+            progress = ocp.progress(result.states, kappa, speed)
+            self._plan = plan = Plan(m.t_s, h, result.states, result.inputs, progress, model.i_cmd, result.dual)
+        else:
+            self._failures += 1
+        if plan is not None:
+            command = plan.command_at(t_next)
+            rate = plan.rate_at(m.t_s)
+        else:  # no plan yet: hold the current command
+            command, rate = float(x0[model.i_cmd]), 0.0
+        limit = self.prediction.max_road_wheel_angle_rad
+        command = min(max(command, -limit), limit)
+        self._last_command = command
+        self._diag = {
+            "solver_status": float(result.status),
+            "solve_time_s": float(result.solve_time_s),
+            "solver_iterations": float(result.iterations),
+            "fallback": 0.0 if result.accepted else 1.0,
+            "plan_age_s": 0.0 if plan is None else m.t_s - plan.t_s,
+            "failed_solves": float(self._failures),
+            "objective": float(result.objective) if math.isfinite(result.objective) else NO_OBJECTIVE,
+            "predicted_cte_end_m": 0.0 if plan is None else float(plan.states[-1, model.i_cte]),
+            "road_wheel_rate_cmd_rad_s": rate,
+            "model_speed_mps": float(speed[0]),
+        }
+        return self.saturate(command * self.prediction.steering_ratio)
+
+    @property
+    def diagnostics(self) -> Mapping[str, float]:
+        return self._diag
+
+    @property
+    def last_plan(self) -> Plan | None:
+        """The plan the last command came from (None before the first accepted solve)."""
+        return self._plan
+
+    # ------------------------------------------------------------------ state estimate
+    def _initial_state(self, m: Measurement, foot: Projection, predicted: np.ndarray | None) -> np.ndarray:
+        """The model state now: measured components, the last command, and the shifted plan for the rest."""
+        model, prm = self.model, self.prediction
+        names = model.state_names
+        x = np.zeros(model.nx) if predicted is None else np.array(predicted, dtype=float)
+        speed = m.speed_mps
+        moving = speed > MIN_MEASURED_SPEED_MPS
+        road_wheel = m.steer_wheel_rad / prm.steering_ratio
+        heading = m.yaw_rad
+        if model.kind != "dynamic" and moving:  # kinematic kinds: the rear axle's course
+            heading += math.atan2(m.vy_mps, m.vx_mps)
+        x[model.i_cte] = foot.cte_m
+        x[model.i_heading] = float(wrap_angle(heading - foot.heading_rad))
+        command = road_wheel if self._last_command is None else self._last_command
+        x[model.i_cmd] = command
+        if model.kind == "dynamic":
+            st = prm.single_track
+            assert st is not None
+            x[names.index("vy_cg_mps")] = m.vy_mps + st.cg_to_rear_axle_m * m.yaw_rate_rad_s
+            x[names.index("yaw_rate_rad_s")] = m.yaw_rate_rad_s
+            x[names.index("road_wheel_rad")] = road_wheel
+        elif model.kind == "kinematic":
+            x[names.index("road_wheel_rad")] = road_wheel
+        else:
+            assert prm.lag is not None  # the kinematic-lag kind is built only with a lag
+            kinematic = prm.lag.steady_state_gain * math.tan(command)  # wheelbase x the curvature it settles at
+            x[names.index("wheelbase_x_curvature")] = (
+                prm.wheelbase_m * m.yaw_rate_rad_s / speed if moving else kinematic
+            )
+            if predicted is None:
+                x[names.index("wheelbase_x_curvature_rate_1ps")] = 0.0
+                if "delayed_wheelbase_x_curvature" in names:
+                    x[names.index("delayed_wheelbase_x_curvature")] = kinematic
+        return x

@@ -1,0 +1,121 @@
+"""Nonlinear MPC (CasADi): a nonlinear single-track prediction, path-following cost, real-time iteration on OSQP.
+
+The baseline of the paper's section 6.6 / Figure 17 (an MPC lateral controller). The prediction model
+(`prediction_model.py`) is a nonlinear dynamic bicycle with the steering angle as a state and its rate as the
+input (or the paper's kinematic-with-lag model when an identified lag file is given); the cost penalises the
+rear axle's cross-track and heading errors (Frenet errors) and the steering rate; steering angle and rate are
+bounded and the lateral acceleration optionally (softly) limited (`ocp.py`). Built once, solved every step:
+everything that changes per step (initial state, path curvature and speed along the horizon) is a parameter, and
+each solve is warm-started from the previous plan shifted to the current time.
+
+Two solvers:
+  "rti"   (default) the real-time iteration: one Gauss-Newton QP per step on OSQP, the model's Jacobians
+          compiled to C (`rti.py`, `codegen.py`); iterates to convergence on the first step only.
+  "ipopt" the full NLP to convergence with IPOPT (expanded SX graphs, warm start of primal and dual variables),
+          a converged reference that is slower (`nlp_solver.py`).
+A failed or late solve is never used nor hidden: the controller replays its previous plan (`common.py`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, ClassVar
+
+import numpy as np
+
+from controllers.mpc.common import MPCConfig, MPCController
+from controllers.mpc.nlp_solver import IpoptSolver
+from controllers.mpc.plan import Plan
+from controllers.mpc.rti import RtiSolver
+from controllers.mpc.sparse_qp import OsqpSettings
+from controllers.mpc.status import SolveResult
+from workbench.errors import WorkbenchInputError, require_in_range
+from workbench.vehicles.base import VehicleGeometry
+
+SOLVERS = ("rti", "ipopt")
+
+
+@dataclass(frozen=True)
+class NMPCConfig(MPCConfig):
+    """The common MPC options (`MPCConfig`) and: solver: "rti" or "ipopt"; first_iterations: SQP iterations of
+    the RTI on its first step after a reset (no previous solution to linearise along); max_iterations: IPOPT's
+    iteration limit; tolerance: IPOPT's tolerance; exact_hessian: IPOPT with the exact Hessian of the Lagrangian
+    instead of the Gauss-Newton one; qp_tolerance: OSQP's absolute and relative tolerance (RTI);
+    qp_max_iterations: OSQP's iteration limit (RTI)."""
+
+    solver: str = "rti"
+    first_iterations: int = 10
+    max_iterations: int = 100
+    tolerance: float = 1e-6
+    exact_hessian: bool = False
+    qp_tolerance: float = 1e-3
+    qp_max_iterations: int = 4000
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        if self.solver not in SOLVERS:
+            raise WorkbenchInputError(f"solver must be one of {', '.join(SOLVERS)}; got {self.solver!r}")
+        for name, low, high in (
+            ("first_iterations", 1, 100),
+            ("max_iterations", 1, 10000),
+            ("qp_max_iterations", 1, 10**6),
+        ):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, int) or not low <= value <= high:
+                raise WorkbenchInputError(f"{name} must be a whole number in [{low}, {high}]; got {value!r}")
+        require_in_range("tolerance", self.tolerance, 1e-12, 1e-1)
+        require_in_range("qp_tolerance", self.qp_tolerance, 1e-10, 1e-1)
+
+
+class NMPCController(MPCController):
+    """CasADi NMPC (module docstring). `vehicle` (optional): the vehicle model or its parameters to predict with;
+    without it the config's `vehicle`/`vehicle_file` decide."""
+
+    name: ClassVar[str] = "nmpc"
+    config_type: ClassVar[type] = NMPCConfig
+
+    def __init__(self, geometry: VehicleGeometry, config: Any | None = None, vehicle: object | None = None) -> None:
+        super().__init__(geometry, config, vehicle)
+
+    def _build_solver(self) -> None:
+        cfg: NMPCConfig = self.config
+        budget = cfg.max_solve_time_s or self._default_budget()
+        if cfg.solver == "ipopt":
+            self.solver: IpoptSolver | RtiSolver = IpoptSolver(
+                self.ocp, cfg.max_iterations, cfg.tolerance, budget, cfg.exact_hessian, cfg.codegen
+            )
+        else:
+            settings = OsqpSettings(
+                eps_abs=cfg.qp_tolerance, eps_rel=cfg.qp_tolerance, max_iter=cfg.qp_max_iterations, time_limit_s=budget
+            )
+            self.solver = RtiSolver(self.ocp, settings, codegen=cfg.codegen)
+
+    @staticmethod
+    def _default_budget() -> float:
+        return 0.02  # the default controller period (50 Hz); reset() sets the actual sample time
+
+    def _set_time_budget(self, seconds: float) -> None:
+        if isinstance(self.solver, IpoptSolver):
+            self.solver.set_time_limit(seconds)
+        else:
+            self.solver.qp.solver.update_settings(time_limit=seconds)
+
+    def _solve(
+        self,
+        x0: np.ndarray,
+        kappa: np.ndarray,
+        speed: np.ndarray,
+        guess_states: np.ndarray,
+        guess_inputs: np.ndarray,
+        guess_dual: tuple[np.ndarray, ...],
+        first: bool,
+    ) -> SolveResult:
+        if isinstance(self.solver, IpoptSolver):
+            return self.solver.solve(x0, kappa, speed, guess_states, guess_inputs, guess_dual)
+        iterations = self.config.first_iterations if first else 1
+        return self.solver.solve(x0, kappa, speed, guess_states, guess_inputs, iterations=iterations)
+
+    def _shift_dual(self, plan: Plan, t_s: float) -> tuple[np.ndarray, ...]:
+        if isinstance(self.solver, IpoptSolver):
+            return self.solver.shift_dual(plan.dual, plan.positions(t_s))
+        return ()

@@ -1,0 +1,542 @@
+"""The MPC prediction model: its parameters, taken from a vehicle preset, and its ODE in path coordinates.
+
+`PredictionParams` is a frozen description of the vehicle as the MPC sees it; `prediction_params_for` builds it
+from a vehicle model, a preset's params dataclass, a preset name or a TOML file, or (when nothing else is known)
+from the `VehicleGeometry` a controller is given. `PredictionModel` turns it into CasADi expressions.
+
+Three model kinds, all referenced at the rear-axle centre (where the paper measures CTE) in Frenet errors with
+respect to the path: e_y (cross-track error, left positive) and e_psi (heading error). Every kind has the
+commanded road-wheel angle delta_c as a state and its rate as the input u, so steering angle and rate limits are
+simple bounds. Per shooting interval two parameters enter: the path curvature kappa and the speed v.
+
+  "dynamic"  nonlinear single track (dynamic bicycle): lateral velocity v_y at the CG and yaw rate r, axle
+             forces from the slip angles through the magic formula of the vehicle's tyres (saturating), the road
+             wheel angle delta following delta_c through the first-order steering actuator of the preset:
+                 v_y' = (Fyf cos(delta) + Fyr) / m - v r,   r' = (a Fyf cos(delta) - b Fyr) / Iz,
+                 delta' = (delta_c - delta) / tau,          delta_c' = u.
+             Neglected against the workbench plants: tyre relaxation, load transfer, the actuator's rate clip.
+  "kinematic" kinematic bicycle with the first-order actuator: the rear axle moves along its heading with
+             curvature tan(delta) / L. Exact for the `kinematic-bicycle` plant; the model used when only the
+             geometry is known.
+  "kinematic-lag" the paper's "kinematic with lag" (section 5.1, Figures 8-9): the path curvature kappa_v
+             follows the kinematic curvature tan(delta_c) / L through the identified second-order lag of Eq. 5
+             and its steady-state gain K (1 in Eq. 5; the understeer that `tuning fit-lag` identifies),
+                 kappa_v'' = wn^2 (K kappa_kin - kappa_v) - 2 zeta wn kappa_v',
+             its pure delay (if any) as a first-order Pade approximant. (The states are L kappa_v and its rate:
+             dimensionless like the road-wheel angle, which keeps the QPs well scaled.) The lag identified by
+             `tuning fit-lag` is the whole steering-wheel-to-curvature response (actuator, tyres, inertia), so it
+             replaces the dynamic bicycle's lateral dynamics rather than being stacked on them (that would count
+             the tyre lag twice). This is how the MPC and the clothoid controller's lead filter use the same
+             identified data.
+
+Path coordinates at the rear axle, with v_r the rear axle's lateral velocity (v_y - b r; zero in the kinematic
+kinds) and omega the yaw rate (r, or v kappa_v in the kinematic kinds):
+    s' = (v cos(e_psi) - v_r sin(e_psi)) / (1 - kappa e_y),  e_y' = v sin(e_psi) + v_r cos(e_psi),
+    e_psi' = omega - kappa s'.
+In the kinematic kinds e_psi is the error of the rear axle's course, which is its heading there.
+
+The tractor-semitrailer is predicted by an equivalent single track (`_truck_equivalent`): the tractor carrying the
+kingpin's share of the trailer (and payload) as a point mass at the fifth wheel, with the axle-group loads and
+cornering stiffnesses of the articulated model. In steady cornering this is exact for the tractor: the trailer
+pushes on the fifth wheel with m_trailer (l_t - e) / l_t times the lateral acceleration, as that point mass
+would, and the drive group's cornering stiffness already includes the kingpin load. It neglects the trailer's yaw
+transient (the articulation angle's own dynamics), which an identified lag file captures if one is given.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import casadi as ca
+import numpy as np
+
+from workbench.errors import WorkbenchInputError, require_in_range, require_positive
+from workbench.vehicles.base import VehicleGeometry, VehicleModel
+from workbench.vehicles.steering_lag import SteeringLag
+
+G_MPS2 = 9.81
+MODEL_KINDS = ("dynamic", "kinematic", "kinematic-lag")
+#: Steering-actuator time constant (s) assumed when only the geometry is known: an electric or hydraulic power
+#: steering position loop (the workbench presets use 0.05 s for the car and 0.1 s for the truck).
+DEFAULT_STEERING_TIME_CONSTANT_S = 0.1
+#: The RK4 step of the prediction is sub-divided until h |lambda| <= this for the fastest lateral mode at the
+#: lowest prediction speed (RK4's real stability limit is 2.785; 2.0 keeps the fast modes well damped).
+RK4_STABILITY_MARGIN = 2.0
+#: 1 - kappa e_y is kept above this in s' (the path's centre of curvature is never crossed in prediction).
+_MIN_FRENET_SCALE = 0.1
+
+
+@dataclass(frozen=True)
+class SingleTrackParams:
+    """Mass, yaw inertia, axle positions and axle tyres of a single-track (bicycle) model, SI units.
+
+    Axle lateral force F = D sin(C atan(B alpha - E (B alpha - atan(B alpha)))) with peak D, shape C, curvature E
+    and B = cornering stiffness / (C D), as in the workbench plants.
+    """
+
+    mass_kg: float
+    yaw_inertia_kgm2: float
+    cg_to_front_axle_m: float
+    cg_to_rear_axle_m: float
+    front_cornering_stiffness_n_per_rad: float
+    rear_cornering_stiffness_n_per_rad: float
+    front_peak_force_n: float
+    rear_peak_force_n: float
+    tyre_shape_factor: float = 1.35
+    tyre_curvature_factor: float = 0.0
+
+    def __post_init__(self) -> None:
+        require_in_range("mass_kg", self.mass_kg, 100.0, 100_000.0, "kg")
+        require_in_range("yaw_inertia_kgm2", self.yaw_inertia_kgm2, 10.0, 5.0e6, "kg m^2")
+        require_in_range("cg_to_front_axle_m", self.cg_to_front_axle_m, 0.05, 15.0, "m")
+        require_in_range("cg_to_rear_axle_m", self.cg_to_rear_axle_m, 0.05, 15.0, "m")
+        for name in (
+            "front_cornering_stiffness_n_per_rad",
+            "rear_cornering_stiffness_n_per_rad",
+            "front_peak_force_n",
+            "rear_peak_force_n",
+        ):
+            require_positive(name, getattr(self, name))
+        require_in_range("tyre_shape_factor", self.tyre_shape_factor, 1.0, 1.9)
+        require_in_range("tyre_curvature_factor", self.tyre_curvature_factor, -5.0, 0.99)
+
+    @property
+    def wheelbase_m(self) -> float:
+        return self.cg_to_front_axle_m + self.cg_to_rear_axle_m
+
+    def understeer_gradient_rad_per_mps2(self) -> float:
+        """K in delta = L kappa + K a_y (linear tyres): (m / L) (b / Cf - a / Cr)."""
+        a, b, m = self.cg_to_front_axle_m, self.cg_to_rear_axle_m, self.mass_kg
+        cf, cr = self.front_cornering_stiffness_n_per_rad, self.rear_cornering_stiffness_n_per_rad
+        return m / (a + b) * (b / cf - a / cr)
+
+    def fastest_lateral_mode_per_s(self, speed_mps: float) -> float:
+        """|lambda|max of the linear single track's (v_y, r) dynamics at this speed (1/s)."""
+        a, b, m, iz = self.cg_to_front_axle_m, self.cg_to_rear_axle_m, self.mass_kg, self.yaw_inertia_kgm2
+        cf, cr = self.front_cornering_stiffness_n_per_rad, self.rear_cornering_stiffness_n_per_rad
+        v = speed_mps
+        mat = np.array(
+            [
+                [-(cf + cr) / (m * v), -(a * cf - b * cr) / (m * v) - v],
+                [-(a * cf - b * cr) / (iz * v), -(a * a * cf + b * b * cr) / (iz * v)],
+            ]
+        )
+        return float(np.max(np.abs(np.linalg.eigvals(mat))))
+
+
+@dataclass(frozen=True)
+class PredictionParams:
+    """The vehicle as the MPC predicts it (SI units).
+
+    wheelbase_m, steering_ratio, max_road_wheel_angle_rad, max_road_wheel_rate_rad_s: as `VehicleGeometry`;
+    steering_time_constant_s: first-order steering actuator (s); single_track: mass, inertia and tyres, or None
+    when unknown (then only the kinematic kinds are available); lag: the identified steering-wheel-to-curvature
+    lag (Eq. 5), or None; source: where the numbers came from, for messages and reports.
+    """
+
+    wheelbase_m: float
+    steering_ratio: float
+    max_road_wheel_angle_rad: float
+    max_road_wheel_rate_rad_s: float
+    steering_time_constant_s: float = DEFAULT_STEERING_TIME_CONSTANT_S
+    single_track: SingleTrackParams | None = None
+    lag: SteeringLag | None = None
+    source: str = ""
+
+    def __post_init__(self) -> None:
+        require_in_range("wheelbase_m", self.wheelbase_m, 0.5, 15.0, "m")
+        require_in_range("steering_ratio", self.steering_ratio, 1.0, 60.0)
+        require_in_range("max_road_wheel_angle_rad", self.max_road_wheel_angle_rad, 0.01, 1.5, "rad")
+        require_positive("max_road_wheel_rate_rad_s", self.max_road_wheel_rate_rad_s)
+        require_in_range("steering_time_constant_s", self.steering_time_constant_s, 1e-3, 2.0, "s")
+        if self.single_track is not None and abs(self.single_track.wheelbase_m - self.wheelbase_m) > 1e-6:
+            raise WorkbenchInputError(
+                f"single_track axle positions add up to {self.single_track.wheelbase_m} m; they must equal "
+                f"wheelbase_m = {self.wheelbase_m} m"
+            )
+
+    def with_lag(self, lag: SteeringLag | None) -> PredictionParams:
+        """A copy with this identified lag (None removes it)."""
+        return dataclasses.replace(self, lag=lag)
+
+    def default_kind(self) -> str:
+        """ "kinematic-lag" with a lag, else "dynamic" when the single track is known, else "kinematic"."""
+        if self.lag is not None:
+            return "kinematic-lag"
+        return "dynamic" if self.single_track is not None else "kinematic"
+
+
+# ---------------------------------------------------------------------------------------------- from vehicles
+def params_from_geometry(geometry: VehicleGeometry) -> PredictionParams:
+    """The default when nothing but the geometry is known: a kinematic single track with the geometry's limits
+    and an assumed actuator time constant (DEFAULT_STEERING_TIME_CONSTANT_S)."""
+    return PredictionParams(
+        wheelbase_m=geometry.wheelbase_m,
+        steering_ratio=geometry.steering_ratio,
+        max_road_wheel_angle_rad=geometry.max_road_wheel_angle_rad,
+        max_road_wheel_rate_rad_s=geometry.max_steer_wheel_rate_rad_s / geometry.steering_ratio,
+        source="geometry only (kinematic single track, assumed actuator time constant)",
+    )
+
+
+def _dynamic_bicycle(p: Any, source: str) -> PredictionParams:
+    a, b = p.cg_to_front_axle_m, p.cg_to_rear_axle_m
+    fzf, fzr = p.mass_kg * G_MPS2 * b / (a + b), p.mass_kg * G_MPS2 * a / (a + b)
+    track = SingleTrackParams(
+        mass_kg=p.mass_kg,
+        yaw_inertia_kgm2=p.yaw_inertia_kgm2,
+        cg_to_front_axle_m=a,
+        cg_to_rear_axle_m=b,
+        front_cornering_stiffness_n_per_rad=p.front_cornering_coeff_per_rad * fzf,
+        rear_cornering_stiffness_n_per_rad=p.rear_cornering_coeff_per_rad * fzr,
+        front_peak_force_n=p.tyre_friction * fzf,
+        rear_peak_force_n=p.tyre_friction * fzr,
+        tyre_shape_factor=p.tyre_shape_factor,
+        tyre_curvature_factor=p.tyre_curvature_factor,
+    )
+    return PredictionParams(
+        wheelbase_m=a + b,
+        steering_ratio=p.steering_ratio,
+        max_road_wheel_angle_rad=p.max_road_wheel_angle_rad,
+        max_road_wheel_rate_rad_s=p.max_road_wheel_rate_rad_s,
+        steering_time_constant_s=p.steering_time_constant_s,
+        single_track=track,
+        source=source,
+    )
+
+
+def _kinematic_bicycle(p: Any, source: str) -> PredictionParams:
+    return PredictionParams(
+        wheelbase_m=p.wheelbase_m,
+        steering_ratio=p.steering_ratio,
+        max_road_wheel_angle_rad=p.max_road_wheel_angle_rad,
+        max_road_wheel_rate_rad_s=p.max_road_wheel_rate_rad_s,
+        steering_time_constant_s=p.steering_time_constant_s,
+        source=source,
+    )
+
+
+def _truck_equivalent(p: Any, source: str) -> PredictionParams:
+    """Equivalent single track of the tractor-semitrailer (module docstring): the tractor plus the kingpin's share
+    of the trailer as a point mass at the fifth wheel; axle loads and cornering stiffnesses of the articulated
+    model (drive group including the kingpin load)."""
+    from workbench.vehicles.tractor_semitrailer import derive
+
+    d = derive(p)
+    l1 = p.cg_to_front_axle_m + p.cg_to_drive_axle_m
+    lt = p.hitch_to_trailer_axle_m
+    king_mass = d.m2 * (lt - d.e) / lt
+    w_front, w_drive = d.loads_n[0], d.loads_n[1]
+    mass = d.m1 + king_mass
+    # Equivalent CG from the static loads (moment balance about the axles); x forward from the drive axle.
+    b_eq = l1 * w_front / (w_front + w_drive)
+    a_eq = l1 - b_eq
+    x_tractor_cg, x_hitch = d.b, p.hitch_ahead_of_drive_m
+    inertia = d.i1 + d.m1 * (x_tractor_cg - b_eq) ** 2 + king_mass * (x_hitch - b_eq) ** 2
+    track = SingleTrackParams(
+        mass_kg=mass,
+        yaw_inertia_kgm2=inertia,
+        cg_to_front_axle_m=a_eq,
+        cg_to_rear_axle_m=b_eq,
+        front_cornering_stiffness_n_per_rad=p.front_cornering_coeff_per_rad * w_front,
+        rear_cornering_stiffness_n_per_rad=p.drive_cornering_coeff_per_rad * w_drive,
+        front_peak_force_n=p.tyre_friction * w_front,
+        rear_peak_force_n=p.tyre_friction * w_drive,
+        tyre_shape_factor=p.tyre_shape_factor,
+        tyre_curvature_factor=0.0,
+    )
+    return PredictionParams(
+        wheelbase_m=l1,
+        steering_ratio=p.steering_ratio,
+        max_road_wheel_angle_rad=p.max_road_wheel_angle_rad,
+        max_road_wheel_rate_rad_s=p.max_road_wheel_rate_rad_s,
+        steering_time_constant_s=p.steering_time_constant_s,
+        single_track=track,
+        source=source + " (equivalent single track: tractor + kingpin share of the trailer at the fifth wheel)",
+    )
+
+
+def _commonroad_mb(p: Any, source: str) -> PredictionParams:
+    """CommonRoad's car parameters (vehicle 1-3) as a single track with CommonRoad's tyre coefficients."""
+    from vehiclemodels.parameters_vehicle1 import parameters_vehicle1
+    from vehiclemodels.parameters_vehicle2 import parameters_vehicle2
+    from vehiclemodels.parameters_vehicle3 import parameters_vehicle3
+
+    cr = {1: parameters_vehicle1, 2: parameters_vehicle2, 3: parameters_vehicle3}[p.vehicle_id]()
+    a, b, m = float(cr.a), float(cr.b), float(cr.m)
+    fzf, fzr = m * G_MPS2 * b / (a + b), m * G_MPS2 * a / (a + b)
+    tyre = cr.tire
+    track = SingleTrackParams(
+        mass_kg=m,
+        yaw_inertia_kgm2=float(cr.I_z),
+        cg_to_front_axle_m=a,
+        cg_to_rear_axle_m=b,
+        front_cornering_stiffness_n_per_rad=-float(tyre.p_ky1) * fzf,
+        rear_cornering_stiffness_n_per_rad=-float(tyre.p_ky1) * fzr,
+        front_peak_force_n=float(tyre.p_dy1) * fzf,
+        rear_peak_force_n=float(tyre.p_dy1) * fzr,
+        tyre_shape_factor=float(tyre.p_cy1),
+        tyre_curvature_factor=float(tyre.p_ey1),
+    )
+    return PredictionParams(
+        wheelbase_m=a + b,
+        steering_ratio=p.steering_ratio,
+        max_road_wheel_angle_rad=float(cr.steering.max),
+        max_road_wheel_rate_rad_s=float(cr.steering.v_max),
+        steering_time_constant_s=p.steering_time_constant_s,
+        single_track=track,
+        source=source + f" (CommonRoad vehicle {p.vehicle_id} as a single track)",
+    )
+
+
+def prediction_params_for(vehicle: object) -> PredictionParams:
+    """Prediction parameters for a vehicle given as a `VehicleModel`, a params dataclass of one (the fields of a
+    preset), a preset name or TOML file path (str/Path), a `VehicleGeometry` (kinematic default) or already as
+    `PredictionParams`."""
+    from workbench.vehicles import (
+        CommonRoadMBParams,
+        DynamicBicycleParams,
+        KinematicBicycleParams,
+        TractorSemitrailerParams,
+        load_vehicle,
+    )
+
+    if isinstance(vehicle, PredictionParams):
+        return vehicle
+    if isinstance(vehicle, VehicleGeometry):
+        return params_from_geometry(vehicle)
+    source = f"{type(vehicle).__name__} parameters"
+    if isinstance(vehicle, str | Path):
+        source = f"vehicle {str(vehicle)!r}"
+        vehicle = load_vehicle(str(vehicle))
+    elif isinstance(vehicle, VehicleModel):
+        source = f"the {vehicle.name} model's parameters"
+    if isinstance(vehicle, VehicleModel):
+        params = getattr(vehicle, "params", None)
+        if params is None:  # a model without a params dataclass: its geometry is all there is
+            return params_from_geometry(vehicle.geometry)
+        vehicle = params
+    builders = (
+        (DynamicBicycleParams, _dynamic_bicycle),
+        (KinematicBicycleParams, _kinematic_bicycle),
+        (TractorSemitrailerParams, _truck_equivalent),
+        (CommonRoadMBParams, _commonroad_mb),
+    )
+    for params_type, build in builders:
+        if isinstance(vehicle, params_type):
+            return build(vehicle, source)
+    raise WorkbenchInputError(
+        f"cannot build an MPC prediction model from a {type(vehicle).__name__}; give a VehicleModel, a vehicle "
+        "params dataclass, a preset name or TOML file, a VehicleGeometry or PredictionParams"
+    )
+
+
+@functools.lru_cache(maxsize=32)
+def matching_preset(geometry: VehicleGeometry) -> str | None:
+    """The shipped preset whose geometry equals `geometry` exactly, or None. Presets with a single-track model
+    (dynamic-bicycle, tractor-semitrailer, commonroad-mb) are tried before the kinematic one."""
+    from workbench.vehicles import VEHICLES
+
+    preference = ("dynamic-bicycle", "tractor-semitrailer", "commonroad-mb", "kinematic-bicycle")
+    order = sorted(VEHICLES, key=lambda name: preference.index(name) if name in preference else len(preference))
+    for name in order:
+        if VEHICLES[name]().geometry == geometry:
+            return name
+    return None
+
+
+# ---------------------------------------------------------------------------------------------- the model
+class PredictionModel:
+    """The ODE of one model kind as CasADi expressions, and its RK4 discretisation.
+
+    x: states (`state_names`); u: [delta_c'] (rad/s); p: [kappa (1/m), v (m/s)], held over an interval.
+    """
+
+    def __init__(self, params: PredictionParams, kind: str | None = None) -> None:
+        kind = kind or params.default_kind()
+        if kind not in MODEL_KINDS:
+            raise WorkbenchInputError(f"model kind must be one of {', '.join(MODEL_KINDS)}; got {kind!r}")
+        if kind == "dynamic" and params.single_track is None:
+            raise WorkbenchInputError(
+                f"the dynamic model needs mass, inertia and tyres, which {params.source or 'these parameters'} "
+                "do not give; name a vehicle preset or file, or use model 'kinematic'"
+            )
+        if kind == "kinematic-lag" and params.lag is None:
+            raise WorkbenchInputError("model 'kinematic-lag' needs an identified lag: give a lag_file")
+        self.params, self.kind = params, kind
+        names = ["cte_m", "heading_error_rad"]
+        if kind == "dynamic":
+            names += ["vy_cg_mps", "yaw_rate_rad_s", "road_wheel_rad"]
+        elif kind == "kinematic":
+            names += ["road_wheel_rad"]
+        else:
+            names += ["wheelbase_x_curvature", "wheelbase_x_curvature_rate_1ps"]
+            if params.lag is not None and params.lag.delay_s > 0.0:
+                names += ["delayed_wheelbase_x_curvature"]
+        names += ["road_wheel_cmd_rad"]
+        self.state_names: tuple[str, ...] = tuple(names)
+        self.nx, self.nu, self.np = len(names), 1, 2
+        self.i_cte, self.i_heading, self.i_cmd = 0, 1, len(names) - 1
+        x, u, p = ca.SX.sym("x", self.nx), ca.SX.sym("u", 1), ca.SX.sym("p", 2)
+        xdot, yaw_rate, progress = self._ode(x, u, p)
+        self.ode = ca.Function("ode", [x, u, p], [xdot], ["x", "u", "p"], ["xdot"])
+        self.lateral_accel = ca.Function("lat_accel", [x, p], [p[1] * yaw_rate], ["x", "p"], ["ay"])
+        self.progress_rate = ca.Function("progress_rate", [x, p], [progress], ["x", "p"], ["sdot"])
+        self.reference = ca.Function("reference", [p], [self._reference(p[0], p[1])], ["p"], ["x_ref"])
+
+    def _ode(self, x: ca.SX, u: ca.SX, p: ca.SX) -> tuple[ca.SX, ca.SX, ca.SX]:
+        prm, kind = self.params, self.kind
+        kappa, v = p[0], p[1]
+        e_y, e_psi, delta_c = x[0], x[1], x[self.i_cmd]
+        wheelbase = prm.wheelbase_m
+        if kind == "dynamic":
+            st = prm.single_track
+            assert st is not None
+            vy, r, delta = x[2], x[3], x[4]
+            a, b = st.cg_to_front_axle_m, st.cg_to_rear_axle_m
+            alpha_f = delta - ca.atan((vy + a * r) / v)
+            alpha_r = -ca.atan((vy - b * r) / v)
+            fyf = _magic(alpha_f, st.front_peak_force_n, st.front_cornering_stiffness_n_per_rad, st)
+            fyr = _magic(alpha_r, st.rear_peak_force_n, st.rear_cornering_stiffness_n_per_rad, st)
+            vy_dot = (fyf * ca.cos(delta) + fyr) / st.mass_kg - v * r
+            r_dot = (a * fyf * ca.cos(delta) - b * fyr) / st.yaw_inertia_kgm2
+            delta_dot = (delta_c - delta) / prm.steering_time_constant_s
+            v_rear, yaw_rate = vy - b * r, r
+            states_dot = [vy_dot, r_dot, delta_dot]
+        elif kind == "kinematic":
+            delta = x[2]
+            v_rear, yaw_rate = 0.0, v * ca.tan(delta) / wheelbase
+            states_dot = [(delta_c - delta) / prm.steering_time_constant_s]
+        else:
+            lag = prm.lag
+            assert lag is not None
+            # States are curvatures times the wheelbase (L kappa, dimensionless, about the road-wheel angle) so that
+            # they are of the size of the other states: the QP then needs no scaling.
+            curvature, curvature_rate = x[2], x[3]
+            kinematic = lag.steady_state_gain * ca.tan(delta_c)  # K tan(delta_c): the settled L kappa
+            wn, zeta = lag.omega_n_rad_s, lag.zeta
+            if lag.delay_s > 0.0:  # first-order Pade: exp(-sT) ~ (1 - sT/2) / (1 + sT/2) = 2 w - 1, w' = 2/T (in - w)
+                w = x[4]
+                lag_input = 2.0 * w - kinematic
+                w_dot = 2.0 / lag.delay_s * (kinematic - w)
+            else:
+                lag_input = kinematic
+            states_dot = [curvature_rate, wn * wn * (lag_input - curvature) - 2.0 * zeta * wn * curvature_rate]
+            if lag.delay_s > 0.0:
+                states_dot.append(w_dot)
+            v_rear, yaw_rate = 0.0, v * curvature / wheelbase
+        scale = ca.fmax(1.0 - kappa * e_y, _MIN_FRENET_SCALE)
+        s_dot = (v * ca.cos(e_psi) - v_rear * ca.sin(e_psi)) / scale
+        e_y_dot = v * ca.sin(e_psi) + v_rear * ca.cos(e_psi)
+        e_psi_dot = yaw_rate - kappa * s_dot
+        xdot = ca.vertcat(e_y_dot, e_psi_dot, *states_dot, u[0])
+        return xdot, yaw_rate, s_dot
+
+    def progress_rate_numpy(self, states: np.ndarray, kappa: np.ndarray, speed: np.ndarray) -> np.ndarray:
+        """s' of `progress_rate` for rows of states (n, nx) with per-row kappa and speed, in numpy (cheaper per
+        step than a CasADi call; the tests check that both agree)."""
+        e_y, e_psi = states[:, self.i_cte], states[:, self.i_heading]
+        scale = np.maximum(1.0 - kappa * e_y, _MIN_FRENET_SCALE)
+        along = speed * np.cos(e_psi)
+        if self.kind == "dynamic":
+            st = self.params.single_track
+            assert st is not None
+            v_rear = states[:, 2] - st.cg_to_rear_axle_m * states[:, 3]
+            along = along - v_rear * np.sin(e_psi)
+        return along / scale
+
+    def _reference(self, kappa: ca.SX, v: ca.SX) -> ca.SX:
+        """Steady cornering on the path (e_y = 0) at curvature kappa and speed v: the state the LTV-MPC linearises
+        about. For the dynamic kind: r = v kappa, the axle forces that hold the turn, their slip angles (the magic
+        formula inverted without its small curvature factor E), the rear axle's sideslip as the heading error and
+        the steering that goes with them (as Rajamani, Vehicle Dynamics and Control, section 3.2, with linear
+        tyres)."""
+        prm, names = self.params, self.state_names
+        x = [ca.SX(0.0)] * self.nx
+        kinematic_angle = ca.atan(prm.wheelbase_m * kappa)
+        if self.kind == "dynamic":
+            st = prm.single_track
+            assert st is not None
+            a, b, m = st.cg_to_front_axle_m, st.cg_to_rear_axle_m, st.mass_kg
+            r = v * kappa
+            alpha_r = _inverse_magic(
+                m * v * r * a / (a + b), st.rear_peak_force_n, st.rear_cornering_stiffness_n_per_rad, st
+            )
+            vy = b * r - v * ca.tan(alpha_r)
+            front = m * v * r * b / (a + b)  # = Fyf cos(delta): one fixed-point pass for the cosine
+            delta = ca.SX(0.0)
+            for _ in range(2):
+                alpha_f = _inverse_magic(
+                    front / ca.cos(delta), st.front_peak_force_n, st.front_cornering_stiffness_n_per_rad, st
+                )
+                delta = alpha_f + ca.atan((vy + a * r) / v)
+            x[names.index("vy_cg_mps")] = vy
+            x[names.index("yaw_rate_rad_s")] = r
+            x[names.index("road_wheel_rad")] = delta
+            x[self.i_heading] = alpha_r
+            x[self.i_cmd] = delta
+        elif self.kind == "kinematic":
+            x[names.index("road_wheel_rad")] = kinematic_angle
+            x[self.i_cmd] = kinematic_angle
+        else:
+            lag = prm.lag
+            assert lag is not None
+            x[names.index("wheelbase_x_curvature")] = prm.wheelbase_m * kappa
+            if "delayed_wheelbase_x_curvature" in names:
+                x[names.index("delayed_wheelbase_x_curvature")] = prm.wheelbase_m * kappa
+            x[self.i_cmd] = ca.atan(prm.wheelbase_m * kappa / lag.steady_state_gain)
+        return ca.vertcat(*x)
+
+    def reference_states(self, kappa: np.ndarray, speed: np.ndarray) -> np.ndarray:
+        """`_reference` at each (kappa, speed) pair: (n, nx)."""
+        kappa, speed = np.atleast_1d(kappa).astype(float), np.atleast_1d(speed).astype(float)
+        out = self.reference.map(kappa.size)(np.vstack((kappa, speed)))
+        return np.asarray(out.full()).T
+
+    def substeps_for(self, step_s: float, min_speed_mps: float) -> int:
+        """RK4 sub-steps per prediction step so that the fastest mode stays within RK4_STABILITY_MARGIN."""
+        prm = self.params
+        fastest = 1.0 / prm.steering_time_constant_s
+        if self.kind == "dynamic":
+            assert prm.single_track is not None
+            fastest = max(fastest, prm.single_track.fastest_lateral_mode_per_s(min_speed_mps))
+        elif self.kind == "kinematic-lag":
+            lag = prm.lag
+            assert lag is not None
+            fastest = lag.omega_n_rad_s * (lag.zeta + math.sqrt(max(lag.zeta**2 - 1.0, 0.0)))
+            if lag.delay_s > 0.0:
+                fastest = max(fastest, 2.0 / lag.delay_s)
+        return max(1, math.ceil(step_s * fastest / RK4_STABILITY_MARGIN - 1e-9))
+
+    def discrete(self, step_s: float, substeps: int, name: str = "F") -> ca.Function:
+        """x_next = F(x, u, p): `substeps` RK4 steps over step_s with u and p held (an SX function)."""
+        x, u, p = ca.SX.sym("x", self.nx), ca.SX.sym("u", 1), ca.SX.sym("p", 2)
+        h = step_s / substeps
+        xk = x
+        for _ in range(substeps):
+            k1 = self.ode(xk, u, p)
+            k2 = self.ode(xk + 0.5 * h * k1, u, p)
+            k3 = self.ode(xk + 0.5 * h * k2, u, p)
+            k4 = self.ode(xk + h * k3, u, p)
+            xk = xk + h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+        return ca.Function(name, [x, u, p], [xk], ["x", "u", "p"], ["x_next"])
+
+
+def _magic(alpha: ca.SX, peak: float, stiffness: float, st: SingleTrackParams) -> ca.SX:
+    shape, curv = st.tyre_shape_factor, st.tyre_curvature_factor
+    bb = stiffness / (shape * peak)
+    z = bb * alpha
+    return peak * ca.sin(shape * ca.atan(z - curv * (z - ca.atan(z))))
+
+
+def _inverse_magic(force: ca.SX, peak: float, stiffness: float, st: SingleTrackParams) -> ca.SX:
+    """Slip angle giving `force` by the magic formula with E = 0 (within 99% of the peak)."""
+    shape = st.tyre_shape_factor
+    bb = stiffness / (shape * peak)
+    ratio = ca.fmin(ca.fmax(force / peak, -0.99), 0.99)
+    return ca.tan(ca.asin(ratio) / shape) / bb
