@@ -26,8 +26,6 @@ import scipy.sparse as sp
 
 from controllers.mpc.status import SolveStatus, osqp_status
 
-_OSQP_MAJOR = int(osqp.__version__.split(".")[0])
-
 
 @dataclass(frozen=True)
 class OsqpSettings:
@@ -54,10 +52,7 @@ class OsqpSettings:
             "check_termination": self.check_termination,
             "scaling": self.scaling,
         }
-        if _OSQP_MAJOR >= 1:
-            out.update(polishing=self.polish, warm_starting=True)
-        else:  # pragma: no cover - OSQP 0.6 names
-            out.update(polish=self.polish, warm_start=True)
+        out.update(polishing=self.polish, warm_starting=True)  # OSQP >= 1.0 names
         if self.time_limit_s > 0.0:
             out["time_limit"] = self.time_limit_s
         return out
@@ -262,7 +257,7 @@ class SparseMPCQP:
         if warm_start is not None:
             self.solver.warm_start(x=warm_start)
         start = time.perf_counter()
-        result = self.solver.solve(raise_error=False) if _OSQP_MAJOR >= 1 else self.solver.solve()
+        result = self.solver.solve(raise_error=False)
         elapsed = time.perf_counter() - start
         status = osqp_status(str(result.info.status))
         z = np.asarray(result.x, dtype=float)
