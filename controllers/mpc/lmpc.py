@@ -28,7 +28,7 @@ import numpy as np
 from controllers.mpc.codegen import FastFunction, compile_function
 from controllers.mpc.common import MPCConfig, MPCController
 from controllers.mpc.ocp import TrackingOCP
-from controllers.mpc.sparse_qp import OsqpSettings, SparseMPCQP
+from controllers.mpc.sparse_qp import OsqpSettings
 from controllers.mpc.status import SolveResult
 from workbench.errors import WorkbenchInputError, require_in_range
 from workbench.vehicles.base import VehicleGeometry
@@ -60,19 +60,7 @@ class LtvSolver:
         compiled = compile_function(ca.Function(name, inputs, mapped.call(inputs)), codegen)
         self.discretise = FastFunction(compiled.function)
         self.compiled, self.codegen_note = compiled.compiled, compiled.note
-        self.qp = SparseMPCQP(
-            N,
-            nx,
-            nu,
-            ocp.Q,
-            ocp.R,
-            ocp.QN,
-            ocp.x_lower,
-            ocp.x_upper,
-            ocp.u_lower,
-            ocp.u_upper,
-            settings=settings,
-        )
+        self.qp = ocp.sparse_qp(settings)
         self._bounds_version = ocp.bounds_version
 
     def matrices(self, kappa: np.ndarray, speed: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -110,13 +98,19 @@ class LtvSolver:
 @dataclass(frozen=True)
 class LMPCConfig(MPCConfig):
     """The common MPC options (`MPCConfig`; model "auto" means kinematic, or kinematic-lag with a lag file) and:
-    qp_tolerance: OSQP's absolute and relative tolerance; qp_max_iterations: OSQP's iteration limit."""
+    qp_tolerance: OSQP's absolute and relative tolerance; qp_max_iterations: OSQP's iteration limit. The
+    lateral-acceleration limit (max_lat_accel_mps2) is the NMPC's only: the LTV-MPC refuses it."""
 
     qp_tolerance: float = 1e-3
     qp_max_iterations: int = 4000
 
     def __post_init__(self) -> None:
         super().__post_init__()
+        if self.max_lat_accel_mps2 != 0.0:
+            raise WorkbenchInputError(
+                f"max_lat_accel_mps2 must be 0 for the LTV-MPC (it has no lateral-acceleration limit; the NMPC has); "
+                f"got {self.max_lat_accel_mps2!r}"
+            )
         require_in_range("qp_tolerance", self.qp_tolerance, 1e-10, 1e-1)
         value = self.qp_max_iterations
         if isinstance(value, bool) or not isinstance(value, int) or not 1 <= value <= 10**6:

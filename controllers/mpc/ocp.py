@@ -22,6 +22,7 @@ import numpy as np
 
 from controllers.mpc.codegen import CompiledFunction, FastFunction, compile_function
 from controllers.mpc.prediction_model import PredictionModel
+from controllers.mpc.sparse_qp import OsqpSettings, SparseMPCQP
 from workbench.errors import WorkbenchInputError, require_in_range, require_positive
 
 
@@ -93,6 +94,26 @@ class TrackingOCP:
         self.u_lower = np.array([-params.max_road_wheel_rate_rad_s])
         self.u_upper = np.array([params.max_road_wheel_rate_rad_s])
         self.bounds_version = 0  # incremented whenever the bounds change, so solvers update only then
+
+    def sparse_qp(self, settings: OsqpSettings) -> SparseMPCQP:
+        """The OSQP problem of this OCP's weights and bounds (with the soft lateral-acceleration rows when the
+        limit is set), built once; the solvers overwrite its dynamics each step."""
+        slack = self.weights.lat_accel_slack
+        return SparseMPCQP(
+            self.N,
+            self.nx,
+            self.nu,
+            self.Q,
+            self.R,
+            self.QN,
+            self.x_lower,
+            self.x_upper,
+            self.u_lower,
+            self.u_upper,
+            soft=self.soft,
+            soft_weights=(slack, slack),
+            settings=settings,
+        )
 
     def linearisation(self, codegen: bool = True) -> CompiledFunction:
         """The discrete model and its Jacobians on all N intervals in one call: (X (nx, N), U (nu, N), P (2, N)) ->

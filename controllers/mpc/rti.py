@@ -21,7 +21,7 @@ import numpy as np
 
 from controllers.mpc.codegen import FastFunction
 from controllers.mpc.ocp import TrackingOCP
-from controllers.mpc.sparse_qp import OsqpSettings, SparseMPCQP
+from controllers.mpc.sparse_qp import OsqpSettings
 from controllers.mpc.status import SolveResult, SolveStatus
 
 #: An SQP iteration whose largest input change is below this (rad/s) counts as converged.
@@ -33,7 +33,7 @@ class RtiSolver:
 
     def __init__(self, ocp: TrackingOCP, settings: OsqpSettings | None = None, codegen: bool = True) -> None:
         self.ocp = ocp
-        N, nx, nu = ocp.N, ocp.nx, ocp.nu
+        N, nx = ocp.N, ocp.nx
         compiled = ocp.linearisation(codegen)
         self.linearise = FastFunction(compiled.function)
         self.compiled, self.codegen_note = compiled.compiled, compiled.note
@@ -43,22 +43,7 @@ class RtiSolver:
             soft = ca.Function("soft", [x, p], [ay, ca.densify(ca.jacobian(ay, x))]).map(N)
             soft_in = soft.mx_in()
             self.soft_fn = FastFunction(ca.Function("soft_map", soft_in, soft.call(soft_in)).expand())
-        weights = ocp.weights
-        self.qp = SparseMPCQP(
-            N,
-            nx,
-            nu,
-            ocp.Q,
-            ocp.R,
-            ocp.QN,
-            ocp.x_lower,
-            ocp.x_upper,
-            ocp.u_lower,
-            ocp.u_upper,
-            soft=ocp.soft,
-            soft_weights=(weights.lat_accel_slack, weights.lat_accel_slack),
-            settings=settings,
-        )
+        self.qp = ocp.sparse_qp(settings)
         self._bounds_version = ocp.bounds_version
 
     def solve(

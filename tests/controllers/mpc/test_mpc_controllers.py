@@ -226,6 +226,7 @@ def test_a_bad_lag_file_is_named(tmp_path: Path) -> None:
         (NMPCConfig, {"tolerance": 1.0}, r"tolerance must be in \[1e-12, 0.1\]"),
         (LMPCConfig, {"vehicle": "bus"}, "vehicle must be 'auto', 'geometry' or a preset name .*; got 'bus'"),
         (LMPCConfig, {"max_lat_accel_mps2": -1.0}, "max_lat_accel_mps2 must be in"),
+        (LMPCConfig, {"max_lat_accel_mps2": 2.0}, "max_lat_accel_mps2 must be 0 for the LTV-MPC"),
         (LMPCConfig, {"min_model_speed_mps": 0.0}, "min_model_speed_mps must be in"),
         (LMPCConfig, {"qp_max_iterations": 0}, "qp_max_iterations must be a whole number"),
         (LMPCConfig, {"max_solve_time_s": -0.1}, "max_solve_time_s must be in"),
