@@ -1,4 +1,5 @@
-"""The `workbench` command line: list scenarios, vehicles and controllers; run a closed-loop simulation."""
+"""The `workbench` command line: list scenarios, vehicles and controllers; run a closed-loop simulation; compare
+controllers side by side (`compare`, and the paper's Figure 17 set-up, `fig17`)."""
 
 from __future__ import annotations
 
@@ -10,7 +11,10 @@ from pathlib import Path
 
 from controllers import CONTROLLERS, make_controller
 from controllers.config_file import config_template, read_controller_config
+from workbench.comparison import Comparison, RunSpec, compare
 from workbench.errors import WorkbenchInputError
+from workbench.fig17 import run_fig17
+from workbench.report import ReportSection, write_report
 from workbench.scenarios import ScenarioOptions, describe_scenarios, make_scenario
 from workbench.simulator import Simulation, SimulationConfig
 from workbench.vehicles import VEHICLES, list_presets, make_vehicle, preset_text
@@ -59,7 +63,82 @@ def _parser() -> argparse.ArgumentParser:
     run.add_argument("--plant-rate-hz", type=float, default=1000.0, help="plant integration rate (default 1 kHz)")
     run.add_argument("--lat-accel-g", type=float, default=0.3, help="speed-profile lateral bound (default 0.3 g)")
     run.add_argument("--no-plots", action="store_true", help="write the trace and metrics only")
+
+    cmp = sub.add_parser("compare", help="run several controllers (and vehicles) on one scenario; write a report")
+    cmp.add_argument("scenario", help="a scenario name (see `workbench scenarios`) or a waypoint CSV file")
+    cmp.add_argument(
+        "--controllers",
+        required=True,
+        metavar="A,B,...",
+        help=f"comma-separated controller names ({', '.join(CONTROLLERS)})",
+    )
+    cmp.add_argument(
+        "--vehicle", required=True, metavar="NAME[,NAME...]", help="vehicle preset(s); each controller runs on each"
+    )
+    cmp.add_argument(
+        "--controller-config",
+        type=Path,
+        metavar="FILE.toml",
+        help="controller options: a TOML file with a table per controller name",
+    )
+    cmp.add_argument("--out", type=Path, required=True, metavar="DIR", help="output directory")
+    _sim_options(cmp)
+
+    fig = sub.add_parser(
+        "fig17", help="the paper's Figure 17/18 comparison: clothoid vs NMPC, as published and each on each plant"
+    )
+    fig.add_argument("--out", type=Path, required=True, metavar="DIR", help="output directory (report.html in it)")
+    fig.add_argument("--speed", type=float, default=30.0, metavar="KMH", help="target speed, km/h (default 30)")
     return parser
+
+
+def _sim_options(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--speed", type=float, default=30.0, metavar="KMH", help="target speed, km/h (default 30)")
+    parser.add_argument("--track", type=Path, help="track CSV for the zandvoort scenario")
+    parser.add_argument("--laps", type=int, default=1, help="laps of a closed path (default 1)")
+    parser.add_argument("--lat-accel-g", type=float, default=0.3, help="speed-profile lateral bound (default 0.3 g)")
+
+
+def _names(text: str, what: str) -> list[str]:
+    names = [n.strip() for n in text.split(",") if n.strip()]
+    if not names:
+        raise WorkbenchInputError(f"--{what} needs at least one name; got {text!r}")
+    return names
+
+
+def _print_summary(comparison: Comparison) -> None:
+    table = comparison.summary()
+    columns = ["controller", "vehicle", "status", "max_abs_cte_m", "rms_cte_m", "converge_distance_m"]
+    columns += ["step_time_median_us", "step_time_ratio"]
+    print(table[columns].to_string(index=False, float_format=lambda v: f"{v:.3g}"))
+
+
+def _compare(args: argparse.Namespace) -> int:
+    runs = [
+        RunSpec(controller, vehicle, config_file=args.controller_config)
+        for vehicle in _names(args.vehicle, "vehicle")
+        for controller in _names(args.controllers, "controllers")
+    ]
+    config = SimulationConfig(speed_kmh=args.speed, laps=args.laps, max_lateral_accel_g=args.lat_accel_g)
+    comparison = compare(args.scenario, runs, config, ScenarioOptions(track_file=args.track))
+    comparison.save(args.out)
+    report = write_report(
+        args.out / "report.html",
+        f"{comparison.scenario.name}: {', '.join(dict.fromkeys(r.controller for r in runs))}",
+        [ReportSection("Side by side", "", comparison)],
+    )
+    _print_summary(comparison)
+    print(f"wrote {report} and summary.csv, figures and runs/ beside it")
+    return 0 if all(r.completed for r in comparison.results) else EXIT_RUN_FAILED
+
+
+def _fig17(args: argparse.Namespace) -> int:
+    result = run_fig17(SimulationConfig(speed_kmh=args.speed))
+    written = result.save(args.out)
+    print("Figure 17, fair set (each controller on each plant):")
+    _print_summary(result.fair)
+    print(f"report: {written[-1]}")
+    return 0 if all(r.completed for r in result.fair.results) else EXIT_RUN_FAILED
 
 
 def _run(args: argparse.Namespace) -> int:
@@ -125,6 +204,10 @@ def main(argv: Sequence[str] | None = None) -> int:
                 return 0
             for name, cls in CONTROLLERS.items():
                 print(f"{name:<14} {cls.summary()}")
+        elif args.command == "compare":
+            return _compare(args)
+        elif args.command == "fig17":
+            return _fig17(args)
         else:
             return _run(args)
     except WorkbenchInputError as exc:

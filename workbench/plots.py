@@ -1,7 +1,10 @@
-"""Plots of one run: trajectory over the reference (with cones), CTE vs distance, steering vs time, speed."""
+"""Plots of one run (trajectory over the reference with cones, CTE vs distance, steering vs time, speed), and of
+several runs on shared axes (the paper's Figures 17 and 18: `trajectories`, `cte_comparison`, `speed_comparison`,
+`steering_comparison`)."""
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -30,8 +33,7 @@ def _distance(result: SimulationResult) -> np.ndarray:
 
 def trajectory(result: SimulationResult, ax: Axes | None = None) -> Axes:
     ax = _axes(ax)
-    path = result.path
-    ax.plot(path.x_m, path.y_m, "k--", lw=1.0, label="reference")
+    _draw_reference(result, ax)
     ax.plot(result.trace["x_m"], result.trace["y_m"], lw=1.5, label=f"{_label(result)} (rear axle)")
     if "trailer_x_m" in result.trace:
         ax.plot(
@@ -41,13 +43,7 @@ def trajectory(result: SimulationResult, ax: Axes | None = None) -> Axes:
             color="tab:green",
             label="trailer rear axle",
         )
-    cones = result.scenario.cones_xy
-    if cones is not None:
-        ax.plot(cones[:, 0], cones[:, 1], "^", color="tab:red", ms=5, label="cones")
     ax.set(xlabel="x (m)", ylabel="y (m)", title=f"{result.scenario.name}: tracked trajectory")
-    width, height = np.ptp(path.x_m), np.ptp(path.y_m)
-    if min(width, height) > 0.25 * max(width, height):  # true shape unless the path is long and thin (a DLC)
-        ax.set_aspect("equal", adjustable="datalim")
     ax.legend(loc="best", fontsize="small")
     return ax
 
@@ -99,3 +95,58 @@ def save_run_plots(result: SimulationResult, out_dir: Path) -> list[Path]:
         plt.close(ax.figure)
         written.append(path)
     return written
+
+
+# ---------------------------------------------------------------------------------------------- several runs
+def _draw_reference(result: SimulationResult, ax: Axes) -> None:
+    path = result.path
+    ax.plot(path.x_m, path.y_m, "k--", lw=1.0, label="reference")
+    cones = result.scenario.cones_xy
+    if cones is not None:
+        ax.plot(cones[:, 0], cones[:, 1], "^", color="tab:red", ms=5, label="cones")
+    width, height = np.ptp(path.x_m), np.ptp(path.y_m)
+    if min(width, height) > 0.25 * max(width, height):  # true shape unless the path is long and thin (a DLC)
+        ax.set_aspect("equal", adjustable="datalim")
+
+
+def trajectories(results: Sequence[SimulationResult], labels: Sequence[str], ax: Axes | None = None) -> Axes:
+    """Figure 17a: each run's rear-axle path over the reference."""
+    ax = _axes(ax)
+    _draw_reference(results[0], ax)
+    for result, label in zip(results, labels, strict=True):
+        ax.plot(result.trace["x_m"], result.trace["y_m"], lw=1.3, label=label)
+    ax.set(xlabel="x (m)", ylabel="y (m)", title=f"{results[0].scenario.name}: tracked trajectories (rear axle)")
+    ax.legend(loc="best", fontsize="small")
+    return ax
+
+
+def cte_comparison(results: Sequence[SimulationResult], labels: Sequence[str], ax: Axes | None = None) -> Axes:
+    """Figure 17b: CTE against distance along the path, every run on one axis."""
+    ax = _axes(ax)
+    for result, label in zip(results, labels, strict=True):
+        ax.plot(_distance(result), result.trace["cte_m"], lw=1.3, label=label)
+    ax.axhline(0.0, color="k", lw=0.5)
+    ax.set(xlabel="distance along path (m)", ylabel="cross-track error (m)", title="CTE at the rear-axle centre")
+    ax.legend(loc="best", fontsize="small")
+    return ax
+
+
+def speed_comparison(results: Sequence[SimulationResult], labels: Sequence[str], ax: Axes | None = None) -> Axes:
+    """Figure 18a: speed against distance along the path (and the planned profile of the first run)."""
+    ax = _axes(ax)
+    ax.plot(_distance(results[0]), results[0].trace["speed_ref_mps"] * 3.6, "k--", lw=1.0, label="planned")
+    for result, label in zip(results, labels, strict=True):
+        ax.plot(_distance(result), result.trace["speed_mps"] * 3.6, lw=1.3, label=label)
+    ax.set(xlabel="distance along path (m)", ylabel="speed (km/h)", title="Speed")
+    ax.legend(loc="best", fontsize="small")
+    return ax
+
+
+def steering_comparison(results: Sequence[SimulationResult], labels: Sequence[str], ax: Axes | None = None) -> Axes:
+    """Figure 18b: measured steering-wheel angle against time."""
+    ax = _axes(ax)
+    for result, label in zip(results, labels, strict=True):
+        ax.plot(result.trace["t_s"], np.degrees(result.trace["steer_wheel_rad"]), lw=1.3, label=label)
+    ax.set(xlabel="time (s)", ylabel="steering-wheel angle (deg)", title="Steering-wheel angle")
+    ax.legend(loc="best", fontsize="small")
+    return ax

@@ -148,3 +148,51 @@ def test_clothoid_options_from_a_config_file_and_set(tmp_path: Path, capsys) -> 
     assert (trace["ctrl_lookahead_m"] == 7.0).all()
     assert main([*args, "--set", "fixed_lookahead_m=-7"]) == 2
     assert "fixed_lookahead_m must be in [0.5, 200.0] m; got -7.0" in capsys.readouterr().err
+
+
+def test_compare_writes_report_summary_and_runs(tmp_path: Path, capsys) -> None:
+    out = tmp_path / "cmp"
+    args = ["compare", "dlc", "--controllers", "pure-pursuit,stanley", "--vehicle", "kinematic-bicycle,dynamic-bicycle"]
+    assert main([*args, "--out", str(out)]) == 0
+    summary = pd.read_csv(out / "summary.csv")
+    assert sorted(zip(summary["controller"], summary["vehicle"], strict=True)) == sorted(
+        (c, v) for c in ("pure-pursuit", "stanley") for v in ("kinematic-bicycle", "dynamic-bicycle")
+    )
+    assert (summary["status"] == "completed").all()
+    html = (out / "report.html").read_text(encoding="utf-8")
+    assert html.count("data:image/png;base64,") == 4 and "report.html" in capsys.readouterr().out
+    for row in summary.itertuples():
+        metrics = json.loads((out / "runs" / f"{row.controller}-{row.vehicle}" / "metrics.json").read_text())
+        assert metrics["max_abs_cte_m"] == pytest.approx(row.max_abs_cte_m)
+
+
+@pytest.mark.parametrize(
+    ("args", "needle"),
+    [
+        (["--controllers", "pure-pursuit,mpc2", "--vehicle", "kinematic-bicycle"], "unknown controller 'mpc2'"),
+        (["--controllers", ",", "--vehicle", "kinematic-bicycle"], "--controllers needs at least one name"),
+        (["--controllers", "stanley", "--vehicle", "bus"], "unknown vehicle 'bus'"),
+    ],
+)
+def test_compare_bad_names_exit_2(args: list[str], needle: str, tmp_path: Path, capsys) -> None:
+    assert main(["compare", "dlc", *args, "--out", str(tmp_path / "x")]) == 2
+    assert needle in capsys.readouterr().err
+    assert not (tmp_path / "x").exists()  # refused before any run
+
+
+def test_fig17_writes_the_published_and_fair_sets(tmp_path: Path, capsys) -> None:
+    out = tmp_path / "fig17"
+    assert main(["fig17", "--out", str(out)]) == 0
+    summary = pd.read_csv(out / "summary.csv")
+    assert len(summary) == 4 and set(summary["controller"]) == {"clothoid", "nmpc"}
+    assert set(summary["vehicle"]) == {"tractor-semitrailer", "dynamic-bicycle"}
+    # every run starts 1 m off the path and converges onto it
+    assert summary["max_abs_cte_m"].min() == pytest.approx(1.0, abs=0.01)
+    assert summary["converge_distance_m"].notna().all() and (summary["converge_distance_m"] > 0).all()
+    assert (summary.loc[summary["controller"] == "clothoid", "step_time_ratio"] == 1.0).all()
+    for prefix in ("", "published_"):
+        for name in ("trajectories", "cte_vs_distance", "speed_vs_distance", "steering_vs_time"):
+            assert (out / f"{prefix}{name}.png").stat().st_size > 10_000
+    html = (out / "report.html").read_text(encoding="utf-8")
+    assert html.count("<h2>") == 2 and html.count("data:image/png;base64,") == 8
+    assert str(out / "report.html") in capsys.readouterr().out
