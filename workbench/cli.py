@@ -89,6 +89,10 @@ def _parser() -> argparse.ArgumentParser:
     )
     fig.add_argument("--out", type=Path, required=True, metavar="DIR", help="output directory (report.html in it)")
     fig.add_argument("--speed", type=float, default=30.0, metavar="KMH", help="target speed, km/h (default 30)")
+
+    paper = sub.add_parser("paper", help="regenerate the paper's figures 4b-16 and a table of ours against its numbers")
+    paper.add_argument("--out", type=Path, required=True, metavar="DIR", help="output directory")
+    paper.add_argument("--track", type=Path, help="Zandvoort track CSV (Figures 15-16)")
     return parser
 
 
@@ -130,6 +134,17 @@ def _compare(args: argparse.Namespace) -> int:
     _print_summary(comparison)
     print(f"wrote {report} and summary.csv, figures and runs/ beside it")
     return 0 if all(r.completed for r in comparison.results) else EXIT_RUN_FAILED
+
+
+def _paper(args: argparse.Namespace) -> int:
+    from workbench.paper import reproduce_paper
+
+    result = reproduce_paper(args.out, ScenarioOptions(track_file=args.track))
+    print(result.table.to_string(index=False, float_format=lambda v: f"{v:.3g}"))
+    for reason in result.skipped:
+        print(f"skipped: {reason}")
+    print(f"wrote {len(result.files)} files to {args.out}")
+    return 0
 
 
 def _fig17(args: argparse.Namespace) -> int:
@@ -208,6 +223,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             return _compare(args)
         elif args.command == "fig17":
             return _fig17(args)
+        elif args.command == "paper":
+            return _paper(args)
         else:
             return _run(args)
     except WorkbenchInputError as exc:
