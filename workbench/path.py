@@ -245,6 +245,20 @@ class ReferencePath:
         """Planned speed (m/s) at arc length s, or None when the path carries no speed."""
         return None if self.speed_mps is None else self._interp(self.speed_mps, s_m)
 
+    def speed_gradient(self, s_m: float | np.ndarray) -> float | np.ndarray | None:
+        """Slope dv/ds (1/s) of the planned speed at arc length s, or None when the path carries no speed.
+
+        The slope of the linear interpolation `speed` uses: constant between two samples, the segment ahead at a
+        sample. Along the path at speed v the reference changes at v dv/ds (m/s^2).
+        """
+        if self.speed_mps is None:
+            return None
+        if isinstance(s_m, float | int):
+            i = min(int(self.wrap_s(s_m) / self.spacing_m), self.speed_mps.size - 2)
+            return float((self.speed_mps[i + 1] - self.speed_mps[i]) / self.spacing_m)
+        i = np.minimum((self.wrap_s(np.asarray(s_m, dtype=float)) / self.spacing_m).astype(int), self.s_m.size - 2)
+        return np.diff(self.speed_mps)[i] / self.spacing_m
+
     def with_speed(self, speed_mps: np.ndarray) -> ReferencePath:
         """A copy of this path carrying the given speed at each of its samples."""
         speed = np.asarray(speed_mps, dtype=float)

@@ -565,6 +565,32 @@ def test_s_at_arc_distance(arc: float) -> None:
     assert line.s_at_arc_distance(5.0, -10.0) == 0.0
 
 
+# ---------------------------------------------------------------------------------------------- speed
+def test_speed_gradient_of_a_linear_speed_is_its_slope() -> None:
+    x = np.linspace(0.0, 100.0, 11)
+    path = ReferencePath.from_waypoints(Waypoints(x, np.zeros_like(x), 12.0 - 0.08 * x, source="ramp"))
+    s = np.array([0.0, 0.05, 13.37, 50.0, 99.95, 100.0])
+    np.testing.assert_allclose(path.speed_gradient(s), -0.08, rtol=1e-9)
+    for value in s:
+        assert path.speed_gradient(float(value)) == pytest.approx(-0.08, rel=1e-9)
+    assert path.speed_gradient(150.0) == pytest.approx(-0.08, rel=1e-9)  # clipped to the last segment
+    assert straight_path().speed_gradient(10.0) is None
+
+
+def test_speed_gradient_on_a_loop_matches_the_derivative_and_wraps() -> None:
+    # v = 8 + 2 sin(s / R) around a circle: dv/ds = (2 / R) cos(s / R), to the O(ds) of linear interpolation.
+    radius, n = 25.0, 120
+    phi = np.linspace(0.0, 2 * math.pi, n, endpoint=False)
+    waypoints = Waypoints(radius * np.cos(phi), radius * np.sin(phi), 8.0 + 2.0 * np.sin(phi), closed=True)
+    loop = ReferencePath.from_waypoints(waypoints)
+    s = np.linspace(0.0, loop.length_m, 97, endpoint=False)
+    expected = 2.0 / radius * np.cos(s / radius)
+    # waypoints 1.3 m apart: the chord slope differs from the derivative by up to (2 / R^2) * 1.3 m / 2
+    np.testing.assert_allclose(loop.speed_gradient(s), expected, atol=2.0 / radius**2 * 1.31 / 2)
+    np.testing.assert_allclose(loop.speed_gradient(s + loop.length_m), loop.speed_gradient(s), atol=1e-12)
+    assert loop.speed_gradient(float(s[5] - loop.length_m)) == pytest.approx(float(loop.speed_gradient(s[5])))
+
+
 # ---------------------------------------------------------------------------------------------- bad input
 def test_fewer_than_three_waypoints() -> None:
     with pytest.raises(WorkbenchInputError, match=r"at least 3 waypoints; got 2"):

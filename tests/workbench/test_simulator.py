@@ -3,10 +3,12 @@
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 from typing import ClassVar
 
 import numpy as np
 import pytest
+from scipy.integrate import solve_ivp
 
 from controllers import PurePursuit
 from controllers.base import Controller, Measurement
@@ -16,6 +18,7 @@ from workbench.path import ReferencePath
 from workbench.result import Status
 from workbench.scenarios import Scenario, make_scenario
 from workbench.simulator import Simulation, SimulationConfig
+from workbench.speed_control import PISpeedGains
 from workbench.speed_profile import G_MPS2
 from workbench.vehicles import KinematicBicycle
 
@@ -73,6 +76,53 @@ def test_steady_cornering_matches_v2_over_r_and_the_speed_profile_bound() -> Non
     assert np.median(lat) == pytest.approx(np.median(v**2) / radius, rel=0.02)
     # Once the start-up transient (wheels straight on a curve) is over, the 0.3 g bound holds.
     assert np.max(np.abs(lat)) <= 0.3 * G_MPS2 * 1.03
+
+
+def _braking_ramp(v0: float, v1: float, decel: float) -> Scenario:
+    """A straight whose own speeds brake at a constant rate: v(s) = sqrt(v0^2 - 2 a s), then v1 for 30 m.
+
+    Followed exactly, v(t) = v0 - a t: a ramp in time. The profile planned at v0 leaves these speeds alone.
+    """
+    brake_m = (v0**2 - v1**2) / (2 * decel)
+    x = np.arange(0.0, brake_m + 30.0, 0.5)
+    speed = np.sqrt(np.maximum(v0**2 - 2 * decel * x, v1**2))
+    return _scenario(ReferencePath.from_xy(x, np.zeros_like(x), speed, name="braking"))
+
+
+@pytest.mark.parametrize("decel", [1.0, 2.0])
+def test_speed_follows_a_braking_ramp_on_time_with_the_feedforward(decel: float) -> None:
+    v0, v1 = 15.0, 5.0
+    config = SimulationConfig(speed_kmh=v0 * 3.6)
+    result = _run(_braking_ramp(v0, v1, decel), config)
+    trace = result.trace
+    assert result.status is Status.COMPLETED
+    assert trace["speed_ref_mps"].max() == pytest.approx(v0, abs=1e-9)
+    assert trace["speed_ref_mps"].min() == pytest.approx(v1, abs=1e-9)
+    # The rate is fed forward: the speed follows the ramp; what is left comes from the 50 Hz steps at the ramp's
+    # start and end, where the rate jumps between steps and is applied at most one step (a dt) early or late.
+    error = trace["speed_ref_mps"] - trace["speed_mps"]
+    assert np.abs(error).max() <= 1.25 * decel / config.controller_rate_hz  # measured 0.015 and 0.039 m/s
+
+    # PI alone the speed lags. Reference: the same loop in continuous time, integrated independently of the
+    # simulator: s' = v, v' = kp e + ki I, I' = e, e = v_ref(s) - v. (Not the time-ramp formula
+    # a (e^{r2 t} - e^{r1 t}) / (r2 - r1): lagging, the vehicle runs down the profile faster than v_ref, so the
+    # reference falls faster than a in time.)
+    pi_only = _run(_braking_ramp(v0, v1, decel), replace(config, speed_feedforward=False)).trace
+    gains = PISpeedGains()
+
+    def v_ref(s_m: float) -> float:
+        return math.sqrt(max(v0**2 - 2 * decel * s_m, v1**2))
+
+    def rhs(_t: float, z: np.ndarray) -> list[float]:
+        s_m, v, integral = z
+        e = v_ref(s_m) - v
+        return [v, gains.kp_per_s * e + gains.ki_per_s2 * integral, e]
+
+    t = pi_only["t_s"]
+    sol = solve_ivp(rhs, (0.0, t[-1]), [0.0, v0, 0.0], t_eval=t, rtol=1e-10, atol=1e-10, max_step=0.05)
+    assert np.abs(sol.y[1] - pi_only["speed_mps"]).max() < 0.01 * decel  # 50 Hz ZOH; measured 0.0035, 0.014 m/s
+    lag = pi_only["speed_mps"] - pi_only["speed_ref_mps"]
+    assert lag.max() > 0.764 * decel  # at least the time-ramp lag's peak: 0.76 and 1.5 m/s too fast
 
 
 def test_plant_rate_convergence() -> None:
@@ -160,6 +210,7 @@ def test_leaving_the_path_stops_the_run() -> None:
         ({"plant_rate_hz": 1010.0}, "whole multiple"),
         ({"laps": 0}, "laps"),
         ({"max_lateral_accel_g": 0.0}, "max_lateral_accel_g"),
+        ({"speed_feedforward": 1}, r"speed_feedforward must be True or False; got 1"),
     ],
 )
 def test_bad_configuration_is_rejected(kwargs: dict, needle: str) -> None:

@@ -30,6 +30,37 @@ def simulate(
     return np.array(speeds), np.array(commands)
 
 
+def simulate_ramp(
+    controller: PISpeedController,
+    ref0_mps: float,
+    rate_mps2: float,
+    duration_s: float,
+    v0_mps: float,
+    feedforward: bool,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Forward-Euler closed loop on dv/dt = u following v_ref(t) = ref0 + rate t, the rate fed forward or not.
+
+    Returns (time of each step, error v_ref - v at each step before its command, command of each step).
+    """
+    speed, times, errors, commands = v0_mps, [], [], []
+    for k in range(round(duration_s / DT_S)):
+        t = k * DT_S
+        ref = ref0_mps + rate_mps2 * t
+        u = controller.step(ref, speed, DT_S, rate_mps2 if feedforward else 0.0)
+        times.append(t)
+        errors.append(ref - speed)
+        commands.append(u)
+        speed += u * DT_S
+    return np.array(times), np.array(errors), np.array(commands)
+
+
+def pi_roots_per_s(gains: PISpeedGains) -> tuple[float, float]:
+    """Roots r1 < r2 < 0 of s^2 + kp s + ki (real for the default gains)."""
+    kp, ki = gains.kp_per_s, gains.ki_per_s2
+    disc = math.sqrt(kp**2 - 4 * ki)
+    return (-kp - disc) / 2, (-kp + disc) / 2
+
+
 def linear_overshoot_mps(gains: PISpeedGains, e0_mps: float) -> float:
     """Overshoot of the unsaturated loop from error e0 with an empty integrator (analytic).
 
@@ -159,3 +190,58 @@ def test_step_rejects_bad_input(args: tuple[float, float, float], match: str) ->
 def test_controller_rejects_non_gains() -> None:
     with pytest.raises(WorkbenchInputError, match=r"gains must be a PISpeedGains; got \{'kp_per_s': 1\.0\}"):
         PISpeedController({"kp_per_s": 1.0})  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize("rate_mps2", [-2.0, -0.5, 1.0])
+def test_without_feedforward_a_ramp_is_followed_with_the_analytic_pi_lag(rate_mps2: float) -> None:
+    # From zero error, E(s) = R(s) s^2 / (s^2 + kp s + ki) with R = a / s^2: e(t) = a (e^{r2 t} - e^{r1 t}) / (r2 - r1),
+    # peaking at 0.764 a after 2.16 s for the default gains: the lag that made the truck enter corners too fast.
+    gains = PISpeedGains()
+    r1, r2 = pi_roots_per_s(gains)
+    t, errors, commands = simulate_ramp(PISpeedController(gains), 20.0, rate_mps2, 8.0, 20.0, feedforward=False)
+    # unsaturated: the linear analysis holds
+    assert np.all((commands < gains.max_accel_mps2) & (commands > -gains.max_decel_mps2))
+    analytic = rate_mps2 * (np.exp(r2 * t) - np.exp(r1 * t)) / (r2 - r1)
+    assert np.abs(errors - analytic).max() <= 0.01 * abs(rate_mps2)  # forward Euler at dt = 10 ms
+    t_peak = math.log(r1 / r2) / (r2 - r1)
+    assert t_peak == pytest.approx(2.16, abs=0.01)
+    assert np.abs(errors).max() == pytest.approx(0.764 * abs(rate_mps2), rel=0.01)
+
+
+@pytest.mark.parametrize("rate_mps2", [-2.0, -0.5, 1.0])
+def test_feedforward_follows_a_ramp_without_lag(rate_mps2: float) -> None:
+    # dv/dt = u = a + kp e + ki I with e(0) = 0: v steps exactly with the reference (up to rounding).
+    _, errors, commands = simulate_ramp(PISpeedController(), 20.0, rate_mps2, 8.0, 20.0, feedforward=True)
+    assert np.abs(errors).max() < 1e-9
+    np.testing.assert_allclose(commands, rate_mps2, atol=1e-9)
+
+
+def test_feedforward_error_decays_like_a_held_reference_whatever_the_ramp() -> None:
+    # With the rate fed forward, e'' + kp e' + ki e = 0 for any reference: from e0 the error is that of a step,
+    # e = A e^{r1 t} + B e^{r2 t} with A + B = e0 and r1 A + r2 B = -kp e0.
+    gains = PISpeedGains()
+    r1, r2 = pi_roots_per_s(gains)
+    e0 = 0.8
+    b = (-gains.kp_per_s * e0 - r1 * e0) / (r2 - r1)
+    a = e0 - b
+    for rate in (-1.5, 0.0, 0.7):
+        t, errors, commands = simulate_ramp(PISpeedController(gains), 15.0, rate, 20.0, 15.0 - e0, feedforward=True)
+        assert np.all((commands < gains.max_accel_mps2) & (commands > -gains.max_decel_mps2))
+        analytic = a * np.exp(r1 * t) + b * np.exp(r2 * t)
+        assert np.abs(errors - analytic).max() <= 0.01 * e0  # forward Euler at dt = 10 ms
+
+
+def test_feedforward_is_saturated_with_the_feedback() -> None:
+    gains = PISpeedGains(max_accel_mps2=1.5, max_decel_mps2=3.0)
+    controller = PISpeedController(gains)
+    assert controller.step(10.0, 10.0, DT_S, 5.0) == 1.5
+    assert controller.step(10.0, 10.0, DT_S, -5.0) == -3.0
+    assert controller.step(10.0, 10.0, DT_S, 0.25) == pytest.approx(0.25)
+
+
+@pytest.mark.parametrize("rate", [float("nan"), float("inf"), -float("inf")])
+def test_step_rejects_a_non_finite_reference_rate(rate: float) -> None:
+    controller = PISpeedController()
+    with pytest.raises(WorkbenchInputError, match=r"speed_ref_rate_mps2 must be finite; got -?(nan|inf)"):
+        controller.step(1.0, 1.0, DT_S, rate)
+    assert controller.integral_m == 0.0
