@@ -26,9 +26,11 @@ from tuning.maneuvers import Maneuver
 from tuning.rollover import rollover_limits, table, to_curvature_limits
 from tuning.schedule import (
     DEFAULT_LAT_ACCEL_G,
+    PAPER_SPEED_KMH,
     compare_closed_loop,
     fixed_and_scheduled_filters,
     identify_schedule,
+    scheduled_against_fixed,
     steer_amplitude_deg,
 )
 from tuning.speeds import parse_speeds
@@ -150,7 +152,11 @@ def _parser() -> argparse.ArgumentParser:
         help=f"kinematic lateral acceleration of the identification maneuvers (default {DEFAULT_LAT_ACCEL_G:g} g)",
     )
     sched.add_argument(
-        "--nominal-speed", type=float, metavar="KMH", help="speed of the top-level filter (default: the first)"
+        "--nominal-speed",
+        type=float,
+        metavar="KMH",
+        help="speed of the top-level filter and of --compare's fixed filter (default: the first speed; with "
+        "--compare, 30 km/h, the paper's, when it is one of the speeds)",
     )
     _design_options(sched)
     sched.add_argument("--plot", type=Path, metavar="FILE.png", help="lag and filter against speed")
@@ -158,7 +164,7 @@ def _parser() -> argparse.ArgumentParser:
         "--compare",
         metavar="60,80",
         help="then run the clothoid controller on --compare-scenario at these speeds with the schedule, the fixed "
-        "filter of --nominal-speed and no filter, and print the tracking",
+        "filter of --nominal-speed and no filter, and print the tracking and whether the schedule tracks better",
     )
     sched.add_argument("--compare-scenario", default="dlc", help="scenario of --compare (default dlc)")
     return parser
@@ -317,11 +323,15 @@ def _schedule(args: argparse.Namespace) -> int:
         max_cascade_peak_db=args.max_cascade_peak_db,
     )
     compare_speeds = parse_speeds(args.compare) if args.compare else None
-    if compare_speeds and args.nominal_speed not in speeds:
+    nominal = args.nominal_speed
+    if compare_speeds and nominal is None and PAPER_SPEED_KMH in speeds:
+        nominal = PAPER_SPEED_KMH  # the paper's fixed filter
+    if compare_speeds and nominal not in speeds:
         raise WorkbenchInputError(
-            f"--compare needs --nominal-speed, one of the --speeds {speeds}, for the fixed filter to compare with"
+            f"--compare needs --nominal-speed, one of the --speeds {speeds}, for the fixed filter to compare with "
+            f"(default {PAPER_SPEED_KMH:g} km/h, the paper's, when it is one of them)"
         )
-    result.write(_prepare(out), nominal_speed_kmh=args.nominal_speed)
+    result.write(_prepare(out), nominal_speed_kmh=nominal)
     print(result.table())
     print(f"wrote {out}")
     if args.plot:
@@ -329,16 +339,20 @@ def _schedule(args: argparse.Namespace) -> int:
 
         print(f"wrote {schedule_figure(result, args.plot)}")
     if compare_speeds:
-        files: dict[str, Path | None] = dict(fixed_and_scheduled_filters(vehicle, result, args.nominal_speed))
+        files: dict[str, Path | None] = dict(fixed_and_scheduled_filters(vehicle, result, nominal))
+        fixed_label = next(label for label in files if label != "scheduled")
         files["no filter"] = None
         rows = compare_closed_loop(lambda: _vehicle(args), files, compare_speeds, args.compare_scenario)
-        print(f"clothoid controller on {args.compare_scenario} ({vehicle.name}):")
-        print("speed_kmh  filter            completed  max_abs_cte_m  rms_cte_m  max_steer_rate_deg_s")
+        print(f"clothoid controller (default options) on {args.compare_scenario} ({vehicle.name}):")
+        print("speed_kmh  filter            completed  max_abs_cte_m  rms_cte_m  max_steer_rate_deg_s  driven_kmh")
         for row in rows:
             print(
                 f"{row.speed_kmh:9.1f}  {row.filter:16s}  {row.completed!s:9s}  {row.max_abs_cte_m:13.3f}  "
-                f"{row.rms_cte_m:9.3f}  {row.max_abs_steer_rate_deg_s:20.0f}"
+                f"{row.rms_cte_m:9.3f}  {row.max_abs_steer_rate_deg_s:20.0f}  "
+                f"{row.min_speed_kmh:.0f}-{row.max_speed_kmh:.0f}"
             )
+        for verdict in scheduled_against_fixed(rows, fixed_label):
+            print(verdict.line())
     return 0
 
 

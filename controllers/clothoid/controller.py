@@ -24,6 +24,26 @@ repository's loaded tractor-semitrailer (measurements in README.md):
     is never below |CTE| (the curves start that far apart), so with the absolute threshold of the paper
     ("absolute") no lookahead qualifies once |CTE| exceeds it, and the controller falls back to the candidate of
     least Fréchet distance, the shortest and most aggressive, which on a lagging plant grows the error further.
+
+Two choices for speeds above the paper's 30 km/h (the paper's future work), also options:
+  - the lower end of the lookahead range is a preview time, min_preview_time_s x speed, not only metres. Linearised
+    about a straight path (lateral offset y, heading error psi, curvature kappa, lookahead L from the predicted pose
+    D = L + V t_p ahead), the hyper-clothoid of Eq. 3 has kappa' = -(6 / L^3) (y + psi D + kappa D^2 / 2), so the
+    loop closed through the integrator of Figure 2 is d kappa_cmd / dt = -(6 V / L^3) (y + psi D + kappa D^2 / 2):
+    with y' = V psi and psi' = V kappa (a lag-free plant) its poles are V / L times those of a fixed polynomial (for
+    a given V t_p / L): the preview time L / V sets the loop's speed. At 30 km/h the paper's 5 m floor is 0.6 s;
+    held at 5 m at 60 km/h it is 0.3 s, twice as fast a loop around a plant whose lag (Eq. 5) has slowed (omega_n
+    4.3 -> 3.4 rad/s on the loaded truck): the loop oscillates in the steering-rate limit whenever the adaptive
+    search picks the floor (a fixed 5 m lookahead on the truck's dlc: max |CTE| 0.04-0.05 m at 30 km/h, 1.0-3.9 m
+    at 60 and 80 km/h, whichever lead filter). The default floor of 0.6 s keeps the paper's 5 m at 30 km/h and
+    below; it suits the truck (a plant with a faster lag, e.g. the dynamic bicycle car, tracks better at 60 km/h
+    with 0: 0.11 against 0.20 m on the dlc).
+  - the adaptive lookahead may shorten at once but grows by at most max_lookahead_growth_m_per_m metres per metre
+    travelled. The Fréchet search alone lets it jump between the ends of its range from one step to the next (on
+    the dlc at 60 km/h, by 0.4-0.7 m per 20 ms step on average): the loop's gain goes as L^-3 (above), so each jump
+    is a 64-fold gain change and the curvature rate kappa' jumps with it. Shortening stays immediate (the search
+    shortens when the path ahead bends away from the clothoid); growing is limited relative to distance travelled,
+    i.e. relative to the loop's own time scale L / V (d ln L / dt <= growth x V / L).
 """
 
 from __future__ import annotations
@@ -51,6 +71,8 @@ HEADINGS = ("course", "yaw")
 THRESHOLD_MODES = ("excess", "absolute")
 #: Below this speed (m/s) yaw rate / speed and the course angle are too noisy to use.
 MIN_SPEED_MPS = 0.5
+#: Largest max_lookahead_growth_m_per_m accepted (m of lookahead per m travelled).
+MAX_GROWTH_M_PER_M = 100.0
 
 
 @dataclass(frozen=True)
@@ -60,7 +82,9 @@ class ClothoidConfig:
     lookahead_mode: "adaptive" (Fréchet, section 3), "fixed" (fixed_lookahead_m) or "speed" (lookahead_gain_s x
     speed, clipped to the range); min/max_lookahead_m: the range (m; the paper: 5-20 m); lookahead_step_m: the
     grid of the adaptive search (m); min_preview_time_s: raises the lower end of the range to this time x speed
-    (s; 0: off); frechet_threshold_m: the adaptive threshold (m; the paper: 0.5 m) and threshold_mode how it
+    (s; 0: off, the paper's 5 m at every speed; module docstring); max_lookahead_growth_m_per_m: the most the
+    lookahead grows per metre travelled (m/m, > 0; None: unlimited, as in the paper; it always shortens at once;
+    module docstring); frechet_threshold_m: the adaptive threshold (m; the paper: 0.5 m) and threshold_mode how it
     applies ("excess" of |CTE| or "absolute"; module docstring); frechet_point_spacing_m: sampling of the curves
     compared (m); tolerance_x_m, tolerance_y_m: delta_x, delta_y of Eq. 3 (m); max_curvature_rate_1pm2: saturation
     of the clothoid's kappa' (1/m^2); initial_curvature: kappa(0) of Eq. 3, "yaw-rate", "command" or "steering";
@@ -74,7 +98,8 @@ class ClothoidConfig:
     min_lookahead_m: float = 5.0
     max_lookahead_m: float = 20.0
     lookahead_step_m: float = 0.5
-    min_preview_time_s: float = 0.0
+    min_preview_time_s: float = 0.6
+    max_lookahead_growth_m_per_m: float | None = 0.3
     fixed_lookahead_m: float = 10.0
     lookahead_gain_s: float = 1.0
     frechet_threshold_m: float = 0.02
@@ -104,6 +129,14 @@ class ClothoidConfig:
                 raise WorkbenchInputError(f"{name} must be one of {', '.join(allowed)}; got {getattr(self, name)!r}")
         require_in_range("prediction_time_s", self.prediction_time_s, 0.0, 2.0, "s")
         require_in_range("min_preview_time_s", self.min_preview_time_s, 0.0, 10.0, "s")
+        growth = self.max_lookahead_growth_m_per_m
+        if growth is not None and (
+            isinstance(growth, bool) or not isinstance(growth, int | float) or not 0.0 < growth <= MAX_GROWTH_M_PER_M
+        ):
+            raise WorkbenchInputError(
+                f"max_lookahead_growth_m_per_m must be None (unlimited) or a number in (0, {MAX_GROWTH_M_PER_M:g}] "
+                f"m per m travelled; got {growth!r}"
+            )
         require_in_range("min_lookahead_m", self.min_lookahead_m, 0.5, 200.0, "m")
         require_in_range("max_lookahead_m", self.max_lookahead_m, self.min_lookahead_m, 200.0, "m")
         require_in_range("fixed_lookahead_m", self.fixed_lookahead_m, 0.5, 200.0, "m")
@@ -158,6 +191,7 @@ class ClothoidController(Controller):
         self._filters = {}
         self._filter: SteeringFilter = PassThroughFilter()
         self._filter_speed_kmh = -1
+        self._lookahead_m: float | None = None
         self._diag: dict[str, float] = {}
 
     def _lead_filter(self, speed_mps: float) -> SteeringFilter:
@@ -203,20 +237,27 @@ class ClothoidController(Controller):
         return x, y, heading
 
     def _lookahead(self, path: ReferencePath, foot_index: float, cte_m: float, pose, kappa0: float, speed_mps: float):
-        """(lookahead m, number of candidates evaluated) by the configured mode."""
+        """(lookahead m, the adaptive search's choice m, number of candidates evaluated) by the configured mode."""
         cfg = self.config
         if cfg.lookahead_mode == "fixed":
-            return cfg.fixed_lookahead_m, 0
+            return cfg.fixed_lookahead_m, cfg.fixed_lookahead_m, 0
         low = min(max(cfg.min_lookahead_m, cfg.min_preview_time_s * speed_mps), cfg.max_lookahead_m)
         if cfg.lookahead_mode == "speed":
-            return min(max(cfg.lookahead_gain_s * speed_mps, low), cfg.max_lookahead_m), 0
+            lookahead = min(max(cfg.lookahead_gain_s * speed_mps, low), cfg.max_lookahead_m)
+            return lookahead, lookahead, 0
         threshold = cfg.frechet_threshold_m + (abs(cte_m) if cfg.threshold_mode == "excess" else 0.0)
         x, y, heading = pose
-        return adaptive_search(
+        chosen, evaluations = adaptive_search(
             path.x_m, path.y_m, path.closed, foot_index, x, y, heading, kappa0, low, cfg.max_lookahead_m,
             cfg.lookahead_step_m, threshold, cfg.tolerance_x_m, cfg.tolerance_y_m, cfg.max_curvature_rate_1pm2,
             cfg.frechet_point_spacing_m, self._buffers, self._scores,
         )  # fmt: skip
+        lookahead = chosen
+        growth = cfg.max_lookahead_growth_m_per_m
+        if growth is not None and self._lookahead_m is not None:  # shorten at once, grow per metre travelled
+            lookahead = max(min(chosen, self._lookahead_m + growth * speed_mps * self._dt), low)
+        self._lookahead_m = lookahead
+        return lookahead, chosen, evaluations
 
     def step(self, measurement: Measurement, path: ReferencePath) -> float:
         cfg, g, m = self.config, self.geometry, measurement
@@ -231,7 +272,7 @@ class ClothoidController(Controller):
         pose = self._start_pose(m, kappa0)
         foot = self._tracker.update(pose[0], pose[1])
         foot_index = foot.s_m / path.spacing_m
-        lookahead, evaluations = self._lookahead(path, foot_index, foot.cte_m, pose, kappa0, m.speed_mps)
+        lookahead, searched, evaluations = self._lookahead(path, foot_index, foot.cte_m, pose, kappa0, m.speed_mps)
         frechet, kdot, length, tx, ty, ex, ey, status = evaluate_candidate(
             path.x_m, path.y_m, path.closed, foot_index, *pose, kappa0, lookahead, cfg.max_curvature_rate_1pm2,
             cfg.frechet_point_spacing_m, self._buffers,
@@ -245,6 +286,7 @@ class ClothoidController(Controller):
         command = self.saturate(self._lead_filter(m.speed_mps).step(steer))  # Eq. 6
         self._diag = {
             "lookahead_m": lookahead,
+            "searched_lookahead_m": searched,
             "frechet_m": frechet,
             "curvature_rate_1pm2": kdot,
             "clothoid_length_m": length,

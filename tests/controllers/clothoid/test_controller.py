@@ -159,12 +159,52 @@ def test_filter_file_is_read_and_a_schedule_follows_speed(tmp_path: Path) -> Non
         ({"initial_curvature": "lut"}, "initial_curvature must be one of"),
         ({"heading": "north"}, "heading must be one of course, yaw"),
         ({"prediction_time_s": -1.0}, "prediction_time_s"),
+        ({"min_preview_time_s": -0.1}, "min_preview_time_s must be in [0.0, 10.0] s"),
+        (
+            {"max_lookahead_growth_m_per_m": 0.0},
+            "max_lookahead_growth_m_per_m must be None (unlimited) or a number in (0, 100] m per m travelled; got 0.0",
+        ),
+        ({"max_lookahead_growth_m_per_m": True}, "max_lookahead_growth_m_per_m must be None (unlimited)"),
+        ({"max_lookahead_growth_m_per_m": "fast"}, "got 'fast'"),
     ],
 )
 def test_bad_options_are_refused_with_the_value_and_what_is_allowed(options: dict, needle: str) -> None:
     with pytest.raises(WorkbenchInputError, match=None) as info:
         ClothoidConfig(**options)
     assert needle in str(info.value)
+
+
+def test_the_lookahead_floor_is_a_preview_time_above_30_kmh() -> None:
+    """In the bend's entry the search picks the bottom of the range: 5 m at 8 m/s; at 25 m/s the default floor
+    is 0.6 s x 25 m/s = 15 m, where the paper's 5 m floor lets it pick 6.5 m (a 0.26 s preview)."""
+    entry = _m(40.0, 0.0, 0.0, 8.0)
+    fast = _m(40.0, 0.0, 0.0, 25.0)
+    assert _step(entry)[1].diagnostics["lookahead_m"] == 5.0
+    assert _step(fast)[1].diagnostics["lookahead_m"] == pytest.approx(0.6 * 25.0, abs=1e-12)
+    assert _step(fast, min_preview_time_s=0.0)[1].diagnostics["lookahead_m"] == 6.5
+
+
+@pytest.mark.parametrize("growth", [0.3, 1.0, None])
+def test_the_lookahead_shortens_at_once_and_grows_per_metre_travelled(growth: float | None) -> None:
+    """From the bend's entry (5 m) to the straight before it, where the search picks 20 m: the lookahead grows by
+    growth x speed x dt per step (None: at once, as in the paper); back in the bend it is 5 m again at once."""
+    dt, speed = 0.02, 8.0
+    controller = ClothoidController(GEOMETRY, ClothoidConfig(max_lookahead_growth_m_per_m=growth))
+    controller.reset(BEND, dt)
+    controller.step(_m(40.0, 0.0, 0.0, speed), BEND)
+    assert controller.diagnostics["lookahead_m"] == 5.0
+    used = []
+    for _ in range(10):
+        controller.step(_m(10.0, 0.0, 0.0, speed), BEND)
+        assert controller.diagnostics["searched_lookahead_m"] == 20.0
+        used.append(controller.diagnostics["lookahead_m"])
+    if growth is None:
+        assert used == [20.0] * 10
+    else:
+        step = growth * speed * dt
+        assert used == pytest.approx([5.0 + step * k for k in range(1, 11)], abs=1e-12)
+    controller.step(_m(40.0, 0.0, 0.0, speed), BEND)
+    assert controller.diagnostics["lookahead_m"] == 5.0
 
 
 def test_missing_filter_file_names_it(tmp_path: Path) -> None:
