@@ -86,6 +86,23 @@ def converge_distance_m(progress_m: np.ndarray, cte_m: np.ndarray, tolerance_m: 
     return float(progress_m[last + 1] - progress_m[0])
 
 
+def step_time_ratios(table: pd.DataFrame, reference_controller: str | None) -> list[float]:
+    """Each row's step_time_median_us over the reference controller's on the same vehicle (the median over its
+    runs there, which may differ in options), or over all its runs when it did not run on that vehicle; NaN
+    without a reference or a step time."""
+    if reference_controller is None or reference_controller not in set(table["controller"]):
+        return [math.nan] * len(table)
+    ref_rows = table[table["controller"] == reference_controller]
+    per_vehicle = ref_rows.groupby("vehicle")["step_time_median_us"].median()
+    overall = float(ref_rows["step_time_median_us"].median())
+    return [
+        float(row.step_time_median_us) / float(per_vehicle.get(row.vehicle, overall))
+        if row.step_time_median_us is not None and math.isfinite(row.step_time_median_us)
+        else math.nan
+        for row in table.itertuples()
+    ]
+
+
 @dataclass(frozen=True, eq=False)
 class Comparison:
     """The runs of one scenario, in the order asked. `reference_controller` is the controller whose step time the
@@ -111,8 +128,7 @@ class Comparison:
 
     def summary(self) -> pd.DataFrame:
         """One row per run: the metrics.json fields, status and message, the distance to converge within
-        CONVERGED_CTE_M, and step_time_ratio (step median over that of the reference controller on the same
-        vehicle, or on any vehicle when it did not run on this one)."""
+        CONVERGED_CTE_M, and step_time_ratio (`step_time_ratios`)."""
         if not self._summary:
             rows = []
             for spec, result in zip(self.specs, self.results, strict=True):
@@ -121,22 +137,9 @@ class Comparison:
                 row["converge_distance_m"] = converge_distance_m(result.trace["progress_m"], result.trace["cte_m"])
                 rows.append(row)
             table = pd.DataFrame(rows)
-            table["step_time_ratio"] = self._step_ratios(table)
+            table["step_time_ratio"] = step_time_ratios(table, self.reference_controller)
             self._summary.append(table)
         return self._summary[0].copy()
-
-    def _step_ratios(self, table: pd.DataFrame) -> list[float]:
-        ref = self.reference_controller
-        if ref is None or ref not in set(table["controller"]):
-            return [math.nan] * len(table)
-        medians = table[table["controller"] == ref].set_index("vehicle")["step_time_median_us"]
-        fallback = float(medians.mean())
-        return [
-            float(row.step_time_median_us) / float(medians.get(row.vehicle, fallback))
-            if row.step_time_median_us is not None
-            else math.nan
-            for row in table.itertuples()
-        ]
 
     def to_pandas(self) -> pd.DataFrame:
         """Every run's trace stacked, with `controller`, `vehicle` and `run` columns."""

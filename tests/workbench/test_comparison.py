@@ -12,7 +12,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from workbench.comparison import RunSpec, compare, converge_distance_m
+from workbench.comparison import RunSpec, compare, converge_distance_m, step_time_ratios
 from workbench.errors import WorkbenchInputError
 from workbench.metrics import METRIC_KEYS
 from workbench.report import ReportSection, render_report, write_report
@@ -136,3 +136,19 @@ def test_empty_or_repeated_runs_are_refused() -> None:
         compare("dlc", [])
     with pytest.raises(WorkbenchInputError, match="once"):
         compare("dlc", [RUNS[0], RUNS[0]])
+
+
+def test_step_time_ratio_with_the_reference_run_more_than_once_on_a_plant() -> None:
+    # two clothoid runs (different options) on the truck, one on the car; nmpc on the truck and on a plant the
+    # reference never ran on
+    table = pd.DataFrame(
+        {
+            "controller": ["clothoid", "clothoid", "nmpc", "clothoid", "nmpc"],
+            "vehicle": ["truck", "truck", "truck", "car", "bus"],
+            "step_time_median_us": [40.0, 60.0, 500.0, 30.0, 700.0],
+        }
+    )
+    ratios = step_time_ratios(table, "clothoid")
+    assert ratios == pytest.approx([0.8, 1.2, 10.0, 1.0, 700.0 / 40.0])  # bus: over the median of all clothoid runs
+    assert all(math.isnan(r) for r in step_time_ratios(table, None))
+    assert all(math.isnan(r) for r in step_time_ratios(table, "stanley"))
