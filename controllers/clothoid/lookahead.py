@@ -2,7 +2,9 @@
 proportional to speed.
 
 For a candidate lookahead distance l: the target is the first path point ahead of the vehicle's foot point at
-Euclidean distance l from the rear axle; the hyper-clothoid is fitted from the vehicle's pose and curvature to it;
+Euclidean distance l from the rear axle (near the end of an open path, the point at l on the path's straight
+extension beyond its end: aiming at the end itself would shrink l to zero and the clothoid's kappa', which goes as
+1 / l^2, would saturate in the last metres); the hyper-clothoid is fitted from the vehicle's pose and curvature to it;
 both the clothoid and the reference path from the foot point to the target are sampled at the same number of
 points, and their discrete Fréchet distance measures how differently they run (Figure 3b).
 
@@ -39,12 +41,28 @@ def candidate_count(min_m: float, max_m: float, step_m: float) -> int:
 
 @njit(cache=True)
 def _point_at_index(x: np.ndarray, y: np.ndarray, index: float, closed: bool) -> tuple[float, float]:
+    """The point at a fractional sample index; on an open path an index past the end extends its last segment."""
     n_seg = x.size - 1
     if closed:
         index = index % n_seg
     i = min(int(index), n_seg - 1)
     f = index - i
     return x[i] + f * (x[i + 1] - x[i]), y[i] + f * (y[i + 1] - y[i])
+
+
+@njit(cache=True)
+def _beyond_end(x: np.ndarray, y: np.ndarray, px: float, py: float, distance_m: float) -> float:
+    """How many last-segment lengths past the end of an open path lies the point of the path's straight extension
+    at `distance_m` from (px, py) (0 when the end itself is at least that far)."""
+    ux, uy = x[-1] - x[-2], y[-1] - y[-2]
+    seg = np.hypot(ux, uy)
+    ux, uy = ux / seg, uy / seg
+    dx, dy = x[-1] - px, y[-1] - py
+    along = dx * ux + dy * uy
+    disc = along * along - (dx * dx + dy * dy) + distance_m * distance_m  # |d + t u| = distance, solved for t
+    if disc <= 0.0:
+        return 0.0
+    return max(0.0, -along + np.sqrt(disc)) / seg
 
 
 @njit(cache=True)
@@ -69,8 +87,8 @@ def evaluate_candidate(
     """
     n_seg = path_x.size - 1
     target_index = first_beyond(path_x, path_y, px, py, foot_index, lookahead_m, closed)
-    if target_index < 0.0:  # the open path ends nearer than the lookahead: aim at its end
-        target_index = float(n_seg)
+    if target_index < 0.0:  # the open path ends nearer than the lookahead: aim beyond it, on its last tangent
+        target_index = float(n_seg) + _beyond_end(path_x, path_y, px, py, lookahead_m)
     tx, ty = _point_at_index(path_x, path_y, target_index, closed)
     kdot, length, ex, ey, status = fit_kernel(px, py, theta, kappa0, tx, ty, kdot_max)
 

@@ -80,3 +80,20 @@ def test_when_nothing_qualifies_the_least_frechet_distance_is_taken() -> None:
     assert fd.min() >= cte - 1e-9  # the curves start |CTE| apart
     k = int(np.argmin(np.abs(grid - chosen)))
     assert fd[k] <= fd.min() + 0.05  # coarse scan and local refinement: within 5 cm of the true minimum
+
+
+@pytest.mark.parametrize("remaining_m", [0.0, 1.0, 3.0, 7.0])
+def test_near_the_end_of_an_open_path_the_target_is_on_its_tangent_at_the_lookahead(remaining_m: float) -> None:
+    # A straight 30 m open path along x: the target stays 10 m from the rear axle on the extension, so the fitted
+    # clothoid stays straight (kappa' = 0) to the last metre instead of bending hard onto the end point.
+    straight = ClothoidChain().straight(30.0).to_path("straight")
+    evaluator = LookaheadEvaluator(straight)
+    x = 30.0 - remaining_m
+    offset = evaluator.evaluate(x, x, 0.5, 0.0, 0.0, 10.0, KDOT_MAX)
+    on_path = evaluator.evaluate(x, x, 0.0, 0.0, 0.0, 10.0, KDOT_MAX)
+    assert on_path.target_xy == pytest.approx((x + 10.0, 0.0), abs=1e-9)
+    assert on_path.curvature_rate_1pm2 == pytest.approx(0.0, abs=1e-9) and on_path.frechet_m < 1e-9
+    # 0.5 m off: the target at 10 m on the extension, as it would be on a longer path
+    assert math.hypot(offset.target_xy[0] - x, offset.target_xy[1] - 0.5) == pytest.approx(10.0, rel=1e-9)
+    assert offset.target_xy[1] == pytest.approx(0.0, abs=1e-9)
+    assert abs(offset.curvature_rate_1pm2) < KDOT_MAX
