@@ -15,6 +15,7 @@ the curvature rate the steering-wheel rate limit allows at small angles, (rate /
 
 from __future__ import annotations
 
+import bisect
 import itertools
 import math
 from dataclasses import dataclass
@@ -63,11 +64,14 @@ class CurvatureLimits:
 
     def at_speed(self, speed_mps: float) -> tuple[float, float]:
         """(max curvature 1/m, max curvature rate 1/(m s)) at this speed, interpolated."""
-        v = speed_mps * 3.6
-        return (
-            float(np.interp(v, self.speeds_kmh, self.max_curvature_1pm)),
-            float(np.interp(v, self.speeds_kmh, self.max_curvature_rate_1pm_s)),
-        )
+        v, speeds = speed_mps * 3.6, self.speeds_kmh  # np.interp's clamped linear interpolation, without its
+        i = bisect.bisect_right(speeds, v)  # per-call overhead (a scalar, every controller step)
+        if i == 0 or i == len(speeds):
+            j = 0 if i == 0 else len(speeds) - 1
+            return self.max_curvature_1pm[j], self.max_curvature_rate_1pm_s[j]
+        f = (v - speeds[i - 1]) / (speeds[i] - speeds[i - 1])
+        k, r = self.max_curvature_1pm, self.max_curvature_rate_1pm_s
+        return k[i - 1] + f * (k[i] - k[i - 1]), r[i - 1] + f * (r[i] - r[i - 1])
 
     @classmethod
     def default_for(

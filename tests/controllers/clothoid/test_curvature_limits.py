@@ -6,7 +6,10 @@ import itertools
 import math
 from pathlib import Path
 
+import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from controllers.clothoid.curvature_limits import G_MPS2, CurvatureLimits
 from workbench.errors import WorkbenchInputError
@@ -64,3 +67,17 @@ def test_bad_tables_are_rejected(text: str, needle: str, tmp_path: Path) -> None
 def test_missing_file_is_named(tmp_path: Path) -> None:
     with pytest.raises(WorkbenchInputError, match=r"nope\.csv"):
         CurvatureLimits.read_csv(tmp_path / "nope.csv", TRUCK)
+
+
+@settings(max_examples=300, deadline=None)
+@given(
+    st.lists(st.floats(0.01, 1.0), min_size=1, max_size=8),
+    st.floats(-10.0, 200.0),
+)
+def test_interpolation_is_numpys_clamped_linear_one(values: list[float], speed_kmh: float) -> None:
+    speeds = tuple(10.0 * (i + 1) for i in range(len(values)))
+    rates = tuple(2.0 * v for v in values)
+    limits = CurvatureLimits(speeds, tuple(values), rates)
+    kappa, rate = limits.at_speed(speed_kmh / 3.6)
+    assert kappa == pytest.approx(float(np.interp(speed_kmh, speeds, values)), rel=1e-12, abs=1e-15)
+    assert rate == pytest.approx(float(np.interp(speed_kmh, speeds, rates)), rel=1e-12, abs=1e-15)
