@@ -1,13 +1,17 @@
 """The `workbench` command line: list scenarios, vehicles and controllers; run a closed-loop simulation; compare
-controllers side by side (`compare`, and the paper's Figure 17 set-up, `fig17`)."""
+controllers side by side (`compare`, and the paper's Figure 17 set-up, `fig17`); run parameter sweeps and tune
+controllers from a study spec (`sweep`, `optimise`; `workbench.studies`)."""
 
 from __future__ import annotations
 
 import argparse
 import math
+import shutil
+import signal
 import sys
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from controllers import CONTROLLERS, make_controller
 from controllers.config_file import config_template, read_controller_config
@@ -19,8 +23,13 @@ from workbench.scenarios import ScenarioOptions, describe_scenarios, make_scenar
 from workbench.simulator import Simulation, SimulationConfig
 from workbench.vehicles import VEHICLES, list_presets, make_vehicle, preset_text
 
+if TYPE_CHECKING:
+    from workbench.studies import StudySpec
+    from workbench.studies.backends import Backend
+
 EXIT_INPUT_ERROR = 2
 EXIT_RUN_FAILED = 1
+EXIT_INTERRUPTED = 130
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -93,7 +102,33 @@ def _parser() -> argparse.ArgumentParser:
     paper = sub.add_parser("paper", help="regenerate the paper's figures 4b-16 and a table of ours against its numbers")
     paper.add_argument("--out", type=Path, required=True, metavar="DIR", help="output directory")
     paper.add_argument("--track", type=Path, help="Zandvoort track CSV (Figures 15-16)")
+
+    swp = sub.add_parser(
+        "sweep", help="run every run a study spec plans (grids, random draws); resumes; DIR/results.parquet"
+    )
+    swp.add_argument("spec", type=Path, metavar="SPEC.toml", help="the study spec (see README: Studies)")
+    swp.add_argument("--out", type=Path, required=True, metavar="DIR", help="output directory (rerun to resume)")
+    _backend_options(swp)
+    swp.add_argument("--no-plots", action="store_true", help="write the results without the figures")
+    opt = sub.add_parser(
+        "optimise", help="tune a controller's options against the spec's objective (optuna TPE); DIR/best.toml"
+    )
+    opt.add_argument("spec", type=Path, metavar="SPEC.toml", help="the study spec with an [optimise] table")
+    opt.add_argument("--out", type=Path, required=True, metavar="DIR", help="output directory (rerun to resume)")
+    _backend_options(opt)
     return parser
+
+
+def _backend_options(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--backend", choices=("local", "dask"), default="local", help="local process pool (default) or dask"
+    )
+    parser.add_argument(
+        "--scheduler", metavar="ADDRESS", help="a dask scheduler (e.g. tcp://host:8786); default: a LocalCluster"
+    )
+    parser.add_argument(
+        "--workers", type=int, metavar="N", help="worker processes (local pool or LocalCluster; default: the CPUs)"
+    )
 
 
 def _sim_options(parser: argparse.ArgumentParser) -> None:
@@ -154,6 +189,83 @@ def _fig17(args: argparse.Namespace) -> int:
     _print_summary(result.fair)
     print(f"report: {written[-1]}")
     return 0 if all(r.completed for r in result.fair.results) else EXIT_RUN_FAILED
+
+
+def _interruptible(study: Callable[[], int], out: Path) -> int:
+    """Run a study; SIGTERM stops it as Ctrl-C does: the rows written so far stay and the same command resumes."""
+    from workbench.studies.backends import BackendError
+
+    previous = signal.signal(signal.SIGTERM, signal.default_int_handler)
+    try:
+        return study()
+    except KeyboardInterrupt:
+        print(f"workbench: interrupted; finished runs are kept in {out / 'runs'}: rerun to resume", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    except BackendError as exc:
+        print(f"workbench: {exc}; finished runs are kept in {out / 'runs'}: rerun to resume", file=sys.stderr)
+        return EXIT_RUN_FAILED
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
+def _start_study(args: argparse.Namespace, kind: str) -> tuple[StudySpec, Backend]:
+    from workbench.studies import load_spec, make_backend
+
+    spec = load_spec(args.spec, kind)
+    backend = make_backend(args.backend, args.scheduler, args.workers)
+    args.out.mkdir(parents=True, exist_ok=True)
+    copy = args.out / "spec.toml"
+    if not copy.exists() or not copy.samefile(args.spec):
+        shutil.copyfile(args.spec, copy)
+    return spec, backend
+
+
+def _sweep(args: argparse.Namespace) -> int:
+    from workbench.studies import run_sweep
+
+    spec, backend = _start_study(args, "sweep")
+    n = len(spec.plan())
+
+    def study() -> int:
+        print(f"{n} runs; running those not yet in {args.out} on the {backend.describe()}")
+        result = run_sweep(spec, args.out, backend, progress=sys.stderr.isatty())
+        written = [args.out / "results.parquet"] + ([] if args.no_plots else result.save_figures(args.out))
+        counts = ", ".join(f"{v} {k}" for k, v in result.status_counts().items())
+        print(f"{n} runs ({n - result.ran} already done, {result.ran} run now): {counts}")
+        print(result.summary().to_string(index=False, float_format=lambda v: f"{v:.3g}"))
+        for message in list(dict.fromkeys(result.errors()["message"]))[:3]:
+            print(f"  error: {message}")
+        print(f"wrote {', '.join(str(p) for p in written)}")
+        return 0
+
+    return _interruptible(study, args.out)
+
+
+def _optimise(args: argparse.Namespace) -> int:
+    from workbench.studies import run_optimisation
+    from workbench.studies.optimise import objective_text
+
+    spec, backend = _start_study(args, "optimise")
+    trials = spec.optimise.trials if spec.optimise else 0
+
+    def study() -> int:
+        print(
+            f"{trials} trials of {len(spec.plan())} runs each, minimising {objective_text(spec)}, "
+            f"on the {backend.describe()}"
+        )
+        result = run_optimisation(spec, args.out, backend, progress=sys.stderr.isatty())
+        failed = int((result.history["state"] == "failed").sum())
+        print(f"{len(result.history)} trials ({failed} failed); {result.ran} runs run now")
+        if result.best_trial is None:
+            reasons = list(dict.fromkeys(result.history["reason"]))[:3]
+            print(f"workbench: no trial completed: {'; '.join(reasons)}", file=sys.stderr)
+            return EXIT_RUN_FAILED
+        params = ", ".join(f"{k} = {v!r}" for k, v in result.best_params.items())
+        print(f"best: trial {result.best_trial}, objective {result.best_value:.6g}: {params}")
+        print(f"wrote {result.config_file} (use with --controller-config), best.json, history.parquet, results.parquet")
+        return 0
+
+    return _interruptible(study, args.out)
 
 
 def _run(args: argparse.Namespace) -> int:
@@ -225,6 +337,10 @@ def main(argv: Sequence[str] | None = None) -> int:
             return _fig17(args)
         elif args.command == "paper":
             return _paper(args)
+        elif args.command == "sweep":
+            return _sweep(args)
+        elif args.command == "optimise":
+            return _optimise(args)
         else:
             return _run(args)
     except WorkbenchInputError as exc:

@@ -28,6 +28,7 @@ METRIC_KEYS: tuple[str, ...] = (
     "max_abs_heading_error_deg",
     "max_abs_steer_wheel_deg",
     "max_abs_steer_rate_deg_s",
+    "rms_steer_rate_deg_s",
     "max_abs_lat_accel_g",
     "max_ltr",
     "max_offtracking_m",
@@ -41,8 +42,9 @@ class Metrics:
     """Summary of one run; None where a quantity does not apply (no samples, no trailer, no roll model).
 
     distance_m: distance travelled by the reference point; path_length_m: the length the run was asked to cover
-    (the path, times the laps of a closed path); max_abs_steer_rate_deg_s: from the measured steering-wheel angle
-    differenced at the controller rate; max_offtracking_m: the largest lateral distance of the trailer's rear-axle
+    (the path, times the laps of a closed path); max_abs_steer_rate_deg_s, rms_steer_rate_deg_s: the largest and the
+    RMS steering-wheel rate (the steering effort), from the measured steering-wheel angle differenced at the
+    controller rate; max_offtracking_m: the largest lateral distance of the trailer's rear-axle
     centre from the path.
     """
 
@@ -57,6 +59,7 @@ class Metrics:
     max_abs_heading_error_deg: float | None
     max_abs_steer_wheel_deg: float | None
     max_abs_steer_rate_deg_s: float | None
+    rms_steer_rate_deg_s: float | None
     max_abs_lat_accel_g: float | None
     max_ltr: float | None
     max_offtracking_m: float | None
@@ -112,6 +115,7 @@ def compute_metrics(
         max_abs_heading_error_deg=_max_abs(trace["heading_error_rad"], 180.0 / math.pi),
         max_abs_steer_wheel_deg=_max_abs(steer, 180.0 / math.pi),
         max_abs_steer_rate_deg_s=_max_abs(steer_rate, 180.0 / math.pi),
+        rms_steer_rate_deg_s=float(math.degrees(math.sqrt(np.mean(steer_rate**2)))) if steer_rate is not None else None,
         max_abs_lat_accel_g=_max_abs(trace["lat_accel_mps2"], 1.0 / G_MPS2),
         max_ltr=_max_abs(trace.get("ltr")),
         max_offtracking_m=_max_abs(off),

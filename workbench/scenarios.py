@@ -6,6 +6,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import os
 from collections.abc import Callable
@@ -22,6 +23,9 @@ from workbench.waypoints import Waypoints
 
 #: Environment variable naming the TUMFTM Zandvoort centre-line CSV when --track is not given.
 ZANDVOORT_ENV = "WORKBENCH_ZANDVOORT_CSV"
+#: Bounds of a run's initial error: lateral offset (m, either side) and heading error (rad, either way).
+MAX_INITIAL_OFFSET_M = 50.0
+MAX_INITIAL_HEADING_ERROR_RAD = math.pi / 2
 ZANDVOORT_SOURCE = (
     "the TUMFTM racetrack-database file tracks/Zandvoort.csv "
     "(https://github.com/TUMFTM/racetrack-database/blob/master/tracks/Zandvoort.csv, LGPL-3.0)"
@@ -48,8 +52,9 @@ class Scenario:
     """A reference path and the initial condition of a run.
 
     initial_offset_m: lateral offset of the vehicle's reference point (rear-axle centre) from the path at s = 0,
-    left positive; initial_heading_error_rad: vehicle heading minus path heading at the start; cones_xy: (n, 2)
-    cone positions (m) to draw, or None; description: one line for `workbench scenarios`.
+    left positive (m, within +-MAX_INITIAL_OFFSET_M); initial_heading_error_rad: vehicle heading minus path heading
+    at the start (rad, within +-pi/2); cones_xy: (n, 2) cone positions (m) to draw, or None; description: one line
+    for `workbench scenarios`.
     """
 
     name: str
@@ -58,6 +63,18 @@ class Scenario:
     initial_offset_m: float = 0.0
     initial_heading_error_rad: float = 0.0
     cones_xy: np.ndarray | None = None
+
+    def __post_init__(self) -> None:
+        require_in_range("initial_offset_m", self.initial_offset_m, -MAX_INITIAL_OFFSET_M, MAX_INITIAL_OFFSET_M, "m")
+        bound = MAX_INITIAL_HEADING_ERROR_RAD
+        require_in_range("initial_heading_error_rad", self.initial_heading_error_rad, -bound, bound, "rad")
+
+    def with_initial_error(self, offset_m: float | None = None, heading_error_rad: float | None = None) -> Scenario:
+        """The same scenario started with this lateral offset (m, left positive) and heading error (rad); None keeps
+        the scenario's own (e.g. fig17 starts 1.0 m left of the path)."""
+        offset = self.initial_offset_m if offset_m is None else offset_m
+        heading = self.initial_heading_error_rad if heading_error_rad is None else heading_error_rad
+        return dataclasses.replace(self, initial_offset_m=offset, initial_heading_error_rad=heading)
 
     def initial_pose(self) -> tuple[float, float, float]:
         """(x, y, heading) of the vehicle's rear-axle centre at the start."""

@@ -49,6 +49,7 @@ def test_hand_computed_values() -> None:
     assert m.max_abs_heading_error_deg == pytest.approx(4.0, rel=1e-9)
     assert m.max_abs_steer_wheel_deg == pytest.approx(100.0, rel=1e-9)
     assert m.max_abs_steer_rate_deg_s == pytest.approx(10.0, rel=1e-9)
+    assert m.rms_steer_rate_deg_s == pytest.approx(10.0, rel=1e-9)
     assert m.max_abs_lat_accel_g == pytest.approx(0.2, rel=1e-12)
     assert m.step_time_median_us == pytest.approx(51.0, rel=1e-9)
     assert m.step_time_p99_us == pytest.approx(np.percentile(np.arange(1, 102), 99), rel=1e-9)
@@ -70,7 +71,8 @@ def test_keys_are_the_stable_metrics_json_names() -> None:
     assert METRIC_KEYS == (
         "scenario", "controller", "vehicle", "completed", "distance_m", "path_length_m", "max_abs_cte_m",
         "rms_cte_m", "max_abs_heading_error_deg", "max_abs_steer_wheel_deg", "max_abs_steer_rate_deg_s",
-        "max_abs_lat_accel_g", "max_ltr", "max_offtracking_m", "step_time_median_us", "step_time_p99_us",
+        "rms_steer_rate_deg_s", "max_abs_lat_accel_g", "max_ltr", "max_offtracking_m", "step_time_median_us",
+        "step_time_p99_us",
     )  # fmt: skip
 
 
@@ -78,5 +80,20 @@ def test_empty_trace_gives_nulls_not_nan() -> None:
     trace = {k: v[:0] for k, v in _straight_trace().items()}
     m = _metrics(trace)
     assert m.distance_m == 0.0
-    for key in ("max_abs_cte_m", "rms_cte_m", "max_abs_steer_rate_deg_s", "step_time_median_us"):
+    for key in (
+        "max_abs_cte_m",
+        "rms_cte_m",
+        "max_abs_steer_rate_deg_s",
+        "rms_steer_rate_deg_s",
+        "step_time_median_us",
+    ):
         assert getattr(m, key) is None
+
+
+def test_rms_steer_rate_of_a_sine() -> None:
+    trace = _straight_trace(n=2001, dt=0.01)
+    trace["steer_wheel_rad"] = np.radians(30.0) * np.sin(2 * np.pi * 0.5 * trace["t_s"])  # 30 deg at 0.5 Hz
+    m = _metrics(trace)
+    peak_rate = 30.0 * 2 * np.pi * 0.5  # deg/s
+    assert m.max_abs_steer_rate_deg_s == pytest.approx(peak_rate, rel=1e-3)
+    assert m.rms_steer_rate_deg_s == pytest.approx(peak_rate / math.sqrt(2), rel=1e-3)
