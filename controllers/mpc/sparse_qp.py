@@ -172,17 +172,21 @@ class SparseMPCQP:
         r_all, c_all, v_all = np.concatenate(rows), np.concatenate(cols), np.concatenate(vals)
         ids = sp.csc_matrix((np.arange(1, r_all.size + 1, dtype=float), (r_all, c_all)), shape=(self.m, self.n))
         ids.sort_indices()
-        self._order = ids.data.astype(int) - 1  # CSC position p holds entry id _order[p]
-        self._a_idx = np.array([np.arange(sl.start, sl.stop).reshape(nx, nx) for sl in self._a_slices]).reshape(
-            N - 1, nx, nx
-        )
-        self._b_idx = np.array([np.arange(sl.start, sl.stop).reshape(nx, nu) for sl in self._b_slices])
+        order = ids.data.astype(int) - 1  # CSC position p holds entry id order[p]
+        a_idx = np.array([np.arange(sl.start, sl.stop).reshape(nx, nx) for sl in self._a_slices]).reshape(N - 1, nx, nx)
+        b_idx = np.array([np.arange(sl.start, sl.stop).reshape(nx, nu) for sl in self._b_slices])
         if soft:
-            self._g_idx = np.array(
+            g_idx = np.array(
                 [[np.arange(hi.start, hi.stop), np.arange(lo.start, lo.stop)] for hi, lo in self._g_slices]
             )
-        self._values = v_all
-        A = sp.csc_matrix((v_all[self._order], ids.indices.copy(), ids.indptr.copy()), shape=(self.m, self.n))
+        # Where each updated entry sits in the CSC data array, so that a step writes there directly.
+        position = np.empty_like(order)
+        position[order] = np.arange(order.size)
+        self._a_pos, self._b_pos = position[a_idx], position[b_idx]
+        if soft:
+            self._g_pos = position[g_idx]
+        self._csc_values = v_all[order]
+        A = sp.csc_matrix((self._csc_values.copy(), ids.indices.copy(), ids.indptr.copy()), shape=(self.m, self.n))
 
         self.lower = np.zeros(self.m)
         self.upper = np.zeros(self.m)
@@ -224,18 +228,18 @@ class SparseMPCQP:
     ) -> None:
         """Dynamics blocks A (N, nx, nx), B (N, nx, nu), c (N, nx); initial state; soft-constraint rows G (N, nx)
         with bounds soft_lo, soft_hi (N,); state references x_ref (N+1, nx) for the linear cost term."""
-        vals = self._values
-        vals[self._a_idx] = -A[1:]
-        vals[self._b_idx] = -B
+        vals = self._csc_values
+        vals[self._a_pos] = -A[1:]
+        vals[self._b_pos] = -B
         self.x0 = np.array(x0, dtype=float)
         rhs = c.copy()
         rhs[0] += A[0] @ self.x0
         self.lower[: self.n_eq] = self.upper[: self.n_eq] = rhs.ravel()
         if self.soft and G is not None:
-            vals[self._g_idx] = G[:, None, :]
+            vals[self._g_pos] = G[:, None, :]
             self.lower[self._soft_lo] = soft_lo
             self.upper[self._soft_hi] = soft_hi
-        update = {"Ax": vals[self._order], "l": self.lower, "u": self.upper}
+        update = {"Ax": vals, "l": self.lower, "u": self.upper}
         if x_ref is not None:
             q = self.q.copy()
             q[self.ix[:-1]] = -2.0 * x_ref[1:-1] @ self.Q
