@@ -33,7 +33,7 @@ from workbench.scenarios import ScenarioOptions, make_scenario
 from workbench.simulator import Simulation, SimulationConfig
 from workbench.studies.lead_filter_scaling import write_scaled_filter
 from workbench.studies.spec import EXTRA_RUN_PARAMETERS, LEAD_FILTER_SCALES, PlannedRun
-from workbench.vehicles import VEHICLES, make_vehicle
+from workbench.vehicles.presets import load_vehicle
 
 #: The status of a run that raised.
 ERROR_STATUS = "error"
@@ -78,10 +78,7 @@ def simulate(run: PlannedRun, progress: bool = False) -> SimulationResult:
     values = dict(run.values)
     extra = {k: values.pop(k, None) for k in EXTRA_RUN_PARAMETERS}
     config = SimulationConfig(**values)
-    if run.vehicle in VEHICLES:
-        vehicle = make_vehicle(run.vehicle, payload_kg=extra["payload_kg"])
-    else:
-        vehicle = make_vehicle(vehicle_file=run.vehicle, payload_kg=extra["payload_kg"])
+    vehicle = load_vehicle(run.vehicle, extra["payload_kg"])  # a preset name or a vehicle file
     scenario = make_scenario(run.scenario, ScenarioOptions(vehicle.geometry.width_m, run.track_file))
     heading_deg = extra["initial_heading_error_deg"]
     scenario = scenario.with_initial_error(

@@ -16,7 +16,7 @@ from workbench.scenarios import ScenarioOptions, make_scenario
 from workbench.simulator import Simulation, SimulationConfig
 from workbench.studies import PlannedRun, execute_run, load_spec
 from workbench.studies.runner import ROW_METRICS, build_controller_config, option_text, simulate
-from workbench.vehicles import make_vehicle
+from workbench.vehicles import make_vehicle, preset_text
 
 
 def _run(**kwargs: object) -> PlannedRun:
@@ -116,3 +116,16 @@ def test_option_text_round_trips(value: object) -> None:
         assert text == ("true" if value else "false")
     else:
         assert text == str(value)
+
+
+def test_a_vehicle_file_runs_as_its_preset_does_with_the_payload_asked(tmp_path: Path) -> None:
+    path = tmp_path / "truck.toml"
+    path.write_text(preset_text("tractor-semitrailer"))
+    values = (("speed_kmh", 20.0), ("payload_kg", 5000.0))
+    from_file = execute_run(_run(vehicle=str(path), values=values))
+    from_preset = execute_run(_run(vehicle="tractor-semitrailer", values=values))
+    assert from_file["status"] == "completed"
+    for key in ("max_abs_cte_m", "rms_cte_m", "max_ltr"):
+        assert from_file[key] == from_preset[key], key
+    light = execute_run(_run(vehicle=str(path), values=(("speed_kmh", 20.0), ("payload_kg", 0.0))))
+    assert light["max_ltr"] != from_file["max_ltr"]  # the payload reached the file's vehicle
