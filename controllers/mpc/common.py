@@ -9,7 +9,8 @@ Each step (section 6.6 of the paper compares the clothoid controller with an MPC
      gives (the lag's curvature rate, the delay state) taken from the previous plan shifted to now;
   3. per interval k the path curvature at the planned progress s_k (from the previous plan: the vehicle's own
      predicted progress, so an offset or a heading error moves the curvature samples as it should) and the speed
-     v_k = measured speed + (planned speed at s_k - planned speed at s_0), at least min_model_speed_mps;
+     v_k = measured speed + (planned speed at s_k - planned speed at s_0), at least min_model_speed_mps
+     (`preview.py`);
   4. the solve, warm-started from the previous plan shifted to now;
   5. the command: the plan's commanded road-wheel angle one controller period ahead (its rate is the input),
      times the steering ratio, saturated. A solve that is not accepted (failed, iteration limit, late, infeasible,
@@ -38,6 +39,7 @@ from controllers.mpc.prediction_model import (
     params_from_geometry,
     prediction_params_for,
 )
+from controllers.mpc.preview import PathPreview
 from controllers.mpc.status import SolveResult, SolveStatus
 from workbench.errors import WorkbenchInputError, require_in_range, require_positive
 from workbench.path import PathTracker, Projection, ReferencePath, wrap_angle
@@ -229,19 +231,7 @@ class MPCController(Controller):
         self._set_time_budget(self.config.max_solve_time_s or self._sample_time_s)
         self._reset_state()
         self._tracker: PathTracker = path.tracker(0.0)
-        self._path = path
-        speed = path.speed_mps if path.speed_mps is not None else np.zeros_like(path.curvature_1pm)
-        self._path_samples = np.column_stack((path.curvature_1pm, speed))
-
-    def _sample_path(self, s_m: np.ndarray) -> np.ndarray:
-        """(curvature, planned speed) of the reset path at arc lengths s_m (wrapped on a loop, clipped at the ends
-        of an open path), linearly interpolated: (len(s_m), 2)."""
-        path, samples = self._path, self._path_samples
-        s_m = np.mod(s_m, path.length_m) if path.closed else np.clip(s_m, 0.0, path.length_m)
-        position = s_m / path.spacing_m
-        i = np.minimum(position.astype(int), samples.shape[0] - 2)
-        frac = (position - i)[:, None]
-        return samples[i] * (1.0 - frac) + samples[i + 1] * frac
+        self._preview = PathPreview(path)
 
     def _reset_state(self) -> None:
         self._plan: Plan | None = None
@@ -272,14 +262,8 @@ class MPCController(Controller):
             progress = shifted[2]
         else:
             progress = max(v0, ocp.min_speed_mps) * h * np.arange(ocp.N + 1)
-        s_mid = foot.s_m + 0.5 * (progress[1:] + progress[:-1])
-        sampled = self._sample_path(np.append(s_mid, foot.s_m))
-        kappa = sampled[:-1, 0]
-        if self._path.speed_mps is not None:
-            speed = v0 + sampled[:-1, 1] - sampled[-1, 1]
-        else:
-            speed = np.full(ocp.N, v0)
-        speed = np.maximum(speed, ocp.min_speed_mps)
+        along = self._preview.along(foot.s_m, progress, v0, ocp.min_speed_mps)
+        kappa, speed = along[:, 0], along[:, 1]
         first = shifted is None
         if first:
             guess_inputs = np.zeros((ocp.N, ocp.nu))

@@ -12,8 +12,9 @@ The QP (`sparse_qp.py`) is sparse, states and inputs both variables, built once;
 blocks, initial state and offsets are overwritten in place, and OSQP starts from the previous plan shifted to now.
 The commanded road-wheel angle is a state and its rate the input, which is Autoware's steering-rate limit and
 rate penalty written as bounds and a diagonal weight. The same prediction kinds as the NMPC are available
-(`model`), so with a lag file the LTV-MPC predicts with the identified lag too; "auto" picks the kinematic model
-(Autoware's default) unless a lag file is given.
+(`model`), so with a lag file the LTV-MPC predicts with the identified lag too. "auto" picks as the NMPC does:
+kinematic-lag with a lag file, else the dynamic single track when the vehicle's mass and tyres are known, else
+Autoware's kinematic model.
 """
 
 from __future__ import annotations
@@ -97,7 +98,7 @@ class LtvSolver:
 
 @dataclass(frozen=True)
 class LMPCConfig(MPCConfig):
-    """The common MPC options (`MPCConfig`; model "auto" means kinematic, or kinematic-lag with a lag file) and:
+    """The common MPC options (`MPCConfig`, model "auto" as the NMPC's) and:
     qp_tolerance: OSQP's absolute and relative tolerance; qp_max_iterations: OSQP's iteration limit. The
     lateral-acceleration limit (max_lat_accel_mps2) is the NMPC's only: the LTV-MPC refuses it."""
 
@@ -137,7 +138,7 @@ class LMPCController(MPCController):
         self.solver = LtvSolver(self.ocp, settings, codegen=cfg.codegen)
 
     def _set_time_budget(self, seconds: float) -> None:
-        self.solver.qp.solver.update_settings(time_limit=seconds)
+        self.solver.qp.set_time_limit(seconds)
 
     def _solve(
         self,

@@ -98,7 +98,7 @@ class NMPCController(MPCController):
         if isinstance(self.solver, IpoptSolver):
             self.solver.set_time_limit(seconds)
         else:
-            self.solver.qp.solver.update_settings(time_limit=seconds)
+            self.solver.qp.set_time_limit(seconds)
 
     def _solve(
         self,

@@ -70,7 +70,6 @@ class TrackingOCP:
         self.substeps = model.substeps_for(step_s, min_speed_mps)
         self.F = model.discrete(step_s, self.substeps)
         self._rollout = FastFunction(self.F.mapaccum(self.N))
-        self._progress_params = np.zeros((self.N + 1, 2))
         self._linearisation: dict[bool, CompiledFunction] = {}
         q = np.zeros(self.nx)
         q[model.i_cte], q[model.i_heading] = weights.cte, weights.heading
@@ -136,14 +135,7 @@ class TrackingOCP:
 
     def progress(self, states: np.ndarray, kappa: np.ndarray, speed: np.ndarray) -> np.ndarray:
         """Predicted arc length travelled along the path (m) at each node: the trapezoidal integral of s'."""
-        params = self._progress_params
-        params[:-1, 0], params[:-1, 1] = kappa, speed
-        params[-1] = params[-2]
-        rate = self.model.progress_rate_numpy(states, params[:, 0], params[:, 1])
-        out = np.empty(self.N + 1)
-        out[0] = 0.0
-        np.cumsum(0.5 * self.step_s * (rate[1:] + rate[:-1]), out=out[1:])
-        return out
+        return self.model.progress(states, kappa, speed, self.step_s)
 
     def set_steer_bounds(self, lower_rad: float, upper_rad: float) -> None:
         """Bounds on the commanded road-wheel angle (rad). Solvers read them at every solve, so this also serves to

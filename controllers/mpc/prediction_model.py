@@ -54,6 +54,7 @@ from typing import Any
 
 import casadi as ca
 import numpy as np
+from numba import njit
 
 from workbench.errors import WorkbenchInputError, require_in_range, require_positive
 from workbench.vehicles.base import VehicleGeometry, VehicleModel
@@ -437,18 +438,21 @@ class PredictionModel:
         xdot = ca.vertcat(e_y_dot, e_psi_dot, *states_dot, u[0])
         return xdot, yaw_rate, s_dot
 
-    def progress_rate_numpy(self, states: np.ndarray, kappa: np.ndarray, speed: np.ndarray) -> np.ndarray:
-        """s' of `progress_rate` for rows of states (n, nx) with per-row kappa and speed, in numpy (cheaper per
-        step than a CasADi call; the tests check that both agree)."""
-        e_y, e_psi = states[:, self.i_cte], states[:, self.i_heading]
-        scale = np.maximum(1.0 - kappa * e_y, _MIN_FRENET_SCALE)
-        along = speed * np.cos(e_psi)
+    def progress(self, states: np.ndarray, kappa: np.ndarray, speed: np.ndarray, step_s: float) -> np.ndarray:
+        """Predicted arc length travelled along the path (m) at each node of a plan, states (N+1, nx) with
+        kappa and speed per interval (N,): the trapezoidal integral of s' (`progress_rate`; node N uses the last
+        interval's kappa and speed). Compiled (`_progress_kernel`); the tests check it against `progress_rate`."""
         if self.kind == "dynamic":
             st = self.params.single_track
             assert st is not None
-            v_rear = states[:, 2] - st.cg_to_rear_axle_m * states[:, 3]
-            along = along - v_rear * np.sin(e_psi)
-        return along / scale
+            i_vy, i_r, b = (
+                self.state_names.index("vy_cg_mps"),
+                self.state_names.index("yaw_rate_rad_s"),
+                st.cg_to_rear_axle_m,
+            )
+        else:
+            i_vy, i_r, b = -1, -1, 0.0
+        return _progress_kernel(states, kappa, speed, step_s, self.i_cte, self.i_heading, i_vy, i_r, b)
 
     def _reference(self, kappa: ca.SX, v: ca.SX) -> ca.SX:
         """Steady cornering on the path (e_y = 0) at curvature kappa and speed v: the state the LTV-MPC linearises
@@ -540,3 +544,34 @@ def _inverse_magic(force: ca.SX, peak: float, stiffness: float, st: SingleTrackP
     bb = stiffness / (shape * peak)
     ratio = ca.fmin(ca.fmax(force / peak, -0.99), 0.99)
     return ca.tan(ca.asin(ratio) / shape) / bb
+
+
+@njit(cache=True)
+def _progress_kernel(
+    states: np.ndarray,
+    kappa: np.ndarray,
+    speed: np.ndarray,
+    step_s: float,
+    i_cte: int,
+    i_heading: int,
+    i_vy: int,
+    i_r: int,
+    cg_to_rear_axle_m: float,
+) -> np.ndarray:  # pragma: no cover - compiled
+    """`PredictionModel.progress`: s' = (v cos(e_psi) - v_r sin(e_psi)) / max(1 - kappa e_y, _MIN_FRENET_SCALE)
+    per node, v_r = v_y - b r (i_vy >= 0, the dynamic kind) or 0, integrated by the trapezoidal rule."""
+    n_nodes, last = states.shape[0], kappa.shape[0] - 1
+    out = np.empty(n_nodes)
+    out[0] = 0.0
+    previous = 0.0
+    for k in range(n_nodes):
+        j = min(k, last)
+        e_y, e_psi = states[k, i_cte], states[k, i_heading]
+        along = speed[j] * math.cos(e_psi)
+        if i_vy >= 0:
+            along -= (states[k, i_vy] - cg_to_rear_axle_m * states[k, i_r]) * math.sin(e_psi)
+        rate = along / max(1.0 - kappa[j] * e_y, _MIN_FRENET_SCALE)
+        if k > 0:
+            out[k] = out[k - 1] + 0.5 * step_s * (rate + previous)
+        previous = rate
+    return out

@@ -13,6 +13,10 @@ are on; x_0 = x_hat is known and not a variable). The problem is
 B_k and G_k stored as dense blocks, so each step only overwrites the values (OSQP `update(Ax=...)`, plus the
 vectors l, u, q) and OSQP re-factors without a new symbolic analysis. The previous solution is the default warm
 start; `solve` accepts a better one (the previous plan shifted to the current time).
+
+The per-step calls go to the compiled solver that `osqp.OSQP` wraps (`OSQP._solver`, osqp 1.x): the wrapper's
+`update` and `solve` spent about 60 us a step in Python (a module lookup for OSQP_INFTY on every update, an info
+namespace built on every solve), a tenth of the LTV-MPC's whole step. Setup and settings go through the wrapper.
 """
 
 from __future__ import annotations
@@ -23,8 +27,12 @@ from dataclasses import dataclass
 import numpy as np
 import osqp
 import scipy.sparse as sp
+from numba import njit
 
 from controllers.mpc.status import SolveStatus, osqp_status
+
+#: OSQP's infinity: bounds beyond it are treated as absent.
+OSQP_INFINITY = float(osqp.constant("OSQP_INFTY"))
 
 
 @dataclass(frozen=True)
@@ -103,6 +111,7 @@ class SparseMPCQP:
         self.x_lower, self.x_upper = np.asarray(x_lower, float).copy(), np.asarray(x_upper, float).copy()
         self.u_lower, self.u_upper = np.asarray(u_lower, float).copy(), np.asarray(u_upper, float).copy()
         self.x0 = np.zeros(nx)
+        self._x0_cost = 0.0
 
         # ---- cost
         blocks = []
@@ -192,21 +201,33 @@ class SparseMPCQP:
         self.upper = np.zeros(self.m)
         self._set_box_bounds()
         if soft:
-            self.lower[self._soft_hi], self.upper[self._soft_hi] = -np.inf, 0.0
-            self.lower[self._soft_lo], self.upper[self._soft_lo] = 0.0, np.inf
-            self.lower[self._eps_rows], self.upper[self._eps_rows] = 0.0, np.inf
+            self.lower[self._soft_hi], self.upper[self._soft_hi] = -OSQP_INFINITY, 0.0
+            self.lower[self._soft_lo], self.upper[self._soft_lo] = 0.0, OSQP_INFINITY
+            self.lower[self._eps_rows], self.upper[self._eps_rows] = 0.0, OSQP_INFINITY
         self._P = P
         self.solver = osqp.OSQP()
         self.solver.setup(
             P=P, q=self.q.copy(), A=A, l=self.lower.copy(), u=self.upper.copy(), **self.settings.as_kwargs()
         )
+        self._native = getattr(self.solver, "_solver", None)
+        if not all(hasattr(self._native, name) for name in ("update_data_vec", "update_data_mat", "solve", "info")):
+            raise RuntimeError(
+                f"osqp {osqp.__version__} is not supported: the MPC needs osqp >= 1.0, < 2 (pip install 'osqp>=1,<2')"
+            )
+
+    def set_time_limit(self, seconds: float) -> None:
+        """OSQP's wall-time limit (s; 0: none)."""
+        self.solver.update_settings(time_limit=float(seconds))
 
     def _set_box_bounds(self) -> None:
+        """Box bounds into l and u, infinite ones as OSQP's infinity (as its wrapper would on every update)."""
         N = self.N
         self.lower[self._u_rows] = np.tile(self.u_lower, N)
         self.upper[self._u_rows] = np.tile(self.u_upper, N)
         self.lower[self._x_rows] = np.tile(self.x_lower[self.bounded], N)
         self.upper[self._x_rows] = np.tile(self.x_upper[self.bounded], N)
+        np.clip(self.lower, -OSQP_INFINITY, OSQP_INFINITY, out=self.lower)
+        np.clip(self.upper, -OSQP_INFINITY, OSQP_INFINITY, out=self.upper)
 
     def set_bounds(self, x_lower: np.ndarray, x_upper: np.ndarray, u_lower: np.ndarray, u_upper: np.ndarray) -> None:
         """New box bounds (same bounded states as at construction; +-inf elsewhere is ignored)."""
@@ -229,60 +250,116 @@ class SparseMPCQP:
         """Dynamics blocks A (N, nx, nx), B (N, nx, nu), c (N, nx); initial state; soft-constraint rows G (N, nx)
         with bounds soft_lo, soft_hi (N,); state references x_ref (N+1, nx) for the linear cost term."""
         vals = self._csc_values
-        vals[self._a_pos] = -A[1:]
-        vals[self._b_pos] = -B
         self.x0 = np.array(x0, dtype=float)
-        rhs = c.copy()
-        rhs[0] += A[0] @ self.x0
-        self.lower[: self.n_eq] = self.upper[: self.n_eq] = rhs.ravel()
+        self._x0_cost = _quadratic_form(self.Q, self.x0)  # x_0' Q x_0: the cost's constant term
+        _write_dynamics(vals, self._a_pos, self._b_pos, A, B, c, self.x0, self.lower, self.upper)
         if self.soft and G is not None:
             vals[self._g_pos] = G[:, None, :]
             self.lower[self._soft_lo] = soft_lo
             self.upper[self._soft_hi] = soft_hi
-        update = {"Ax": vals, "l": self.lower, "u": self.upper}
+        q = None
         if x_ref is not None:
             q = self.q.copy()
             q[self.ix[:-1]] = -2.0 * x_ref[1:-1] @ self.Q
             q[self.ix[-1]] = -2.0 * x_ref[-1] @ self.QN
-            update["q"] = q
-        self.solver.update(**update)
+        self._native.update_data_vec(q=q, l=self.lower, u=self.upper)
+        self._native.update_data_mat(P_x=None, P_i=None, A_x=vals, A_i=None)
 
     def pack(self, states: np.ndarray, inputs: np.ndarray, slacks: np.ndarray | None = None) -> np.ndarray:
         """z from states (N+1, nx; node 0 is not a variable), inputs (N, nu) and slacks (N,)."""
         z = np.zeros(self.n)
-        z[self.ix] = states[1:]
-        z[self.iu] = inputs
+        stages = self._stages(z)
+        stages[:, : self.nu] = inputs
+        stages[:, self.nu :] = states[1:]
         if self.soft and slacks is not None:
             z[self.ie] = slacks
         return z
 
+    def _stages(self, z: np.ndarray) -> np.ndarray:
+        """The view of z as rows [u_k, x_{k+1}], k = 0..N-1: (N, nu + nx)."""
+        return z[: self.N * (self.nu + self.nx)].reshape(self.N, self.nu + self.nx)
+
     def solve(self, warm_start: np.ndarray | None = None) -> QPSolution:
         """Solve; warm_start (z) replaces the primal part of OSQP's own warm start (its previous solution)."""
+        native = self._native
         if warm_start is not None:
-            self.solver.warm_start(x=warm_start)
+            native.warm_start(warm_start, None)
         start = time.perf_counter()
-        result = self.solver.solve(raise_error=False)
+        native.solve()
         elapsed = time.perf_counter() - start
-        status = osqp_status(str(result.info.status))
-        z = np.asarray(result.x, dtype=float)
-        if not np.isfinite(z).all():
+        info, solution = native.info, native.solution
+        status = osqp_status(info.status)
+        z = solution.x
+        states, inputs, finite = _unpack(z, self.x0, self.N, self.u_lower, self.u_upper)
+        if not finite:
             status = SolveStatus.NOT_FINITE if status.accepted else status
             z = np.zeros(self.n)
-        objective = float(result.info.obj_val) + float(self.x0 @ self.Q @ self.x0)
-        states = np.empty((self.N + 1, self.nx))
-        states[0] = self.x0
-        states[1:] = z[self.ix]
-        # OSQP meets bounds to its tolerance only; the inputs are projected so that the plan never asks for more
-        # than the actuator's rate (the state bounds are enforced where the command is saturated).
-        inputs = np.clip(z[self.iu], self.u_lower, self.u_upper)
-        return QPSolution(
-            status,
-            states,
-            inputs,
-            z[self.ie],
-            int(result.info.iter),
-            elapsed,
-            objective,
-            z,
-            np.asarray(result.y, dtype=float),
-        )
+            states, inputs, _ = _unpack(z, self.x0, self.N, self.u_lower, self.u_upper)
+        objective = float(info.obj_val) + self._x0_cost
+        return QPSolution(status, states, inputs, z[self.ie], int(info.iter), elapsed, objective, z, solution.y)
+
+
+# ---------------------------------------------------------------------------------------------- compiled kernels
+# The per-step array work around OSQP's calls: a dozen small numpy operations each, which cost 20-30 us a step
+# (far more inside the control loop than in isolation), against a few us as one compiled call.
+
+
+@njit(cache=True)
+def _write_dynamics(
+    values: np.ndarray,
+    a_pos: np.ndarray,
+    b_pos: np.ndarray,
+    A: np.ndarray,
+    B: np.ndarray,
+    c: np.ndarray,
+    x0: np.ndarray,
+    lower: np.ndarray,
+    upper: np.ndarray,
+) -> None:  # pragma: no cover - compiled
+    """values[a_pos] = -A[1:] and values[b_pos] = -B (CSC positions of the dynamics blocks); the equality rows'
+    bounds (the first N nx rows of l and u) = c_k, plus A_0 x0 for k = 0 (x_0 is not a variable)."""
+    N, nx, nu = B.shape
+    for k in range(N):
+        for i in range(nx):
+            for j in range(nu):
+                values[b_pos[k, i, j]] = -B[k, i, j]
+            rhs = c[k, i]
+            if k == 0:
+                for j in range(nx):
+                    rhs += A[0, i, j] * x0[j]
+            else:
+                for j in range(nx):
+                    values[a_pos[k - 1, i, j]] = -A[k, i, j]
+            lower[k * nx + i] = rhs
+            upper[k * nx + i] = rhs
+
+
+@njit(cache=True)
+def _unpack(
+    z: np.ndarray, x0: np.ndarray, N: int, u_lower: np.ndarray, u_upper: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, bool]:  # pragma: no cover - compiled
+    """States (N+1, nx; node 0 = x0) and inputs (N, nu) from z = [u_0, x_1, ..., u_{N-1}, x_N, ...], and whether
+    all of z is finite. OSQP meets bounds to its tolerance only; the inputs are projected so that the plan never
+    asks for more than the actuator's rate (the state bounds are enforced where the command is saturated)."""
+    finite = np.isfinite(z).all()
+    nx, nu = x0.shape[0], u_lower.shape[0]
+    states = np.empty((N + 1, nx))
+    inputs = np.empty((N, nu))
+    states[0] = x0
+    for k in range(N):
+        base = k * (nu + nx)
+        for j in range(nu):
+            inputs[k, j] = min(max(z[base + j], u_lower[j]), u_upper[j])
+        for i in range(nx):
+            states[k + 1, i] = z[base + nu + i]
+    return states, inputs, finite
+
+
+@njit(cache=True)
+def _quadratic_form(Q: np.ndarray, x: np.ndarray) -> float:  # pragma: no cover - compiled
+    """x' Q x (numpy's @ would call BLAS for these few numbers)."""
+    total = 0.0
+    for i in range(x.shape[0]):
+        for j in range(x.shape[0]):
+            total += x[i] * Q[i, j] * x[j]
+    return total

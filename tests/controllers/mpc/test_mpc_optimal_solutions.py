@@ -222,3 +222,15 @@ def test_ltv_mpc_on_a_straight_is_the_lqr_of_its_model() -> None:
     # |u| stays below the rate bound here, so the QP is unconstrained
     assert np.max(np.abs(result.inputs)) < ocp.u_upper[0]
     assert result.inputs[0, 0] == pytest.approx(float((-K @ x0)[0]), rel=1e-6)
+
+
+def test_non_finite_dynamics_give_a_reported_failure_not_nan_plans() -> None:
+    A, B = SYSTEMS["unstable"]
+    free = np.full(2, np.inf)
+    qp = SparseMPCQP(N, 2, 1, np.eye(2), np.eye(1), np.eye(2), -free, free, np.array([-1.0]), np.array([1.0]))
+    A_k = np.repeat(A[None], N, 0)
+    A_k[3, 0, 0] = np.nan
+    qp.update(np.array([0.1, 0.0]), A_k, np.repeat(B[None], N, 0), np.zeros((N, 2)))
+    solution = qp.solve()
+    assert not solution.status.accepted
+    assert np.isfinite(solution.states).all() and np.isfinite(solution.inputs).all()

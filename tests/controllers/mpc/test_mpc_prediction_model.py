@@ -207,14 +207,22 @@ def test_rk4_substeps_keep_the_fast_modes_stable(min_speed: float, step: float) 
     assert n == 1 or step / (n - 1) * fastest > 2.0
 
 
-@pytest.mark.parametrize("kind", ["dynamic", "kinematic"])
-def test_numpy_progress_rate_matches_casadi(kind: str) -> None:
-    model = PredictionModel(prediction_params_for("dynamic-bicycle"), kind)
+@pytest.mark.parametrize("kind", ["dynamic", "kinematic", "kinematic-lag"])
+def test_compiled_progress_is_the_trapezoidal_integral_of_the_casadi_rate(kind: str) -> None:
+    params = prediction_params_for("dynamic-bicycle")
+    if kind == "kinematic-lag":
+        params = params.with_lag(SteeringLag(omega_n_rad_s=6.0, zeta=0.8, delay_s=0.05))
+    model = PredictionModel(params, kind)
     rng = np.random.default_rng(1)
-    states = rng.normal(0.0, 0.3, size=(7, model.nx))
-    kappa, speed = rng.normal(0.0, 0.05, 7), rng.uniform(2.0, 20.0, 7)
-    expected = [float(model.progress_rate(x, [k, v])) for x, k, v in zip(states, kappa, speed, strict=True)]
-    np.testing.assert_allclose(model.progress_rate_numpy(states, kappa, speed), expected, rtol=1e-12)
+    n, step = 7, 0.05
+    states = rng.normal(0.0, 0.3, size=(n + 1, model.nx))
+    states[2, 0] = 30.0  # 1 - kappa e_y below the floor: s' is held finite, as in the CasADi model
+    kappa, speed = rng.normal(0.0, 0.05, n), rng.uniform(2.0, 20.0, n)
+    kappa[2] = 0.5
+    node_params = np.vstack((np.append(kappa, kappa[-1]), np.append(speed, speed[-1]))).T  # node N: last interval
+    rate = np.array([float(model.progress_rate(x, p)) for x, p in zip(states, node_params, strict=True)])
+    expected = np.concatenate(([0.0], np.cumsum(0.5 * step * (rate[1:] + rate[:-1]))))
+    np.testing.assert_allclose(model.progress(states, kappa, speed, step), expected, rtol=1e-12, atol=1e-12)
 
 
 def test_prediction_params_are_frozen() -> None:
