@@ -41,6 +41,23 @@ def shift_rows(rows: np.ndarray, offset: float, count: int) -> np.ndarray:  # pr
     return out
 
 
+@njit(cache=True)
+def _shifted(
+    states: np.ndarray, inputs: np.ndarray, progress_m: np.ndarray, offset: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:  # pragma: no cover - compiled
+    """`Plan.shifted` for a node offset in [0, N]: states and progress by `shift_rows`, the progress counted from
+    the new start, the inputs of the intervals the new ones start in (the last one held)."""
+    n = inputs.shape[0]
+    new_states = shift_rows(states, offset, n + 1)
+    new_progress = shift_rows(progress_m.reshape(-1, 1), offset, n + 1)[:, 0]
+    new_progress -= new_progress[0]
+    whole = min(int(offset), n - 1)
+    new_inputs = np.empty_like(inputs)
+    for k in range(n):
+        new_inputs[k] = inputs[min(whole + k, n - 1)]
+    return new_states, new_inputs, new_progress
+
+
 @dataclass
 class Plan:
     """t_s: time of the measurement the plan starts from; step_s: prediction step h; states (N+1, nx);
@@ -65,13 +82,8 @@ class Plan:
 
     def shifted(self, t_s: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(states, inputs, progress from t_s) re-sampled for a plan starting at t_s (not before the plan)."""
-        n = self.horizon_steps
-        offset = min(max((t_s - self.t_s) / self.step_s, 0.0), float(n))
-        states = shift_rows(self.states, offset, n + 1)
-        progress = shift_rows(self.progress_m.reshape(-1, 1), offset, n + 1)[:, 0]
-        whole = min(int(offset), n - 1)
-        inputs = self.inputs[np.minimum(np.arange(whole, whole + n), n - 1)]
-        return states, inputs, progress - progress[0]
+        offset = min(max((t_s - self.t_s) / self.step_s, 0.0), float(self.horizon_steps))
+        return _shifted(self.states, self.inputs, self.progress_m, offset)
 
     def command_at(self, t_s: float) -> float:
         """The planned command (road-wheel angle, rad) at time t_s: exact, the rate is piecewise constant."""
