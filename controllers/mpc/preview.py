@@ -38,6 +38,7 @@ class PathPreview:
 def _sample(
     samples: np.ndarray, spacing_m: float, length_m: float, closed: bool, s_m: float
 ) -> tuple[float, float]:  # pragma: no cover - compiled
+    """(curvature, planned speed) at arc length s_m, linearly interpolated on the uniform grid."""
     s_m = s_m % length_m if closed else min(max(s_m, 0.0), length_m)
     position = s_m / spacing_m
     i = min(int(position), samples.shape[0] - 2)
@@ -59,6 +60,7 @@ def _along(
     v0_mps: float,
     min_speed_mps: float,
 ) -> np.ndarray:  # pragma: no cover - compiled
+    """`PathPreview.along` (the module docstring's kappa_k, v_k)."""
     n = progress_m.shape[0] - 1
     out = np.empty((n, 2))
     planned_now = _sample(samples, spacing_m, length_m, closed, s0_m)[1]

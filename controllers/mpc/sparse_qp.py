@@ -268,16 +268,11 @@ class SparseMPCQP:
     def pack(self, states: np.ndarray, inputs: np.ndarray, slacks: np.ndarray | None = None) -> np.ndarray:
         """z from states (N+1, nx; node 0 is not a variable), inputs (N, nu) and slacks (N,)."""
         z = np.zeros(self.n)
-        stages = self._stages(z)
-        stages[:, : self.nu] = inputs
-        stages[:, self.nu :] = states[1:]
+        z[self.ix] = states[1:]
+        z[self.iu] = inputs
         if self.soft and slacks is not None:
             z[self.ie] = slacks
         return z
-
-    def _stages(self, z: np.ndarray) -> np.ndarray:
-        """The view of z as rows [u_k, x_{k+1}], k = 0..N-1: (N, nu + nx)."""
-        return z[: self.N * (self.nu + self.nx)].reshape(self.N, self.nu + self.nx)
 
     def solve(self, warm_start: np.ndarray | None = None) -> QPSolution:
         """Solve; warm_start (z) replaces the primal part of OSQP's own warm start (its previous solution)."""
