@@ -18,6 +18,7 @@ from controllers.config_file import config_template, read_controller_config
 from workbench.comparison import Comparison, RunSpec, compare
 from workbench.errors import WorkbenchInputError
 from workbench.fig17 import run_fig17
+from workbench.limit_cycle import detect_limit_cycle
 from workbench.report import ReportSection, write_report
 from workbench.scenarios import ScenarioOptions, describe_scenarios, make_scenario
 from workbench.simulator import Simulation, SimulationConfig
@@ -148,8 +149,11 @@ def _names(text: str, what: str) -> list[str]:
 def _print_summary(comparison: Comparison) -> None:
     table = comparison.summary()
     columns = ["controller", "vehicle", "status", "max_abs_cte_m", "rms_cte_m", "converge_distance_m"]
-    columns += ["step_time_median_us", "step_time_ratio"]
+    columns += ["rms_steer_rate_deg_s", "steer_oscillation_deg", "step_time_median_us", "step_time_ratio"]
     print(table[columns].to_string(index=False, float_format=lambda v: f"{v:.3g}"))
+    for spec, cycle in zip(comparison.specs, comparison.limit_cycles(), strict=True):
+        if cycle.detected:
+            print(f"  WARNING: steering limit cycle: {spec.label} at {cycle.describe()}")
 
 
 def _compare(args: argparse.Namespace) -> int:
@@ -301,6 +305,13 @@ def _run(args: argparse.Namespace) -> int:
         f"  max |steering-wheel angle| {fmt(m.max_abs_steer_wheel_deg, 'deg')}, "
         f"max |lateral acceleration| {fmt(m.max_abs_lat_accel_g, 'g')}"
     )
+    print(
+        f"  steering oscillation {fmt(m.steer_oscillation_deg, 'deg')} (RMS about its 1 s average), "
+        f"RMS steering rate {fmt(m.rms_steer_rate_deg_s, 'deg/s')}"
+    )
+    cycle = detect_limit_cycle(result.trace["t_s"], result.trace["steer_wheel_rad"])
+    if cycle.detected:
+        print(f"  WARNING: steering limit cycle at {cycle.describe()}")
     print(f"  controller step median {fmt(m.step_time_median_us, 'us')}, p99 {fmt(m.step_time_p99_us, 'us')}")
     print(f"  wrote {len(written)} files to {args.out}")
     if not result.completed:

@@ -25,6 +25,7 @@ from controllers import CONTROLLERS, make_controller
 from controllers.config_file import read_controller_config
 from workbench import plots
 from workbench.errors import WorkbenchInputError
+from workbench.limit_cycle import LimitCycle, detect_limit_cycle
 from workbench.metrics import METRIC_KEYS
 from workbench.result import SimulationResult
 from workbench.scenarios import Scenario, ScenarioOptions, make_scenario
@@ -140,6 +141,11 @@ class Comparison:
             table["step_time_ratio"] = step_time_ratios(table, self.reference_controller)
             self._summary.append(table)
         return self._summary[0].copy()
+
+    def limit_cycles(self) -> list[LimitCycle]:
+        """Each run's steering limit cycle (`workbench.limit_cycle`; the summary's limit_cycle fields, plus when it
+        starts and how long it lasts), in the runs' order."""
+        return [detect_limit_cycle(r.trace["t_s"], r.trace["steer_wheel_rad"]) for r in self.results]
 
     def to_pandas(self) -> pd.DataFrame:
         """Every run's trace stacked, with `controller`, `vehicle` and `run` columns."""

@@ -12,6 +12,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
+from workbench.limit_cycle import detect_limit_cycle, oscillation
 from workbench.path import ReferencePath
 from workbench.speed_profile import G_MPS2
 
@@ -29,6 +30,10 @@ METRIC_KEYS: tuple[str, ...] = (
     "max_abs_steer_wheel_deg",
     "max_abs_steer_rate_deg_s",
     "rms_steer_rate_deg_s",
+    "steer_oscillation_deg",
+    "limit_cycle",
+    "limit_cycle_hz",
+    "limit_cycle_amplitude_deg",
     "max_abs_lat_accel_g",
     "max_ltr",
     "max_offtracking_m",
@@ -44,8 +49,11 @@ class Metrics:
     distance_m: distance travelled by the reference point; path_length_m: the length the run was asked to cover
     (the path, times the laps of a closed path); max_abs_steer_rate_deg_s, rms_steer_rate_deg_s: the largest and the
     RMS steering-wheel rate (the steering effort), from the measured steering-wheel angle differenced at the
-    controller rate; max_offtracking_m: the largest lateral distance of the trailer's rear-axle
-    centre from the path.
+    controller rate; steer_oscillation_deg: the RMS of the measured steering-wheel angle about its centred 1 s moving
+    average, away from the trace's ends (`workbench.limit_cycle.oscillation`; None for a trace under about 2 s);
+    limit_cycle, limit_cycle_hz, limit_cycle_amplitude_deg: whether the steering wheel limit-cycles, at what
+    frequency and steering-wheel amplitude (`workbench.limit_cycle.detect_limit_cycle`; None when it does not);
+    max_offtracking_m: the largest lateral distance of the trailer's rear-axle centre from the path.
     """
 
     scenario: str
@@ -60,6 +68,10 @@ class Metrics:
     max_abs_steer_wheel_deg: float | None
     max_abs_steer_rate_deg_s: float | None
     rms_steer_rate_deg_s: float | None
+    steer_oscillation_deg: float | None
+    limit_cycle: bool
+    limit_cycle_hz: float | None
+    limit_cycle_amplitude_deg: float | None
     max_abs_lat_accel_g: float | None
     max_ltr: float | None
     max_offtracking_m: float | None
@@ -100,6 +112,8 @@ def compute_metrics(
     step_us = trace["step_time_s"] * 1e6
     distance = float(np.trapezoid(trace["speed_mps"], t)) if n > 1 else 0.0
     steer_rate = np.diff(steer) / np.diff(t) if n > 1 else None
+    deviation = oscillation(t, steer)
+    cycle = detect_limit_cycle(t, steer)
     off = None
     if "trailer_x_m" in trace and n:
         off = offtracking(path, trace["trailer_x_m"], trace["trailer_y_m"])
@@ -116,6 +130,10 @@ def compute_metrics(
         max_abs_steer_wheel_deg=_max_abs(steer, 180.0 / math.pi),
         max_abs_steer_rate_deg_s=_max_abs(steer_rate, 180.0 / math.pi),
         rms_steer_rate_deg_s=float(math.degrees(math.sqrt(np.mean(steer_rate**2)))) if steer_rate is not None else None,
+        steer_oscillation_deg=math.degrees(math.sqrt(np.mean(deviation[1] ** 2))) if deviation is not None else None,
+        limit_cycle=cycle.detected,
+        limit_cycle_hz=cycle.frequency_hz,
+        limit_cycle_amplitude_deg=cycle.amplitude_deg,
         max_abs_lat_accel_g=_max_abs(trace["lat_accel_mps2"], 1.0 / G_MPS2),
         max_ltr=_max_abs(trace.get("ltr")),
         max_offtracking_m=_max_abs(off),

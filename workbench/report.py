@@ -2,8 +2,9 @@
 it can be mailed, archived and read offline.
 
 A report has sections; each shows one `Comparison`: a short text, its summary table (one row per controller and
-plant) and its four figures (Figures 17a/b and 18a/b of the paper: trajectories, CTE against distance, speed
-against distance, steering against time).
+plant), a line naming each run whose steering limit-cycles (`workbench.limit_cycle`: frequency, steering-wheel
+amplitude, duration, start) and its four figures (Figures 17a/b and 18a/b of the paper: trajectories, CTE against
+distance, speed against distance, steering against time).
 """
 
 from __future__ import annotations
@@ -20,6 +21,7 @@ from pathlib import Path
 import pandas as pd
 
 from workbench.comparison import FIGURES, Comparison
+from workbench.limit_cycle import LimitCycle
 
 #: Summary columns shown in the report, with their headings (the CSV keeps every column).
 TABLE_COLUMNS: tuple[tuple[str, str], ...] = (
@@ -31,6 +33,9 @@ TABLE_COLUMNS: tuple[tuple[str, str], ...] = (
     ("converge_distance_m", "converged within 0.1 m after (m)"),
     ("max_abs_steer_wheel_deg", "max |steering wheel| (deg)"),
     ("max_abs_steer_rate_deg_s", "max |steering rate| (deg/s)"),
+    ("rms_steer_rate_deg_s", "RMS steering rate (deg/s)"),
+    ("steer_oscillation_deg", "steering oscillation (deg)"),
+    ("limit_cycle", "limit cycle"),
     ("max_abs_lat_accel_g", "max |lateral accel.| (g)"),
     ("max_ltr", "max LTR"),
     ("max_offtracking_m", "max off-tracking (m)"),
@@ -45,7 +50,7 @@ table { border-collapse: collapse; margin: 1em 0; font-size: 0.9em; }
 th, td { border: 1px solid #bbb; padding: 0.3em 0.6em; text-align: right; }
 th { background: #eee; } td:nth-child(-n+3) { text-align: left; }
 figure { display: inline-block; margin: 0.5em; } img { max-width: 34em; }
-.failed { color: #b00; }
+.failed, .warning { color: #b00; }
 """
 
 
@@ -66,12 +71,13 @@ def _cell(value: object) -> str:
     return html.escape(str(value))
 
 
-def _table(summary: pd.DataFrame) -> str:
+def _table(summary: pd.DataFrame, cycles: Sequence[LimitCycle]) -> str:
     head = "".join(f"<th>{html.escape(title)}</th>" for _, title in TABLE_COLUMNS)
     rows = []
-    for _, row in summary.iterrows():
+    for (_, row), cycle in zip(summary.iterrows(), cycles, strict=True):
         cls = "" if row["status"] == "completed" else ' class="failed"'
-        cells = "".join(f"<td>{_cell(row.get(key))}</td>" for key, _ in TABLE_COLUMNS)
+        values = {key: row.get(key) for key, _ in TABLE_COLUMNS} | {"limit_cycle": cycle.brief()}
+        cells = "".join(f"<td>{_cell(value)}</td>" for value in values.values())
         rows.append(f"<tr{cls}>{cells}</tr>")
     failed = summary[summary["status"] != "completed"]
     notes = "".join(
@@ -112,7 +118,14 @@ def render_report(title: str, sections: Sequence[ReportSection], intro: str = ""
             f"speed {cfg.speed_kmh:g} km/h, lateral-acceleration bound {cfg.max_lateral_accel_g:g} g, controllers "
             f"at {cfg.controller_rate_hz:g} Hz, plant at {cfg.plant_rate_hz:g} Hz.</p>"
         )
-        parts.append(_table(c.summary()))
+        cycles = c.limit_cycles()
+        parts.append(_table(c.summary(), cycles))
+        parts += [
+            f"<p class='warning'>Limit cycle: {html.escape(spec.label)} oscillates at {html.escape(cycle.describe())}"
+            ".</p>"
+            for spec, cycle in zip(c.specs, cycles, strict=True)
+            if cycle.detected
+        ]
         for name, method in FIGURES:
             alt = html.escape(f"{section.heading}: {name.removesuffix('.png').replace('_', ' ')}")
             parts.append(

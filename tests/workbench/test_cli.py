@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -164,6 +165,24 @@ def test_compare_writes_report_summary_and_runs(tmp_path: Path, capsys) -> None:
     for row in summary.itertuples():
         metrics = json.loads((out / "runs" / f"{row.controller}-{row.vehicle}" / "metrics.json").read_text())
         assert metrics["max_abs_cte_m"] == pytest.approx(row.max_abs_cte_m)
+
+
+def test_run_and_compare_warn_of_a_steering_limit_cycle(tmp_path: Path, capsys) -> None:
+    # Stanley at 8/s weaves on the loaded truck (tests/workbench/test_metrics.py)
+    args = ["run", "dlc", "--controller", "stanley", "--vehicle", "tractor-semitrailer", "--no-plots"]
+    assert main([*args, "--set", "gain_per_s=8", "--out", str(tmp_path / "run")]) == 0
+    out = capsys.readouterr().out
+    assert re.search(r"steering oscillation \d+\.\d+ deg \(RMS about its 1 s average\), RMS steering rate", out)
+    assert re.search(
+        r"\n  WARNING: steering limit cycle at 0\.\d\d Hz, ±\d+° steering wheel for \d+\.\d s from t = ", out
+    )
+    config = tmp_path / "stanley.toml"
+    config.write_text("[stanley]\ngain_per_s = 8.0\n")
+    args = ["compare", "dlc", "--controllers", "stanley", "--vehicle", "tractor-semitrailer"]
+    assert main([*args, "--controller-config", str(config), "--out", str(tmp_path / "cmp")]) == 0
+    out = capsys.readouterr().out
+    assert "steer_oscillation_deg" in out
+    assert "  WARNING: steering limit cycle: stanley on tractor-semitrailer at 0." in out
 
 
 @pytest.mark.parametrize(

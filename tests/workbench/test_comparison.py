@@ -96,6 +96,23 @@ def test_report_is_valid_html_with_its_images_embedded(comparison, tmp_path: Pat
     assert len(re.findall(r"<tr", text)) == 1 + len(RUNS)
 
 
+def test_the_report_says_which_run_limit_cycles() -> None:
+    # Stanley at 8/s weaves on the loaded truck (tests/workbench/test_metrics.py); at its default it does not
+    runs = (RunSpec("stanley", "tractor-semitrailer"), RunSpec("stanley", "tractor-semitrailer", ("gain_per_s=8",)))
+    weaving = compare("dlc", runs)
+    quiet_cycle, cycle = weaving.limit_cycles()
+    assert not quiet_cycle.detected and cycle.detected and cycle.duration_s >= 3.0
+    table = weaving.summary()
+    assert list(table["limit_cycle"]) == [False, True] and table["limit_cycle_hz"].iloc[1] == cycle.frequency_hz
+    html = render_report("t", [ReportSection("s", "", weaving)])
+    for heading in ("RMS steering rate (deg/s)", "steering oscillation (deg)", "limit cycle"):
+        assert f"<th>{heading}</th>" in html
+    assert "<td>no</td>" in html and f"<td>{cycle.brief()}</td>" in html
+    line = f"Limit cycle: stanley (gain_per_s=8) on tractor-semitrailer oscillates at {cycle.describe()}."
+    assert line in html and html.count("Limit cycle:") == 1
+    assert re.search(r"at 0\.\d\d Hz, ±\d+° steering wheel for \d+\.\d s from t = \d+\.\d s\.", line)
+
+
 def test_a_failed_run_keeps_its_row_and_says_why() -> None:
     # fig17 starts 1 m off the path: a 0.5 m leave-the-path bound stops every run at once
     failing = compare("fig17", RUNS[:1], SimulationConfig(max_abs_cte_m=0.5))

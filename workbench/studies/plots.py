@@ -17,6 +17,9 @@ LABELS = {
     "max_abs_cte_m": "max |CTE| (m)",
     "rms_steer_rate_deg_s": "RMS steering-wheel rate (deg/s)",
     "max_abs_steer_rate_deg_s": "max |steering-wheel rate| (deg/s)",
+    "steer_oscillation_deg": "steering-wheel oscillation, RMS about its 1 s average (deg)",
+    "limit_cycle_hz": "steering limit cycle (Hz)",
+    "limit_cycle_amplitude_deg": "steering limit cycle, steering-wheel amplitude (deg)",
     "speed_kmh": "speed (km/h)",
 }
 

@@ -56,10 +56,13 @@ class SweepResult:
         return {str(k): int(v) for k, v in self.table["status"].value_counts(sort=False).items()}
 
     def summary(self) -> pd.DataFrame:
-        """Per scenario, vehicle and controller: runs, completed, errors, and the median and worst RMS and max
-        |CTE| and RMS steering rate over the completed runs."""
+        """Per scenario, vehicle and controller: runs, completed, errors, and over the completed runs the median
+        RMS CTE, the worst max |CTE|, the median RMS steering rate and steering oscillation, and how many
+        limit-cycle (`workbench.limit_cycle`)."""
         table = self.table.assign(
-            is_completed=self.table["status"] == "completed", is_error=self.table["status"] == "error"
+            is_completed=self.table["status"] == "completed",
+            is_error=self.table["status"] == "error",
+            has_limit_cycle=self.table["limit_cycle"].eq(True),
         )
         done = table[table["is_completed"]]
         keys = ["scenario", "vehicle", "controller"]
@@ -70,6 +73,8 @@ class SweepResult:
             median_rms_cte_m=("rms_cte_m", "median"),
             worst_max_abs_cte_m=("max_abs_cte_m", "max"),
             median_rms_steer_rate_deg_s=("rms_steer_rate_deg_s", "median"),
+            median_steer_oscillation_deg=("steer_oscillation_deg", "median"),
+            limit_cycles=("has_limit_cycle", "sum"),
         )
         return counts.join(stats).reset_index()
 

@@ -78,11 +78,14 @@ RUN_PARAMETERS: dict[str, Any] = {
 }
 #: Factors on a lead filter's zero and pole frequencies, parameters of controllers that read one (`filter_file`).
 LEAD_FILTER_SCALES = ("lead_filter_zero_scale", "lead_filter_pole_scale")
-#: Metrics an objective may weigh: the numeric metrics.json fields except the wall-clock step times.
+#: Metrics an objective may weigh: the numeric metrics.json fields except the wall-clock step times and the limit
+#: cycle's frequency and amplitude (null for a run without one, which would fail the trial). limit_cycle counts as
+#: 1 or 0 (a penalty on runs that limit-cycle).
 OBJECTIVE_METRICS = tuple(
     k
     for k in METRIC_KEYS
     if k not in ("scenario", "controller", "vehicle", "completed", "step_time_median_us", "step_time_p99_us")
+    and k not in ("limit_cycle_hz", "limit_cycle_amplitude_deg")
 )
 AGGREGATES = ("mean", "max")
 STUDY_KEYS = (
@@ -325,7 +328,8 @@ class OptimiseSettings:
             if key not in OBJECTIVE_METRICS:
                 raise WorkbenchInputError(
                     f"unknown metric optimise.objective.{key}; allowed: {', '.join(OBJECTIVE_METRICS)} (the wall-clock "
-                    "step times are not: they differ between runs and machines)"
+                    "step times are not: they differ between runs and machines; nor limit_cycle_hz and "
+                    "limit_cycle_amplitude_deg: null for a run without a limit cycle; weigh limit_cycle)"
                 )
             weights[key] = typed_value(f"optimise.objective.{key}", weight, float, Path())
         if not any(weights.values()):

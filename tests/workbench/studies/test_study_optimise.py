@@ -55,6 +55,8 @@ def test_trial_value() -> None:
     assert trial_value(rows, {"rms_cte_m": 2.0}, "max") == (pytest.approx(0.6), "")
     value, reason = trial_value(rows, {"max_ltr": 1.0}, "mean")
     assert value is None and "metric max_ltr is None for run a" in reason
+    rows[0]["limit_cycle"], rows[1]["limit_cycle"] = True, False  # a penalty of 1 per run that limit-cycles
+    assert trial_value(rows, {"rms_cte_m": 1.0, "limit_cycle": 0.5}, "mean") == (pytest.approx(0.45), "")
     rows[1] |= {"status": "left_path", "message": "|CTE| = 31 m exceeds max_abs_cte_m"}
     value, reason = trial_value(rows, {"rms_cte_m": 1.0}, "mean")
     assert (

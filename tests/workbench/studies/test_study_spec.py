@@ -167,6 +167,7 @@ OPT = (
         (OPT.replace("trials = 4", "trails = 4"), ["unknown key(s) optimise.trails", "allowed: trials"]),
         (OPT.replace("rms_cte_m = 1.0", "rms_cte = 1.0"), ["unknown metric optimise.objective.rms_cte", "rms_cte_m"]),
         (OPT.replace("rms_cte_m = 1.0", "step_time_median_us = 1.0"), ["step times are not"]),
+        (OPT.replace("rms_cte_m = 1.0", "limit_cycle_hz = 1.0"), ["null for a run without a limit cycle"]),
         (OPT.replace("rms_cte_m = 1.0", "rms_cte_m = 0.0"), ["a weight other than 0"]),
         (OPT.replace("log_uniform = [0.01, 0.5]", "normal = [0.1, 0.01]"), ["bounded distribution"]),
         (OPT.replace("frechet_threshold_m =", "frechet_m ="), ["unknown parameter optimise.search.frechet_m"]),

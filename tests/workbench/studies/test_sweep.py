@@ -46,6 +46,9 @@ def test_the_results_table_has_a_row_per_run_with_real_values(local_sweep: tuple
             assert row["rms_cte_m"] == direct["rms_cte_m"] and row["max_abs_cte_m"] == direct["max_abs_cte_m"]
             assert 0.0 < row["max_abs_cte_m"] < 0.5
     assert table.loc[table["controller"] == "pure-pursuit", "clothoid.min_lookahead_m"].isna().all()
+    done = table[table["status"] == "completed"]
+    assert (done["steer_oscillation_deg"] > 0).all() and done["limit_cycle"].eq(False).all()
+    assert table["limit_cycle_hz"].isna().all() and table["limit_cycle_amplitude_deg"].isna().all()
 
 
 def test_a_failing_run_is_recorded_with_its_error(local_sweep: tuple[Path, SweepResult]) -> None:
@@ -58,6 +61,7 @@ def test_a_failing_run_is_recorded_with_its_error(local_sweep: tuple[Path, Sweep
     assert result.status_counts() == {"completed": 4, "error": 2}
     summary = result.summary().set_index("controller")
     assert summary.loc["clothoid", "errors"] == 2 and summary.loc["pure-pursuit", "completed"] == 2
+    assert (summary["limit_cycles"] == 0).all() and (summary["median_steer_oscillation_deg"] > 0).all()
 
 
 def test_dask_gives_the_local_results_bit_for_bit(local_sweep: tuple[Path, SweepResult], tmp_path: Path) -> None:
