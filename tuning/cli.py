@@ -4,7 +4,11 @@
     tuning fit-lag          fit the lag of Eq. 5 to vehicle logs, write lag.json (steering-lag/1)
     tuning design-lead      design the lead filter of Eq. 6 for a lag, write lead.json/.toml (lead-filter/1)
     tuning rollover-limits  step-steer series: curvature at LTR = 1 per speed, write limits.csv
+    tuning steering-limits  steering lock, lateral acceleration and steering rate per speed (vehicles without a
+                            roll model), write limits.csv
     tuning schedule         lag and lead filter at each speed, write a scheduled lead-filter file
+    tuning margins          the clothoid loop's margins against lookahead per speed and the lookahead floor,
+                            write margins.csv
 
 Exit codes: 0 done; 2 bad input (one line on stderr naming the value and what is allowed).
 """
@@ -17,6 +21,7 @@ import sys
 from collections.abc import Sequence
 from pathlib import Path
 
+from controllers.clothoid.curvature_limits import DEFAULT_LIMIT_LATERAL_ACCEL_G
 from controllers.clothoid.filter_file import write_filter_file
 from tuning.data_generation import generate_open_loop_log
 from tuning.lag_fit import CURVATURE_SOURCES, LagFitOptions, SteeringGeometry, fit_lag
@@ -25,7 +30,10 @@ from tuning.log_file import read_log
 from tuning.maneuvers import Maneuver
 from tuning.rollover import rollover_limits, table, to_curvature_limits
 from tuning.schedule import (
+    DEFAULT_CONTROLLER_RATE_HZ,
     DEFAULT_LAT_ACCEL_G,
+    DEFAULT_PREDICTION_TIME_S,
+    DESIGNS,
     PAPER_SPEED_KMH,
     compare_closed_loop,
     fixed_and_scheduled_filters,
@@ -34,6 +42,9 @@ from tuning.schedule import (
     steer_amplitude_deg,
 )
 from tuning.speeds import parse_speeds
+from tuning.steering_limits import steering_limits
+from tuning.steering_limits import table as steering_table
+from tuning.steering_limits import to_curvature_limits as steering_curvature_limits
 from workbench.errors import WorkbenchInputError
 from workbench.vehicles import make_vehicle
 from workbench.vehicles.base import VehicleModel
@@ -93,6 +104,18 @@ def _parser() -> argparse.ArgumentParser:
         "--lat-accel-g", type=float, help="size the amplitude for this kinematic lateral acceleration (g) instead"
     )
     gen.add_argument("--duration-s", type=float, default=20.0, help="log length (default 20 s)")
+    gen.add_argument(
+        "--chirp-hz",
+        default="0.1:2",
+        metavar="LOW:HIGH",
+        help="frequency band of --maneuver chirp, swept exponentially over the log (default 0.1:2 Hz)",
+    )
+    gen.add_argument(
+        "--max-rate-deg-s",
+        type=float,
+        help="limit the steering-wheel rate of the profile (deg/s; steps become ramps, the chirp's amplitude falls "
+        "at high frequency; default: no limit)",
+    )
     gen.add_argument("--sample-rate-hz", type=float, default=100.0, help="log sample rate (default 100 Hz)")
     gen.add_argument("--out", type=Path, required=True, metavar="FILE.csv", help="output CSV")
 
@@ -140,11 +163,57 @@ def _parser() -> argparse.ArgumentParser:
     roll.add_argument("--out", type=Path, required=True, metavar="limits.csv", help="output curvature-limits CSV")
     roll.add_argument("--plot", type=Path, metavar="FILE.png", help="Figure 6")
 
+    steer = sub.add_parser(
+        "steering-limits",
+        help="curvature limits of a vehicle without a roll model: steering lock, lateral acceleration, steering "
+        "rate; write limits.csv",
+    )
+    _vehicle_options(steer)
+    steer.add_argument("--speeds", required=True, metavar="10,20,...,150", help="speeds, km/h")
+    steer.add_argument(
+        "--lat-accel-g",
+        type=float,
+        default=DEFAULT_LIMIT_LATERAL_ACCEL_G,
+        help=f"lateral-acceleration bound (default {DEFAULT_LIMIT_LATERAL_ACCEL_G:g} g, the controller's default)",
+    )
+    steer.add_argument("--out", type=Path, required=True, metavar="limits.csv", help="output curvature-limits CSV")
+
     sched = sub.add_parser("schedule", help="lag and lead filter at each speed; write a scheduled lead-filter file")
     _vehicle_options(sched)
     sched.add_argument("--speeds", required=True, metavar="20,30,...,90", help="speeds, km/h")
     sched.add_argument("--out", type=Path, required=True, metavar="schedule.json", help="output lead-filter file")
     _format_option(sched)
+    sched.add_argument(
+        "--delay",
+        action="store_true",
+        help="fit the lag of Eq. 5 with a pure delay at each speed (as fit-lag --delay); per_speed records delay_s",
+    )
+    sched.add_argument(
+        "--design",
+        choices=DESIGNS,
+        default="cancel",
+        help="the lead filter at each speed: cancel (default; zeros on the path lag's poles, design-lead's) or margins "
+        "(the shortest lookahead floor of the clothoid loop with 45 deg / 6 dB margins, from the path and the "
+        "measured lag; records lookahead_floor_m and floor_without_lead_m per speed; a few s a speed)",
+    )
+    sched.add_argument(
+        "--controller-rate-hz",
+        type=float,
+        default=DEFAULT_CONTROLLER_RATE_HZ,
+        help=f"the clothoid controller's rate for --design margins (default {DEFAULT_CONTROLLER_RATE_HZ:g} Hz)",
+    )
+    sched.add_argument(
+        "--prediction-time-s",
+        type=float,
+        default=DEFAULT_PREDICTION_TIME_S,
+        help=f"its pose prediction for --design margins (default {DEFAULT_PREDICTION_TIME_S:g} s)",
+    )
+    sched.add_argument(
+        "--drop-refused",
+        action="store_true",
+        help="leave out a speed whose lag fit or lead design is refused (saying why, on stderr and in the file's "
+        "design.dropped_speeds) instead of refusing the schedule",
+    )
     sched.add_argument(
         "--lat-accel-g",
         type=float,
@@ -167,6 +236,7 @@ def _parser() -> argparse.ArgumentParser:
         "filter of --nominal-speed and no filter, and print the tracking and whether the schedule tracks better",
     )
     sched.add_argument("--compare-scenario", default="dlc", help="scenario of --compare (default dlc)")
+    _add_margins_parser(sub)
     return parser
 
 
@@ -219,7 +289,15 @@ def _generate_data(args: argparse.Namespace) -> int:
         if not args.speed > 0:
             raise WorkbenchInputError(f"speed_kmh must be > 0; got {args.speed!r}")
         amplitude = steer_amplitude_deg(vehicle, args.speed, args.lat_accel_g)
-    maneuver = Maneuver(args.maneuver, amplitude_deg=amplitude, duration_s=args.duration_s)
+    low, high = _band(args.chirp_hz)
+    maneuver = Maneuver(
+        args.maneuver,
+        amplitude_deg=amplitude,
+        duration_s=args.duration_s,
+        start_hz=low,
+        end_hz=high,
+        max_rate_deg_s=args.max_rate_deg_s,
+    )
     log = generate_open_loop_log(vehicle, maneuver, args.speed, sample_rate_hz=args.sample_rate_hz)
     _prepare(args.out)
     log.to_csv(args.out, index=False, float_format="%.9g")
@@ -228,6 +306,16 @@ def _generate_data(args: argparse.Namespace) -> int:
         f"{args.speed:g} km/h) to {args.out}"
     )
     return 0
+
+
+def _band(text: str) -> tuple[float, float]:
+    """--chirp-hz LOW:HIGH as two numbers (Hz)."""
+    parts = text.split(":")
+    try:
+        low, high = (float(p) for p in parts)
+    except ValueError:
+        raise WorkbenchInputError(f"--chirp-hz {text!r}: give LOW:HIGH in Hz, e.g. 0.1:2") from None
+    return low, high
 
 
 def _fit_lag(args: argparse.Namespace) -> int:
@@ -311,17 +399,19 @@ def _rollover_limits(args: argparse.Namespace) -> int:
     return 0
 
 
+def _steering_limits(args: argparse.Namespace) -> int:
+    vehicle = _vehicle(args)
+    limits = steering_limits(vehicle.geometry, parse_speeds(args.speeds), args.lat_accel_g)
+    steering_curvature_limits(limits, vehicle.name, args.lat_accel_g).write_csv(_prepare(args.out))
+    print(steering_table(limits))
+    print(f"wrote {args.out}")
+    return 0
+
+
 def _schedule(args: argparse.Namespace) -> int:
     out = _filter_path(args)
     vehicle = _vehicle(args)
     speeds = parse_speeds(args.speeds)
-    result = identify_schedule(
-        vehicle,
-        speeds,
-        lat_accel_g=args.lat_accel_g,
-        max_lead_gain=args.max_lead_gain,
-        max_cascade_peak_db=args.max_cascade_peak_db,
-    )
     compare_speeds = parse_speeds(args.compare) if args.compare else None
     nominal = args.nominal_speed
     if compare_speeds and nominal is None and PAPER_SPEED_KMH in speeds:
@@ -331,6 +421,21 @@ def _schedule(args: argparse.Namespace) -> int:
             f"--compare needs --nominal-speed, one of the --speeds {speeds}, for the fixed filter to compare with "
             f"(default {PAPER_SPEED_KMH:g} km/h, the paper's, when it is one of them)"
         )
+    result = identify_schedule(
+        vehicle,
+        speeds,
+        lat_accel_g=args.lat_accel_g,
+        fit_options=LagFitOptions(fit_delay=args.delay),
+        max_lead_gain=args.max_lead_gain,
+        max_cascade_peak_db=args.max_cascade_peak_db,
+        drop_refused=args.drop_refused,
+        progress=lambda line: print(f"tuning schedule: {line}", file=sys.stderr, flush=True),
+        design=args.design,
+        controller_rate_hz=args.controller_rate_hz,
+        prediction_time_s=args.prediction_time_s,
+    )
+    if compare_speeds and nominal not in result.speeds_kmh:
+        raise WorkbenchInputError(f"--compare: the nominal speed {nominal:g} km/h was dropped from the schedule")
     result.write(_prepare(out), nominal_speed_kmh=nominal)
     print(result.table())
     print(f"wrote {out}")
@@ -356,12 +461,186 @@ def _schedule(args: argparse.Namespace) -> int:
     return 0
 
 
+def _add_margins_parser(sub: argparse._SubParsersAction) -> None:
+    from controllers.clothoid.loop_analysis import REQUIRED_GAIN_MARGIN_DB, REQUIRED_PHASE_MARGIN_DEG
+
+    marg = sub.add_parser(
+        "margins",
+        help="the clothoid loop's phase and gain margins against lookahead per speed, and the lookahead floor; "
+        "write a table (CSV) and a plot",
+    )
+    marg.add_argument(
+        "--lag", type=Path, metavar="lag.json", help="path-curvature lag (fit-lag; default: the vehicle's)"
+    )
+    marg.add_argument(
+        "--measured-lag",
+        type=Path,
+        metavar="yawlag.json",
+        help="lag to the measured (yaw-rate) curvature (fit-lag --curvature-from yaw-rate; default: the vehicle's "
+        "with --vehicle alone, else the path lag)",
+    )
+    lead = marg.add_mutually_exclusive_group()
+    lead.add_argument(
+        "--lead",
+        type=Path,
+        metavar="lead.json|lead.toml",
+        help="lead filter (design-lead or schedule; default: the vehicle's with --vehicle alone, else none)",
+    )
+    lead.add_argument("--no-lead", action="store_true", help="analyse the loop without a lead filter")
+    _vehicle_options(marg)
+    marg.add_argument("--speeds", required=True, metavar="20,30,...,90", help="speeds, km/h")
+    marg.add_argument(
+        "--lookahead", default="3:40:0.5", metavar="LOW:HIGH:STEP", help="lookaheads, m (default 3:40:0.5)"
+    )
+    marg.add_argument("--out", type=Path, required=True, metavar="margins.csv", help="output table (CSV)")
+    marg.add_argument("--plot", type=Path, metavar="FILE.png", help="margins against lookahead per speed")
+    marg.add_argument("--prediction-time-s", type=float, default=0.2, help="pose prediction (default 0.2 s)")
+    marg.add_argument("--controller-rate-hz", type=float, default=50.0, help="controller rate (default 50 Hz)")
+    marg.add_argument(
+        "--measurement-delay-s", type=float, default=0.0, help="extra delay of the measurements (default 0 s)"
+    )
+    marg.add_argument(
+        "--arc-lateral-accel-g",
+        type=float,
+        default=0.4,
+        help="also analyse about an arc of this lateral acceleration at each speed, capped at the curvature limit "
+        "(default 0.4 g, the controller's; 0: the straight only)",
+    )
+    marg.add_argument(
+        "--phase-margin-deg",
+        type=float,
+        default=REQUIRED_PHASE_MARGIN_DEG,
+        help=f"required phase margin (default {REQUIRED_PHASE_MARGIN_DEG:g} deg)",
+    )
+    marg.add_argument(
+        "--gain-margin-db",
+        type=float,
+        default=REQUIRED_GAIN_MARGIN_DB,
+        help=f"required gain margin, both ways (default {REQUIRED_GAIN_MARGIN_DB:g} dB)",
+    )
+
+
+def _margin_lookaheads(text: str) -> tuple[float, ...]:
+    from tuning.margins import lookahead_grid
+
+    parts = text.split(":")
+    usage = "give LOW:HIGH:STEP in m, e.g. 3:40:0.5"
+    if len(parts) != 3:
+        raise WorkbenchInputError(f"--lookahead {text!r}: {usage}")
+    try:
+        low, high, step = (float(p) for p in parts)
+    except ValueError:
+        raise WorkbenchInputError(f"--lookahead {text!r}: not numbers; {usage}") from None
+    try:
+        return lookahead_grid(low, high, step)
+    except WorkbenchInputError as exc:
+        raise WorkbenchInputError(f"--lookahead {text!r}: {exc}") from None
+
+
+def _margins(args: argparse.Namespace) -> int:
+    from controllers.clothoid.filter_file import read_filter_file
+    from controllers.clothoid.loop_analysis import PlantLags
+    from tuning.margins import MarginStudy, run_margins
+    from workbench.errors import require_in_range
+
+    for flag, value, low, high, unit in (
+        ("--prediction-time-s", args.prediction_time_s, 0.0, 2.0, "s"),
+        ("--controller-rate-hz", args.controller_rate_hz, 1.0, 1000.0, "Hz"),
+        ("--measurement-delay-s", args.measurement_delay_s, 0.0, 2.0, "s"),
+        ("--arc-lateral-accel-g", args.arc_lateral_accel_g, 0.0, 2.0, "g"),
+        ("--phase-margin-deg", args.phase_margin_deg, 0.0, 180.0, "deg"),
+        ("--gain-margin-db", args.gain_margin_db, 0.0, 60.0, "dB"),
+    ):
+        require_in_range(flag, value, low, high, unit)
+    try:
+        speeds = parse_speeds(args.speeds)
+    except WorkbenchInputError as exc:
+        raise WorkbenchInputError(f"--speeds {args.speeds!r}: {exc}") from None
+    lookaheads = _margin_lookaheads(args.lookahead)
+
+    def lag_file(flag: str, path: Path):
+        try:
+            return read_lag_file(path)
+        except OSError as exc:
+            raise WorkbenchInputError(f"{flag} {str(path)!r} cannot be read: {exc}") from None
+
+    vehicle = _vehicle(args) if args.vehicle is not None or args.vehicle_file is not None else None
+    limits = None
+    if args.lag is None:
+        if vehicle is None:
+            raise WorkbenchInputError(
+                "give --lag lag.json (and optionally --measured-lag, --lead), or --vehicle NAME / --vehicle-file F "
+                "for the lags and lead filter of the vehicle's own tuning"
+            )
+        from controllers.clothoid.vehicle_tuning import tuning_for
+
+        tuning = tuning_for(vehicle)
+        path_at, measured_at = tuning.lag_at, getattr(tuning, "measured_lag_at", None)
+        lead, limits = tuning.filter_schedule, tuning.limits
+        source = f"the tuning of {vehicle.name}: {tuning.source}"
+    else:
+        path_lag = lag_file("--lag", args.lag)
+
+        def path_at(_speed: float):
+            return path_lag
+
+        measured_at, lead, source = None, None, f"lag {args.lag}"
+    if args.measured_lag is not None:
+        measured_lag = lag_file("--measured-lag", args.measured_lag)
+
+        def measured_at(_speed: float):
+            return measured_lag
+
+        source += f", measured lag {args.measured_lag}"
+    if args.lead is not None:
+        lead = read_filter_file(args.lead)
+        source += f", lead filter {args.lead}"
+    elif args.no_lead:
+        lead = None
+    if lead is None:
+        source += ", no lead filter"
+
+    def lags_at(speed: float) -> PlantLags:
+        return PlantLags(path_at(speed), measured_at(speed) if measured_at is not None else None)
+
+    study = MarginStudy(
+        lags_at,
+        lead,
+        tuple(speeds),
+        lookaheads,
+        path_curvatures_1pm=(0.0,),
+        sample_time_s=1.0 / args.controller_rate_hz,
+        prediction_time_s=args.prediction_time_s,
+        measurement_delay_s=args.measurement_delay_s,
+        phase_margin_deg=args.phase_margin_deg,
+        gain_margin_db=args.gain_margin_db,
+        geometry=vehicle.geometry if vehicle is not None else None,
+        arc_lateral_accel_g=args.arc_lateral_accel_g,
+        limits=limits,
+    )
+    result = run_margins(study)
+    try:
+        result.table.to_csv(_prepare(args.out), index=False, float_format="%.9g")
+    except OSError as exc:
+        raise WorkbenchInputError(f"cannot write --out {str(args.out)!r}: {exc}") from None
+    print(f"clothoid loop margins ({source}; {args.controller_rate_hz:g} Hz, prediction {args.prediction_time_s:g} s)")
+    print(result.summary())
+    print(f"wrote {args.out} ({len(result.table)} rows)")
+    if args.plot:
+        from tuning.plots import margins_figure
+
+        print(f"wrote {margins_figure(result, args.plot)}")
+    return 0
+
+
 COMMANDS = {
     "generate-data": _generate_data,
     "fit-lag": _fit_lag,
     "design-lead": _design_lead,
     "rollover-limits": _rollover_limits,
+    "steering-limits": _steering_limits,
     "schedule": _schedule,
+    "margins": _margins,
 }
 
 

@@ -28,7 +28,10 @@ def generate_open_loop_log(
     sample_rate_hz: float = 100.0,
     plant_rate_hz: float = 1000.0,
 ) -> pd.DataFrame:
-    """Simulate the maneuver at a held speed (PI speed control) and return the log, one row per sample."""
+    """Simulate the maneuver at a held speed (PI speed control) and return the log, one row per sample. The plant
+    is driven at plant_rate_hz with the profile at each plant step's midpoint, so that the steering between two
+    log samples is the profile's, as a real steering wheel's is (not held from one sample to the next, which would
+    delay the logged steering by half a sample: the fit interpolates the logged steering linearly)."""
     require_in_range("speed_kmh", speed_kmh, 1e-3, 400.0, "km/h (must be > 0)")
     require_in_range("sample_rate_hz", sample_rate_hz, 1.0, 10_000.0, "Hz")
     substeps = max(1, round(plant_rate_hz / sample_rate_hz))
@@ -36,6 +39,8 @@ def generate_open_loop_log(
     speed_ref = speed_kmh / 3.6
     t = np.arange(0.0, maneuver.duration_s + 0.5 * dt, dt)
     steer = maneuver.steer_wheel_rad(t)
+    h = dt / substeps
+    fine = maneuver.steer_wheel_rad(t[:, None] + h * (np.arange(substeps) + 0.5)[None, :])
     state = vehicle.initial_state(0.0, 0.0, 0.0, speed_ref)
     speed_control = PISpeedController()
     rows = np.empty((t.size, len(LOG_COLUMNS)))
@@ -45,5 +50,6 @@ def generate_open_loop_log(
         speed = math.hypot(vx, vy)
         rows[k] = (tk, math.degrees(sw), speed, x, y, yaw, yaw_rate)
         accel = speed_control.step(speed_ref, speed, dt)
-        state = vehicle.advance(state, float(sw), accel, dt, substeps)
+        for sw_fine in fine[k].tolist():
+            state = vehicle.advance(state, sw_fine, accel, h, 1)
     return pd.DataFrame(rows, columns=list(LOG_COLUMNS))

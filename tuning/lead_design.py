@@ -61,13 +61,23 @@ including any identified delay (which no filter of this form compensates).
 
 from __future__ import annotations
 
+import itertools
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import control
 import numpy as np
 
 from controllers.clothoid.lead_filter import OMEGA_RANGE_RAD_S, POLE_RATIO_RANGE, PSI_MAX, LeadFilterParams
+from controllers.clothoid.loop_analysis import (
+    REQUIRED_GAIN_MARGIN_DB,
+    REQUIRED_PHASE_MARGIN_DEG,
+    LoopSettings,
+    Margins,
+    PlantLags,
+    lookahead_floor,
+    loop_margins,
+)
 from tuning.lag_fit import (
     LagFitOptions,
     SteeringGeometry,
@@ -90,6 +100,9 @@ TRACKING_ERROR = 1.0 - BANDWIDTH_GAIN
 _BISECTIONS = 40
 _OMEGA_DECADES = (-2.0, 3.5)  # frequency grid relative to wn
 _OMEGA_POINTS = 551
+#: |path curvature| x lookahead at or above which an arc is not analysed (no target on it that far ahead; as
+#: `lookahead_floor`).
+_MAX_CURVATURE_LOOKAHEAD = 1.8
 
 
 @dataclass(frozen=True)
@@ -145,6 +158,9 @@ class LeadDesign:
         criterion = (
             "zeros on the lag's poles (omega_z = omega_n, psi = zeta); the largest omega_p with peak |G_lead| <= "
             "max_lead_gain and peak |G_lead G_lag| <= max_cascade_peak_db"
+            if self.method == METHOD
+            else "the shortest lookahead floor of the clothoid loop (45 deg, 6 dB) among a grid of (omega_z, psi, "
+            "omega_p) with peak |G_lead| <= max_lead_gain and peak |G_lead G_lag| <= max_cascade_peak_db"
         )
         out: dict[str, object] = {
             "method": self.method,
@@ -282,9 +298,18 @@ def design_lead(
     if phase_frequency_rad_s is not None:
         require_in_range("phase_frequency_rad_s", phase_frequency_rad_s, 1e-3, 1e4, "rad/s")
     problem = _Problem(lag, max_lead_gain, max_cascade_peak_db)
-    wz, psi, wp = _cancelling_design(problem, lag)
-    params = LeadFilterParams(wz, psi, wp)
-    # Report with python-control, independently of the grid the search used.
+    params = LeadFilterParams(*_cancelling_design(problem, lag))
+    return _report(params, lag, max_lead_gain, max_cascade_peak_db, phase_frequency_rad_s)
+
+
+def _report(
+    params: LeadFilterParams,
+    lag: SteeringLag,
+    max_lead_gain: float,
+    max_cascade_peak_db: float,
+    phase_frequency_rad_s: float | None,
+) -> LeadDesign:
+    """A LeadDesign for these parameters, measured with python-control independently of any search grid."""
     plant = lag_transfer_function(lag)
     cascade = params.transfer_function() * plant
     plant_bw = float(control.bandwidth(plant))
@@ -352,3 +377,164 @@ def validate(design: LeadDesign, log: VehicleLog, geometry: VehicleGeometry | St
         nrmse_lagged=float(np.sqrt(np.mean((lagged - kin) ** 2)) / span),
         nrmse_compensated=float(np.sqrt(np.mean((compensated - kin) ** 2)) / span),
     )
+
+
+#: The candidate grid of the margins design: zero frequencies (rad/s, log-spaced 1-64 rad/s: the lags identified
+#: on the presets' vehicles reach from the truck's 4 rad/s to the cars' 80), zero dampings, pole / zero ratios.
+MARGINS_OMEGA_Z_RAD_S = tuple(float(w) for w in np.geomspace(1.0, 64.0, 13))
+MARGINS_PSI = (0.5, 0.7, 1.0, 1.4, 2.0)
+MARGINS_POLE_RATIOS = (1.5, 2.0, 3.0, 4.0, 6.0)
+#: The refinement about the grid's best: factors on omega_z, psi and the pole ratio, and how many rounds.
+_REFINE_FACTORS = (2**-0.25, 1.0, 2**0.25)
+_REFINE_ROUNDS = 2
+
+
+@dataclass(frozen=True)
+class MarginsDesign:
+    """The margins design (`design_lead_for_margins`): the chosen design, the lookahead floor it gives (m), the
+    floor without a lead filter (m; nan when no lookahead in the range keeps the margins without one), how many
+    candidates met the gain bound, and margin_score: when no candidate keeps the margins at any lookahead in the
+    range (floor_m nan), the chosen one's score at the longest lookahead (`margin_score`, under 1), else nan."""
+
+    design: LeadDesign
+    floor_m: float
+    floor_without_lead_m: float
+    candidates: int
+    margin_score: float = math.nan
+
+
+def margin_score(margins: Margins, phase_margin_deg: float, gain_margin_db: float) -> float:
+    """How well a loop meets the required margins: the least of phase margin / required, gain margin / required
+    and -(gain-reduction margin) / required (1: just met; -inf: unstable). The margins design ranks candidates by it
+    where none keeps the margins at any lookahead."""
+    if not margins.stable:
+        return -math.inf
+    ratios = [margins.phase_margin_deg / phase_margin_deg if phase_margin_deg > 0 else math.inf]
+    if gain_margin_db > 0:
+        ratios += [margins.gain_margin_db / gain_margin_db, -margins.gain_reduction_margin_db / gain_margin_db]
+    return min(ratios)
+
+
+def design_lead_for_margins(
+    lags: PlantLags,
+    speed_mps: float,
+    settings: LoopSettings,
+    min_lookahead_m: float = 3.0,
+    max_lookahead_m: float = 40.0,
+    lookahead_step_m: float = 0.5,
+    path_curvatures_1pm: tuple[float, ...] = (0.0,),
+    max_lead_gain: float = DEFAULT_MAX_LEAD_GAIN,
+    phase_margin_deg: float = REQUIRED_PHASE_MARGIN_DEG,
+    gain_margin_db: float = REQUIRED_GAIN_MARGIN_DB,
+) -> MarginsDesign:
+    """Eq. 6 chosen, among a grid of (omega_z, psi, omega_p) within the gain bound, for the shortest lookahead floor
+    of the clothoid controller's loop (`controllers/clothoid/loop_analysis.py`, `lookahead_floor`) at this speed:
+    loop shaping on the loop itself rather than on the lag alone. Cancelling the lag's poles (`design_lead`) is the
+    right shape for a lag without delay; with the delay `tuning fit-lag --delay` identifies (the loaded truck: 0.25 s
+    at 30 km/h), the lag's fitted poles are fast and cancelling them leaves the delay, which limits the loop,
+    untouched. Ties go to the smaller peak gain. Only the peak gain is bounded: the cancellation design's bound on
+    the cascade's resonance stands in for the loop's damping, which the margins measure here directly.
+
+    The search: the grid MARGINS_OMEGA_Z_RAD_S x MARGINS_PSI x MARGINS_POLE_RATIOS (those within max_lead_gain),
+    by increasing peak gain, then _REFINE_ROUNDS rounds about the best (omega_z, psi and the ratio each x
+    2^(+-1/4)). A candidate is first checked where it would have to keep the margins to win (the best floor so far,
+    or one step shorter if its peak gain is not smaller; 2 loop analyses, one per path curvature): if it misses them
+    there, its floor is longer and it is skipped; only the others get the full floor search. 1-5 s a speed.
+
+    Where no candidate keeps the margins at any lookahead up to max_lookahead_m (the loaded truck at 100 km/h just
+    does, at 40 m), the floor is nan and the candidate with the best `margin_score` at max_lookahead_m (the least
+    bad loop there) is chosen, its score reported. Refused (WorkbenchInputError) when no candidate meets max_lead_gain."""
+    require_in_range("max_lead_gain", max_lead_gain, 1.0, 1000.0)
+    require_in_range("speed_mps", speed_mps, 0.1, 100.0, "m/s")
+    floor_args = (speed_mps, min_lookahead_m, max_lookahead_m, lookahead_step_m, path_curvatures_1pm,
+                  phase_margin_deg, gain_margin_db)  # fmt: skip
+
+    def meets(params: LeadFilterParams | None, lookahead: float) -> bool:
+        lead_settings = replace(settings, lead=params)
+        return all(
+            loop_margins(lags, lead_settings, float(speed_mps), float(lookahead), kr).meets(
+                phase_margin_deg, gain_margin_db
+            )
+            for kr in path_curvatures_1pm
+            if abs(kr) * lookahead < _MAX_CURVATURE_LOOKAHEAD
+        )
+
+    def floor_of(params: LeadFilterParams | None) -> float:
+        """The floor, nan when max_lookahead_m misses the margins (then no floor in the range has them: the floor
+        is the shortest lookahead from which every longer one keeps them)."""
+        if not meets(params, max_lookahead_m):
+            return math.nan
+        return lookahead_floor(lags, replace(settings, lead=params), *floor_args)
+
+    def score(params: LeadFilterParams) -> float:
+        lead_settings = replace(settings, lead=params)
+        return min(
+            margin_score(
+                loop_margins(lags, lead_settings, float(speed_mps), float(max_lookahead_m), kr),
+                phase_margin_deg,
+                gain_margin_db,
+            )
+            for kr in path_curvatures_1pm
+            if abs(kr) * max_lookahead_m < _MAX_CURVATURE_LOOKAHEAD
+        )
+
+    best: tuple[float, float, LeadFilterParams] | None = None
+    fallback: tuple[float, float, LeadFilterParams] | None = None  # (-score, peak, params) while nothing has a floor
+    seen: set[tuple[float, float, float]] = set()
+    count = 0
+
+    def consider(wz: float, psi: float, ratio: float) -> None:
+        nonlocal best, fallback, count
+        key = (round(wz, 9), round(psi, 9), round(ratio, 9))
+        if key in seen:
+            return
+        seen.add(key)
+        try:
+            params = LeadFilterParams(wz, psi, ratio * wz)
+        except WorkbenchInputError:
+            return  # outside Eq. 6's ranges (a refinement step past psi 5, a ratio under 1, ...)
+        peak = params.peak_gain
+        if peak > max_lead_gain:
+            return
+        count += 1
+        if best is not None:
+            # it wins only with a shorter floor, or the same floor and a smaller peak gain: missing the margins there
+            # means a longer floor (the floor is the shortest lookahead from which every longer one keeps them)
+            threshold = best[0] if peak < best[1] else best[0] - lookahead_step_m
+            if threshold < min_lookahead_m - 1e-9 or not meets(params, threshold):
+                return
+        floor = floor_of(params)
+        if math.isnan(floor):
+            if best is None:
+                ranked = (-score(params), peak, params)
+                if fallback is None or ranked[:2] < fallback[:2]:
+                    fallback = ranked
+            return
+        if best is None or (floor, peak) < best[:2]:
+            best = (floor, peak, params)
+
+    # the grid by increasing peak gain, so that ties are settled early and the larger gains mostly pruned
+    grid = []
+    for wz, psi, ratio in itertools.product(MARGINS_OMEGA_Z_RAD_S, MARGINS_PSI, MARGINS_POLE_RATIOS):
+        grid.append((LeadFilterParams(wz, psi, ratio * wz).peak_gain, wz, psi, ratio))
+    for _, wz, psi, ratio in sorted(grid):
+        consider(wz, psi, ratio)
+    for _ in range(_REFINE_ROUNDS):
+        if best is None and fallback is None:
+            break
+        centre = best[2] if best is not None else fallback[2]
+        wz0, psi0 = centre.omega_z_rad_s, centre.psi
+        ratio0 = centre.omega_p_rad_s / centre.omega_z_rad_s
+        for fw in _REFINE_FACTORS:
+            for fp in _REFINE_FACTORS:
+                for fr in _REFINE_FACTORS:
+                    consider(wz0 * fw, psi0 * fp, max(1.0, ratio0 * fr))
+    if best is None and fallback is None:
+        raise WorkbenchInputError(f"no lead filter of the grid meets max_lead_gain = {max_lead_gain:g}; raise it")
+    without = floor_of(None)
+    if best is not None:
+        floor, params, chosen_score = best[0], best[2], math.nan
+    else:
+        floor, params, chosen_score = math.nan, fallback[2], -fallback[0]
+    design = replace(_report(params, lags.path, max_lead_gain, math.inf, None), method="margins")
+    return MarginsDesign(design, floor, without, count, chosen_score)

@@ -1,5 +1,6 @@
 """The tuning figures: Figure 6 (rollover curvature limits), Figure 8 (lag fit), Figure 9 (time-domain validation of
-the lead filter), Figure 10 (Bode of plant, compensator and cascade), and the schedule against speed.
+the lead filter), Figure 10 (Bode of plant, compensator and cascade), the schedule against speed, and the clothoid
+loop's margins against lookahead (`tuning margins`).
 
 Each function draws one figure, writes it to `path` (PNG, or any format matplotlib knows by suffix) and returns
 the path.
@@ -15,6 +16,7 @@ import numpy as np
 
 from tuning.lag_fit import LagFit
 from tuning.lead_design import LeadDesign, ValidationTrace
+from tuning.margins import MarginResult
 from tuning.rollover import RolloverLimit
 from tuning.schedule import ScheduleResult
 from workbench.errors import WorkbenchInputError
@@ -144,4 +146,12 @@ def schedule_figure(result: ScheduleResult, path: str | Path) -> Path:
         ax.grid(True, alpha=0.3)
         ax.legend(fontsize=8)
     a1.set_title(f"lead-filter schedule ({result.vehicle})")
+    return _save(fig, path)
+
+
+def margins_figure(result: MarginResult, path: str | Path) -> Path:
+    """The clothoid loop's margins against lookahead per speed, the lookaheads the controller may use shaded
+    (`MarginResult.plot`)."""
+    fig = plt.figure(figsize=(9, 7), layout="constrained")
+    result.plot(fig)
     return _save(fig, path)

@@ -12,38 +12,37 @@ Each step:
      schedule; `lead_filter.py`, `filter_file.py`) against the lag between steering wheel and path curvature
      (Eq. 5), unless switched off.
 
-Three choices the paper leaves open, each an option (ClothoidConfig), defaulting to what tracked best on this
-repository's loaded tractor-semitrailer (measurements in README.md):
+Choices the paper leaves open, each an option (ClothoidConfig), with the reasons for the defaults (measurements
+in README.md):
   - kappa(0) is the curvature the vehicle actually drives, yaw rate / speed ("yaw-rate"). The integrator's own
     command ("command") or the kinematic curvature of the measured steering ("steering") differ from it by the
     vehicle's understeer and lag, and the fit then settles on a circle through the target with the wrong
     curvature: a steady offset in every bend (about 1 m on the figure8 at 30 km/h with the truck).
   - the clothoid starts along the rear axle's course (yaw plus its sideslip), the direction the vehicle moves in,
     not its body yaw ("course"; the truck's tandem slips up to 3 degrees at 30 km/h).
-  - the Fréchet threshold applies to the distance in excess of the current |CTE| ("excess"): the Fréchet distance
-    is never below |CTE| (the curves start that far apart), so with the absolute threshold of the paper
-    ("absolute") no lookahead qualifies once |CTE| exceeds it, and the controller falls back to the candidate of
-    least Fréchet distance, the shortest and most aggressive, which on a lagging plant grows the error further.
+  - the Fréchet threshold is the paper's, absolute ("absolute", 0.02 m): off the path no lookahead qualifies and
+    the search takes the candidate of least Fréchet distance, the shortest, which brings the vehicle back fastest.
+    Before the lookahead floor (below) that choice could drive a lagging plant into a limit cycle, so the
+    threshold applied to the distance in excess of |CTE| ("excess", still an option), which keeps long lookaheads
+    off the path and converges slowly (35 m instead of 12 m from fig17's 1 m offset on the cars).
 
-Two choices for speeds above the paper's 30 km/h (the paper's future work), also options:
-  - the lower end of the lookahead range is a preview time, min_preview_time_s x speed, not only metres. Linearised
-    about a straight path (lateral offset y, heading error psi, curvature kappa, lookahead L from the predicted pose
-    D = L + V t_p ahead), the hyper-clothoid of Eq. 3 has kappa' = -(6 / L^3) (y + psi D + kappa D^2 / 2), so the
-    loop closed through the integrator of Figure 2 is d kappa_cmd / dt = -(6 V / L^3) (y + psi D + kappa D^2 / 2):
-    with y' = V psi and psi' = V kappa (a lag-free plant) its poles are V / L times those of a fixed polynomial (for
-    a given V t_p / L): the preview time L / V sets the loop's speed. At 30 km/h the paper's 5 m floor is 0.6 s;
-    held at 5 m at 60 km/h it is 0.3 s, twice as fast a loop around a plant whose lag (Eq. 5) has slowed (omega_n
-    4.3 -> 3.4 rad/s on the loaded truck): the loop oscillates in the steering-rate limit whenever the adaptive
-    search picks the floor (a fixed 5 m lookahead on the truck's dlc: max |CTE| 0.04-0.05 m at 30 km/h, 1.0-3.9 m
-    at 60 and 80 km/h, whichever lead filter). The default floor of 0.6 s keeps the paper's 5 m at 30 km/h and
-    below; it suits the truck (a plant with a faster lag, e.g. the dynamic bicycle car, tracks better at 60 km/h
-    with 0: 0.11 against 0.20 m on the dlc).
-  - the adaptive lookahead may shorten at once but grows by at most max_lookahead_growth_m_per_m metres per metre
-    travelled. The Fréchet search alone lets it jump between the ends of its range from one step to the next (on
-    the dlc at 60 km/h, by 0.4-0.7 m per 20 ms step on average): the loop's gain goes as L^-3 (above), so each jump
-    is a 64-fold gain change and the curvature rate kappa' jumps with it. Shortening stays immediate (the search
-    shortens when the path ahead bends away from the clothoid); growing is limited relative to distance travelled,
-    i.e. relative to the loop's own time scale L / V (d ln L / dt <= growth x V / L).
+What this controller adds to the paper, so that its loop keeps its margins on the vehicle it steers (issue 15):
+  - lookahead floor: `loop_analysis.py` linearises the loop (Eq. 3 on the predicted pose, the integrator of
+    Figure 2, the lead filter, the vehicle's identified lags of Eq. 5, sampling) and finds, per speed, the
+    shortest lookahead from which every lookahead keeps min_phase_margin_deg (45) and min_gain_margin_db (6, both
+    ways) about a straight and about an arc at the lateral-acceleration limit. The adaptive search never goes
+    below it. The loop's gain goes as L^-3 (about a straight kappa' = -(6 / L^3) (y + psi D + kappa D^2 / 2), D the
+    lookahead from the predicted pose), so each jump of the search's choice is a step change of the loop: the
+    choice is followed with hysteresis and at a limited rate both ways (`lookahead_filter.py`), slowly against
+    the loop's own time scale L / V, so that the frozen-lookahead margins hold.
+  - two degrees of freedom (`path_feedforward.py`): the feedback is Eq. 3's kappa' less that of the path's own
+    clothoid to the same target, and the path's curvature rate is fed forward, so tracking no longer needs the
+    short lookaheads where the loop has no margin.
+  - the lead filter, curvature limits and lags are the steered vehicle's own (`vehicle_tuning.py`), made by the
+    project's tuning chain (the lead chosen for the shortest floor, `tuning schedule --design margins`); without
+    a vehicle (geometry only) and without files, no lead filter and no floor.
+  - min_preview_time_s (default 0) can still raise the lower end of the lookahead range to a preview time, as
+    before the analysis floor did that job with the vehicle's own numbers.
 """
 
 from __future__ import annotations
@@ -58,12 +57,16 @@ import numpy as np
 
 from controllers.base import Controller, Measurement
 from controllers.clothoid.curvature_limits import CurvatureLimits
-from controllers.clothoid.filter_file import DEFAULT_FILTER, FilterSchedule, read_filter_file
+from controllers.clothoid.filter_file import FilterSchedule, read_filter_file
 from controllers.clothoid.lead_filter import DiscreteLeadFilter, PassThroughFilter, SteeringFilter
 from controllers.clothoid.lookahead import MAX_CURVE_POINTS, adaptive_search, candidate_count, evaluate_candidate
+from controllers.clothoid.lookahead_filter import LookaheadFilter, LookaheadFilterSettings, require_rate
+from controllers.clothoid.loop_analysis import LoopSettings, PlantLags, lookahead_floor
+from controllers.clothoid.path_feedforward import FeedforwardTiming, two_degree_of_freedom_rate
+from controllers.clothoid.vehicle_tuning import VehicleTuning, tuning_for
 from workbench.errors import WorkbenchInputError, require_in_range, require_positive
 from workbench.path import PathTracker, ReferencePath
-from workbench.vehicles.base import VehicleGeometry
+from workbench.vehicles.base import VehicleGeometry, VehicleModel
 
 LOOKAHEAD_MODES = ("adaptive", "fixed", "speed")
 INITIAL_CURVATURE = ("yaw-rate", "command", "steering")
@@ -71,8 +74,14 @@ HEADINGS = ("course", "yaw")
 THRESHOLD_MODES = ("excess", "absolute")
 #: Below this speed (m/s) yaw rate / speed and the course angle are too noisy to use.
 MIN_SPEED_MPS = 0.5
-#: Largest max_lookahead_growth_m_per_m accepted (m of lookahead per m travelled).
-MAX_GROWTH_M_PER_M = 100.0
+#: The lookahead floor is computed per band of this many km/h (and at least at the band's lower speed, 5 km/h).
+FLOOR_SPEED_BAND_KMH = 5.0
+#: Longest lookahead (m) the floor search considers when the configured range has no margin at a speed.
+MAX_FLOOR_LOOKAHEAD_M = 40.0
+#: Lateral acceleration (g) of the arc about which the floor is checked besides the straight (the speed profile's
+#: 0.3 g bound, with margin), capped by the curvature limit.
+FLOOR_ARC_LATERAL_ACCEL_G = 0.4
+G_MPS2 = 9.80665
 
 
 @dataclass(frozen=True)
@@ -80,30 +89,38 @@ class ClothoidConfig:
     """Options of the clothoid controller (the paper's values where it gives them).
 
     lookahead_mode: "adaptive" (Fréchet, section 3), "fixed" (fixed_lookahead_m) or "speed" (lookahead_gain_s x
-    speed, clipped to the range); min/max_lookahead_m: the range (m; the paper: 5-20 m); lookahead_step_m: the
-    grid of the adaptive search (m); min_preview_time_s: raises the lower end of the range to this time x speed
-    (s; 0: off, the paper's 5 m at every speed; module docstring); max_lookahead_growth_m_per_m: the most the
-    lookahead grows per metre travelled (m/m, > 0; None: unlimited, as in the paper; it always shortens at once;
-    module docstring); frechet_threshold_m: the adaptive threshold (m; the paper: 0.5 m) and threshold_mode how it
-    applies ("excess" of |CTE| or "absolute"; module docstring); frechet_point_spacing_m: sampling of the curves
-    compared (m); tolerance_x_m, tolerance_y_m: delta_x, delta_y of Eq. 3 (m); max_curvature_rate_1pm2: saturation
-    of the clothoid's kappa' (1/m^2); initial_curvature: kappa(0) of Eq. 3, "yaw-rate", "command" or "steering";
-    heading: "course" or "yaw"; prediction_time_s: pose prediction (s; 0: off); filter_file: lead filter
-    (JSON/TOML, the `tuning design-lead` format; None: DEFAULT_FILTER); use_lead_filter: False switches the filter
-    off; limits_file: curvature limits CSV (the `tuning rollover-limits` format; None: limits from the vehicle's
-    geometry, `CurvatureLimits.default_for`).
+    speed, clipped to the range); min/max_lookahead_m: the range (m; the paper: 5-20 m; the analysis floor raises
+    the lower end, and the upper one with it where needed); lookahead_step_m: the grid of the adaptive search (m);
+    min_preview_time_s: raises the lower end of the range to this time x speed (s; 0: off); lookahead_hysteresis_m,
+    max_lookahead_growth_m_per_m, max_lookahead_shrink_m_per_m: how the search's choice is followed
+    (`lookahead_filter.py`; None: at once); min_phase_margin_deg, min_gain_margin_db: the margins the lookahead
+    floor keeps (`loop_analysis.py`; 0 and 0: no floor); frechet_threshold_m: the adaptive threshold (m; the paper:
+    0.5 m) and threshold_mode how it applies ("excess" of |CTE| or "absolute"; module docstring);
+    frechet_point_spacing_m: sampling of the curves compared (m); tolerance_x_m, tolerance_y_m: delta_x, delta_y of
+    Eq. 3 (m); max_curvature_rate_1pm2: saturation of the clothoid's kappa' (1/m^2); initial_curvature: kappa(0)
+    of Eq. 3, "yaw-rate", "command" or "steering"; heading: "course" or "yaw"; prediction_time_s: pose prediction
+    (s; 0: off); path_feedforward: the two-degree-of-freedom form (`path_feedforward.py`; False: Eq. 3 alone);
+    feedforward_window_m: the window the path's curvature rate is averaged over (m); feedforward_time_s,
+    reference_lead_s: its timings (s; None: from the vehicle's identified lags); filter_file: lead filter (JSON/TOML,
+    the `tuning design-lead` or `tuning schedule` format; None: the steered vehicle's own); use_lead_filter: False
+    switches the filter off; limits_file: curvature limits CSV (the `tuning rollover-limits` format; None: the
+    vehicle's own, else limits from its geometry, `CurvatureLimits.default_for`).
     """
 
     lookahead_mode: str = "adaptive"
     min_lookahead_m: float = 5.0
     max_lookahead_m: float = 20.0
     lookahead_step_m: float = 0.5
-    min_preview_time_s: float = 0.6
+    min_preview_time_s: float = 0.0
+    lookahead_hysteresis_m: float = 0.5
     max_lookahead_growth_m_per_m: float | None = 0.3
+    max_lookahead_shrink_m_per_m: float | None = 1.0
+    min_phase_margin_deg: float = 45.0
+    min_gain_margin_db: float = 6.0
     fixed_lookahead_m: float = 10.0
     lookahead_gain_s: float = 1.0
     frechet_threshold_m: float = 0.02
-    threshold_mode: str = "excess"
+    threshold_mode: str = "absolute"
     frechet_point_spacing_m: float = 0.5
     tolerance_x_m: float = 0.5
     tolerance_y_m: float = 0.5
@@ -111,6 +128,10 @@ class ClothoidConfig:
     initial_curvature: str = "yaw-rate"
     heading: str = "course"
     prediction_time_s: float = 0.2
+    path_feedforward: bool = True
+    feedforward_window_m: float = 6.0
+    feedforward_time_s: float | None = None
+    reference_lead_s: float | None = None
     filter_file: Path | None = None
     use_lead_filter: bool = True
     limits_file: Path | None = None
@@ -129,14 +150,11 @@ class ClothoidConfig:
                 raise WorkbenchInputError(f"{name} must be one of {', '.join(allowed)}; got {getattr(self, name)!r}")
         require_in_range("prediction_time_s", self.prediction_time_s, 0.0, 2.0, "s")
         require_in_range("min_preview_time_s", self.min_preview_time_s, 0.0, 10.0, "s")
-        growth = self.max_lookahead_growth_m_per_m
-        if growth is not None and (
-            isinstance(growth, bool) or not isinstance(growth, int | float) or not 0.0 < growth <= MAX_GROWTH_M_PER_M
-        ):
-            raise WorkbenchInputError(
-                f"max_lookahead_growth_m_per_m must be None (unlimited) or a number in (0, {MAX_GROWTH_M_PER_M:g}] "
-                f"m per m travelled; got {growth!r}"
-            )
+        require_in_range("lookahead_hysteresis_m", self.lookahead_hysteresis_m, 0.0, 50.0, "m")
+        require_rate("max_lookahead_growth_m_per_m", self.max_lookahead_growth_m_per_m)
+        require_rate("max_lookahead_shrink_m_per_m", self.max_lookahead_shrink_m_per_m)
+        require_in_range("min_phase_margin_deg", self.min_phase_margin_deg, 0.0, 89.0, "deg")
+        require_in_range("min_gain_margin_db", self.min_gain_margin_db, 0.0, 40.0, "dB")
         require_in_range("min_lookahead_m", self.min_lookahead_m, 0.5, 200.0, "m")
         require_in_range("max_lookahead_m", self.max_lookahead_m, self.min_lookahead_m, 200.0, "m")
         require_in_range("fixed_lookahead_m", self.fixed_lookahead_m, 0.5, 200.0, "m")
@@ -146,6 +164,12 @@ class ClothoidConfig:
         require_positive("tolerance_y_m", self.tolerance_y_m)
         require_positive("max_curvature_rate_1pm2", self.max_curvature_rate_1pm2)
         require_in_range("lookahead_step_m", self.lookahead_step_m, 0.05, 50.0, "m")
+        require_in_range("feedforward_window_m", self.feedforward_window_m, 0.1, 100.0, "m")
+        for name in ("feedforward_time_s", "reference_lead_s"):
+            if getattr(self, name) is not None:
+                require_in_range(name, getattr(self, name), 0.0, 5.0, "s (or None: from the vehicle's lags)")
+        if not isinstance(self.path_feedforward, bool):
+            raise WorkbenchInputError(f"path_feedforward must be true or false; got {self.path_feedforward!r}")
         steps = (self.max_lookahead_m - self.min_lookahead_m) / self.lookahead_step_m
         if steps > 1000:
             raise WorkbenchInputError(
@@ -161,7 +185,11 @@ class ClothoidConfig:
 
 
 class ClothoidController(Controller):
-    """The clothoid controller (Figure 2). Build once for a vehicle and a ClothoidConfig; `reset` for each path."""
+    """The clothoid controller (Figure 2). Build once for a vehicle and a ClothoidConfig; `reset` for each path.
+
+    `vehicle` (the steered VehicleModel) selects its tuning (`vehicle_tuning.tuning_for`): the lead filter, the
+    curvature limits and the identified lags the lookahead floor and the feed-forward timing are computed from.
+    """
 
     name: ClassVar[str] = "clothoid"
     config_type: ClassVar[type] = ClothoidConfig
@@ -171,33 +199,47 @@ class ClothoidController(Controller):
     ) -> None:
         super().__init__(geometry, config)
         cfg = self.config
-        self.limits = (
-            CurvatureLimits.read_csv(cfg.limits_file, geometry)
-            if cfg.limits_file
-            else CurvatureLimits.default_for(geometry)
-        )
-        self.filter_schedule: FilterSchedule = (
-            read_filter_file(cfg.filter_file) if cfg.filter_file else FilterSchedule.single(DEFAULT_FILTER)
-        )
+        self.tuning: VehicleTuning | None = tuning_for(vehicle) if isinstance(vehicle, VehicleModel) else None
+        if cfg.limits_file:
+            self.limits = CurvatureLimits.read_csv(cfg.limits_file, geometry)
+        elif self.tuning is not None:
+            self.limits = self.tuning.limits
+        else:
+            self.limits = CurvatureLimits.default_for(geometry)
+        self.filter_schedule: FilterSchedule | None = None
+        if cfg.use_lead_filter:
+            if cfg.filter_file:
+                self.filter_schedule = read_filter_file(cfg.filter_file)
+            elif self.tuning is not None:
+                self.filter_schedule = self.tuning.filter_schedule
         self._buffers = np.empty((4, MAX_CURVE_POINTS))
-        self._scores = np.empty(candidate_count(cfg.min_lookahead_m, cfg.max_lookahead_m, cfg.lookahead_step_m))
+        top = max(cfg.max_lookahead_m, MAX_FLOOR_LOOKAHEAD_M)
+        self._scores = np.empty(candidate_count(cfg.min_lookahead_m, top, cfg.lookahead_step_m))
         self._filters: dict[int, DiscreteLeadFilter] = {}
+        self._floors: dict[int, float] = {}
+        self._choice = LookaheadFilter(
+            LookaheadFilterSettings(
+                cfg.lookahead_hysteresis_m, cfg.max_lookahead_growth_m_per_m, cfg.max_lookahead_shrink_m_per_m
+            )
+        )
 
     def reset(self, path: ReferencePath, sample_time_s: float) -> None:
         require_positive("sample_time_s", sample_time_s)
         self._dt = float(sample_time_s)
         self._tracker: PathTracker = path.tracker(0.0)
+        self._here: PathTracker = path.tracker(0.0)
         self._kappa_cmd: float | None = None
         self._filters = {}
+        self._floors = {}
         self._filter: SteeringFilter = PassThroughFilter()
         self._filter_speed_kmh = -1
-        self._lookahead_m: float | None = None
+        self._choice.reset()
         self._diag: dict[str, float] = {}
 
     def _lead_filter(self, speed_mps: float) -> SteeringFilter:
         """The lead filter for this speed: the schedule's filter at the nearest whole km/h (discretised once per
         km/h and cached), continuing from the previous filter's state."""
-        if not self.config.use_lead_filter:
+        if self.filter_schedule is None:
             return self._filter
         speed_kmh = round(speed_mps * 3.6) if len(self.filter_schedule.speeds_kmh) > 1 else 0
         if speed_kmh != self._filter_speed_kmh:
@@ -209,6 +251,58 @@ class ClothoidController(Controller):
                 new.continue_from(self._filter)
             self._filter, self._filter_speed_kmh = new, speed_kmh
         return self._filter
+
+    def plant_lags(self, speed_kmh: float) -> PlantLags | None:
+        """The vehicle's identified lags at this speed (None without a tuning)."""
+        if self.tuning is None:
+            return None
+        measured = getattr(self.tuning, "measured_lag_at", None)
+        return PlantLags(self.tuning.lag_at(speed_kmh), measured(speed_kmh) if measured else None)
+
+    def loop_settings(self, speed_kmh: float) -> LoopSettings:
+        """What the controller does at this speed, for `loop_analysis`."""
+        lead = self.filter_schedule.at_speed(speed_kmh) if self.filter_schedule is not None else None
+        return LoopSettings(self._dt, self.config.prediction_time_s, lead=lead)
+
+    def lookahead_floor_m(self, speed_mps: float) -> float:
+        """The shortest lookahead (m) that keeps the configured margins at this speed (per FLOOR_SPEED_BAND_KMH band,
+        computed once per band and run; min_lookahead_m without a tuning or with the margins set to 0)."""
+        cfg = self.config
+        band = max(1, round(speed_mps * 3.6 / FLOOR_SPEED_BAND_KMH))
+        floor = self._floors.get(band)
+        if floor is None:
+            speed_kmh = band * FLOOR_SPEED_BAND_KMH
+            lags = self.plant_lags(speed_kmh)
+            if lags is None or (cfg.min_phase_margin_deg <= 0.0 and cfg.min_gain_margin_db <= 0.0):
+                floor = cfg.min_lookahead_m
+            else:
+                v = speed_kmh / 3.6
+                kappa_max, _ = self.limits.at_speed(v)
+                arc = min(kappa_max, FLOOR_ARC_LATERAL_ACCEL_G * G_MPS2 / v**2)
+                floor = lookahead_floor(
+                    lags, self.loop_settings(speed_kmh), v, cfg.min_lookahead_m,
+                    max(cfg.max_lookahead_m, MAX_FLOOR_LOOKAHEAD_M), cfg.lookahead_step_m, (0.0, arc),
+                    cfg.min_phase_margin_deg, cfg.min_gain_margin_db,
+                )  # fmt: skip
+            self._floors[band] = floor
+        return floor
+
+    def feedforward_timing(self, speed_mps: float) -> FeedforwardTiming:
+        """The feed-forward's timing at this speed: the options, else from the identified lags (path_feedforward.py):
+        feed-forward time = the low-frequency delay of lead filter and path lag; reference lead = the path lag's less
+        the measured (yaw-rate) lag's, within [0, prediction time]; K of the path lag."""
+        cfg, speed_kmh = self.config, speed_mps * 3.6
+        lags = self.plant_lags(speed_kmh)
+        lead = self.filter_schedule.at_speed(speed_kmh) if self.filter_schedule is not None else None
+        path_delay = 0.0 if lags is None else lags.path.group_delay_s
+        measured_delay = path_delay if lags is None or lags.measured is None else lags.measured.group_delay_s
+        lead_delay = 0.0 if lead is None else lead.group_delay_s
+        ff = cfg.feedforward_time_s if cfg.feedforward_time_s is not None else max(0.0, path_delay + lead_delay)
+        ref = cfg.reference_lead_s
+        if ref is None:
+            ref = min(max(path_delay - measured_delay, 0.0), cfg.prediction_time_s)
+        gain = 1.0 if lags is None else lags.path.steady_state_gain
+        return FeedforwardTiming(min(ff, 5.0), min(ref, 5.0), gain)
 
     def _initial_curvature(self, m: Measurement, steering_kappa: float) -> float:
         """kappa(0) of Eq. 3 (see ClothoidConfig.initial_curvature)."""
@@ -237,27 +331,24 @@ class ClothoidController(Controller):
         return x, y, heading
 
     def _lookahead(self, path: ReferencePath, foot_index: float, cte_m: float, pose, kappa0: float, speed_mps: float):
-        """(lookahead m, the adaptive search's choice m, number of candidates evaluated) by the configured mode."""
+        """(lookahead m, the adaptive search's choice m, the floor m, number of candidates evaluated)."""
         cfg = self.config
+        floor = max(self.lookahead_floor_m(speed_mps), cfg.min_lookahead_m, cfg.min_preview_time_s * speed_mps)
+        top = max(cfg.max_lookahead_m, floor)
         if cfg.lookahead_mode == "fixed":
-            return cfg.fixed_lookahead_m, cfg.fixed_lookahead_m, 0
-        low = min(max(cfg.min_lookahead_m, cfg.min_preview_time_s * speed_mps), cfg.max_lookahead_m)
+            return cfg.fixed_lookahead_m, cfg.fixed_lookahead_m, floor, 0
         if cfg.lookahead_mode == "speed":
-            lookahead = min(max(cfg.lookahead_gain_s * speed_mps, low), cfg.max_lookahead_m)
-            return lookahead, lookahead, 0
+            lookahead = min(max(cfg.lookahead_gain_s * speed_mps, floor), top)
+            return lookahead, lookahead, floor, 0
         threshold = cfg.frechet_threshold_m + (abs(cte_m) if cfg.threshold_mode == "excess" else 0.0)
         x, y, heading = pose
         chosen, evaluations = adaptive_search(
-            path.x_m, path.y_m, path.closed, foot_index, x, y, heading, kappa0, low, cfg.max_lookahead_m,
+            path.x_m, path.y_m, path.closed, foot_index, x, y, heading, kappa0, floor, top,
             cfg.lookahead_step_m, threshold, cfg.tolerance_x_m, cfg.tolerance_y_m, cfg.max_curvature_rate_1pm2,
             cfg.frechet_point_spacing_m, self._buffers, self._scores,
         )  # fmt: skip
-        lookahead = chosen
-        growth = cfg.max_lookahead_growth_m_per_m
-        if growth is not None and self._lookahead_m is not None:  # shorten at once, grow per metre travelled
-            lookahead = max(min(chosen, self._lookahead_m + growth * speed_mps * self._dt), low)
-        self._lookahead_m = lookahead
-        return lookahead, chosen, evaluations
+        lookahead = self._choice.step(chosen, floor, top, speed_mps * self._dt)
+        return lookahead, chosen, floor, evaluations
 
     def step(self, measurement: Measurement, path: ReferencePath) -> float:
         cfg, g, m = self.config, self.geometry, measurement
@@ -272,11 +363,19 @@ class ClothoidController(Controller):
         pose = self._start_pose(m, kappa0)
         foot = self._tracker.update(pose[0], pose[1])
         foot_index = foot.s_m / path.spacing_m
-        lookahead, searched, evaluations = self._lookahead(path, foot_index, foot.cte_m, pose, kappa0, m.speed_mps)
+        lookahead, searched, floor, evaluations = self._lookahead(
+            path, foot_index, foot.cte_m, pose, kappa0, m.speed_mps
+        )
         frechet, kdot, length, tx, ty, ex, ey, status = evaluate_candidate(
             path.x_m, path.y_m, path.closed, foot_index, *pose, kappa0, lookahead, cfg.max_curvature_rate_1pm2,
             cfg.frechet_point_spacing_m, self._buffers,
         )  # fmt: skip
+        clothoid_kdot = reference_kdot = feedforward_kdot = kdot
+        if cfg.path_feedforward:  # path_feedforward.py: feedback relative to the path's own clothoid, plus its rate
+            kdot, reference_kdot, feedforward_kdot = two_degree_of_freedom_rate(
+                kdot, path, self._here.update(m.x_m, m.y_m), (tx, ty), m.speed_mps, cfg.prediction_time_s,
+                self.feedforward_timing(m.speed_mps), cfg.feedforward_window_m,
+            )  # fmt: skip
 
         # Figure 2: kappa' x V integrated to curvature, under the rate and curvature limits (section 4).
         rate = min(max(kdot * m.speed_mps, -rate_max), rate_max)
@@ -287,8 +386,12 @@ class ClothoidController(Controller):
         self._diag = {
             "lookahead_m": lookahead,
             "searched_lookahead_m": searched,
+            "lookahead_floor_m": floor,
             "frechet_m": frechet,
             "curvature_rate_1pm2": kdot,
+            "clothoid_curvature_rate_1pm2": clothoid_kdot,
+            "reference_curvature_rate_1pm2": reference_kdot,
+            "feedforward_curvature_rate_1pm2": feedforward_kdot,
             "clothoid_length_m": length,
             "end_error_m": math.hypot(ex - tx, ey - ty),
             "fit_status": float(status),

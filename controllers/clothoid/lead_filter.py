@@ -113,6 +113,12 @@ class LeadFilterParams:
         return max(float(gains[i]), -float(res.fun))
 
     @property
+    def group_delay_s(self) -> float:
+        """The low-frequency delay of Eq. 6 (s), -d(phase)/d(omega) at omega = 0: 3 / wp - 2 psi / wz (negative: the
+        filter advances slow signals by that much)."""
+        return 3.0 / self.omega_p_rad_s - 2.0 * self.psi / self.omega_z_rad_s
+
+    @property
     def high_frequency_gain(self) -> float:
         """Alias of `peak_gain`: the filter's largest amplification of high-frequency content."""
         return self.peak_gain

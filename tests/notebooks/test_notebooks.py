@@ -56,7 +56,7 @@ def check_lag_and_lead(summary: dict) -> None:
         assert compensated < lagged
     assert summary["closed_loop_completed"]
     cte = summary["closed_loop_max_abs_cte_m"]
-    assert cte["designed filter"] < 0.2 < cte["no filter"]
+    assert cte["designed filter"] < cte["no filter"] and cte["designed filter"] < 0.2
     # The lag slows with speed (Figure 7b).
     omega_n = summary["schedule_omega_n_rad_s"]
     assert omega_n == sorted(omega_n, reverse=True)
@@ -81,8 +81,11 @@ def check_parameter_study(summary: dict) -> None:
     for mode in ("excess", "absolute"):
         by_threshold = {row["frechet_threshold_m"]: row for row in rows if row["threshold_mode"] == mode}
         assert set(by_threshold) == {0.01, 0.02, 0.05, 0.2, 0.5}
-        # The paper's threshold tracks several times worse than a small one.
-        assert by_threshold[0.01]["max_abs_cte_m"] < 0.2 * by_threshold[0.5]["max_abs_cte_m"]
+        # With the feed-forward, tracking no longer depends on the threshold: every one within 0.1 m, within 20 % of
+        # each other; a larger threshold steers less (longer lookaheads, a lower loop gain).
+        cte = [row["max_abs_cte_m"] for row in by_threshold.values()]
+        assert max(cte) < 0.1 and max(cte) < 1.2 * min(cte)
+        assert by_threshold[0.5]["rms_steer_rate_deg_s"] < 0.95 * by_threshold[0.01]["rms_steer_rate_deg_s"]
         for row in by_threshold.values():
             # the notebook's steering rate from the trace is the summary's metric
             assert row["max_steer_rate_deg_s"] == pytest.approx(row["max_abs_steer_rate_deg_s"], rel=1e-9)

@@ -68,3 +68,64 @@ def test_bad_input_exits_2(args: list[str], needle: str, tmp_path: Path, capsys)
 def test_unknown_maneuver_is_rejected() -> None:
     with pytest.raises(WorkbenchInputError, match="unknown maneuver 'slalom'"):
         Maneuver("slalom")
+
+
+def test_chirp_sweeps_from_start_to_end_frequency_at_the_amplitude() -> None:
+    m = Maneuver("chirp", amplitude_deg=30.0, start_s=1.0, duration_s=21.0, start_hz=0.1, end_hz=2.0)
+    t = np.arange(0.0, 21.0, 0.001)
+    sw = m.steer_wheel_rad(t)
+    assert sw[t < 1.0].max() == 0.0 and sw[0] == 0.0
+    assert np.max(np.abs(sw)) == pytest.approx(math.radians(30.0), rel=1e-3)
+    # the periods between rising zero crossings are those of the frequency at their middle (6.3 s, then down to
+    # 0.53 s; 2 Hz is reached at the end)
+    rising = t[1:][(sw[:-1] < 0.0) & (sw[1:] >= 0.0)]
+    middles = 0.5 * (rising[1:] + rising[:-1])
+    np.testing.assert_allclose(np.diff(rising), 1.0 / m.chirp_frequency_hz(middles), rtol=0.03)
+    assert m.chirp_frequency_hz(np.array([1.0, 11.0, 21.0])) == pytest.approx([0.1, 0.1 * 20**0.5, 2.0])
+    # about 12 cycles in all: (f1 - f0) T / ln(f1 / f0)
+    assert rising.size == pytest.approx(1.9 * 20.0 / math.log(20.0), abs=1.5)
+
+
+def test_a_rate_limit_turns_steps_into_ramps_and_lowers_the_chirp_at_high_frequency() -> None:
+    t = np.arange(0.0, 20.0, 0.001)
+    step = Maneuver("step", amplitude_deg=90.0, start_s=1.0, max_rate_deg_s=45.0).steer_wheel_rad(t)
+    rate = np.degrees(np.diff(step)) / 0.001
+    assert rate.max() == pytest.approx(45.0, rel=1e-3)
+    assert step[t >= 3.05] == pytest.approx(math.radians(90.0))  # the 2 s ramp is done
+    assert step[np.searchsorted(t, 2.0)] == pytest.approx(math.radians(45.0), rel=0.01)
+    chirp = Maneuver("chirp", amplitude_deg=90.0, max_rate_deg_s=180.0)
+    sw = chirp.steer_wheel_rad(t)
+    assert np.max(np.abs(np.degrees(np.diff(sw)) / 0.001)) <= 180.0 * 1.001
+    early, late = np.abs(sw[t < 6.0]).max(), np.abs(sw[t > 17.0]).max()
+    assert math.degrees(early) == pytest.approx(90.0, rel=1e-3)  # 0.1-0.3 Hz: 90 deg x 2 pi f under 180 deg/s
+    # capped at 180 / (2 pi f), largest at the window's lowest frequency, 1.25 Hz
+    assert math.degrees(late) == pytest.approx(180.0 / (2 * math.pi * chirp.chirp_frequency_hz(17.0)), rel=0.01)
+
+
+def test_the_chirp_is_checked() -> None:
+    with pytest.raises(WorkbenchInputError, match="end_hz must be in"):
+        Maneuver("chirp", start_hz=2.0, end_hz=1.0)
+    with pytest.raises(WorkbenchInputError, match="a chirp needs duration_s > start_s"):
+        Maneuver("chirp", start_s=5.0, duration_s=5.0)
+    with pytest.raises(WorkbenchInputError, match="max_rate_deg_s must be"):
+        Maneuver("dlc", max_rate_deg_s=0.0)
+
+
+def test_the_steering_between_samples_is_the_profiles() -> None:
+    """The plant is driven with the profile at each 1 ms plant step, not with the logged sample held: the
+    kinematic bicycle's yaw rate after a ramp is the same whatever the log's sample rate."""
+    vehicle = KinematicBicycle()
+    maneuver = Maneuver("chirp", amplitude_deg=20.0, duration_s=6.0, end_hz=1.0)
+    fine = generate_open_loop_log(vehicle, maneuver, 30.0, sample_rate_hz=100.0)
+    coarse = generate_open_loop_log(vehicle, maneuver, 30.0, sample_rate_hz=10.0)
+    np.testing.assert_allclose(coarse["yaw_rate_rad_s"].to_numpy(), fine["yaw_rate_rad_s"].to_numpy()[::10], atol=1e-4)
+
+
+def test_cli_writes_a_chirp(tmp_path: Path) -> None:
+    out = tmp_path / "chirp.csv"
+    argv = ["generate-data", "--vehicle", "kinematic-bicycle", "--maneuver", "chirp", "--speed", "30",
+            "--lat-accel-g", "0.1", "--chirp-hz", "0.2:1.5", "--max-rate-deg-s", "100", "--out", str(out)]  # fmt: skip
+    assert main(argv) == 0
+    log = pd.read_csv(out)
+    assert np.max(np.abs(np.diff(log["steer_wheel_deg"]))) / 0.01 <= 100.0 * 1.01
+    assert main([*argv[:-2], "--chirp-hz", "fast", "--out", str(out)]) == 2

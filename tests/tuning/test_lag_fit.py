@@ -13,11 +13,20 @@ from hypothesis import strategies as st
 from scipy import signal
 from synthetic_logs import GEOMETRY, synthetic_frame
 
-from tuning.lag_fit import LagFitOptions, fit_lag, kinematic_curvature, path_curvature, simulate_lag
+from tuning.lag_fit import (
+    DELAY_FIT_MAX_ZETA,
+    LagFitOptions,
+    fit_lag,
+    kinematic_curvature,
+    path_curvature,
+    simulate_lag,
+)
 from tuning.log_file import VehicleLog
 from tuning.schedule import identification_logs
 from workbench.errors import WorkbenchInputError
 from workbench.vehicles import make_vehicle
+
+KINDS = ("dlc", "step-series", "chirp")
 
 
 def logs(wn: float, zeta: float, **kwargs) -> list[VehicleLog]:
@@ -94,16 +103,50 @@ def test_unit_gain_fixes_k() -> None:
 
 
 def test_truck_lag_grows_with_speed_figure_7b() -> None:
-    # Measured (dlc + step series at 0.1 g, path curvature): omega_n / zeta / K = 4.28 / 0.78 / 0.94 at 30 km/h,
-    # 2.54 / 1.32 / 0.78 at 90 km/h; NRMSE about 0.02 and 0.01.
+    # Measured (dlc, step series and chirp at 0.1 g, path curvature): omega_n / zeta / K = 4.40 / 0.70 / 0.94 at
+    # 30 km/h, 2.55 / 1.29 / 0.78 at 90 km/h; NRMSE 0.036 and 0.026.
     truck = make_vehicle("tractor-semitrailer")
     slow = fit_lag(identification_logs(truck, 30.0), truck.geometry)
     fast = fit_lag(identification_logs(truck, 90.0), truck.geometry)
-    assert slow.lag.omega_n_rad_s == pytest.approx(4.28, rel=0.03)
-    assert slow.lag.zeta == pytest.approx(0.78, rel=0.03)
+    assert slow.lag.omega_n_rad_s == pytest.approx(4.40, rel=0.03)
+    assert slow.lag.zeta == pytest.approx(0.70, rel=0.03)
     assert fast.lag.omega_n_rad_s < 0.7 * slow.lag.omega_n_rad_s
     assert fast.gain < slow.gain < 1.0  # understeer grows with speed
-    assert slow.nrmse < 0.03 and fast.nrmse < 0.03
+    assert slow.nrmse < 0.05 and fast.nrmse < 0.05
+
+
+def test_a_delay_fit_of_a_first_order_lag_behind_a_delay_stops_at_the_zeta_bound() -> None:
+    """A lag whose second pole is far faster than the first (zeta 6: poles 0.08 and 12 wn) behind a delay: over the
+    logs' frequencies the fast pole and the delay trade off, and the fit, zeta bounded at DELAY_FIT_MAX_ZETA = 2, is
+    accepted there with the same response (the true and the fitted lag within 1 % and 1 deg up to 8 rad/s)."""
+    wn, zeta, delay = 40.0, 6.0, 0.15
+    frames = [synthetic_frame(kind, wn, zeta, delay_s=delay, seed=i) for i, kind in enumerate(KINDS)]
+    fit = fit_lag([VehicleLog.from_frame(f, "x") for f in frames], GEOMETRY, LagFitOptions(fit_delay=True))
+    lag = fit.lag
+    assert lag.zeta == pytest.approx(DELAY_FIT_MAX_ZETA)
+    w = np.geomspace(0.3, 8.0, 20)
+    ratio = _response(lag.omega_n_rad_s, lag.zeta, lag.delay_s, w) / _response(wn, zeta, delay, w)
+    assert np.max(np.abs(np.abs(ratio) - 1.0)) < 0.01
+    assert np.max(np.abs(np.degrees(np.angle(ratio)))) < 1.0
+    # with the old bound the same data run zeta far out, and a fit at 10 is refused
+    wide = fit_lag(
+        [VehicleLog.from_frame(f, "x") for f in frames], GEOMETRY, LagFitOptions(fit_delay=True, max_zeta=10.0)
+    )
+    assert wide.lag.zeta > 3.0
+
+
+def _response(wn: float, zeta: float, delay: float, w: np.ndarray) -> np.ndarray:
+    s = 1j * w
+    return wn**2 / (s * s + 2 * zeta * wn * s + wn**2) * np.exp(-s * delay)
+
+
+def test_the_zeta_bound_and_its_acceptance() -> None:
+    assert LagFitOptions().zeta_upper_bound == 10.0 and not LagFitOptions().accepts_zeta_at_bound
+    assert LagFitOptions(fit_delay=True).zeta_upper_bound == DELAY_FIT_MAX_ZETA
+    assert LagFitOptions(fit_delay=True).accepts_zeta_at_bound
+    assert not LagFitOptions(fit_delay=True, max_zeta=10.0).accepts_zeta_at_bound
+    with pytest.raises(WorkbenchInputError, match="max_zeta must be in"):
+        LagFitOptions(max_zeta=20.0)
 
 
 # --- refusals -------------------------------------------------------------------------------------------------
@@ -139,10 +182,12 @@ def test_data_no_second_order_lag_explains_are_refused() -> None:
 
 
 def test_forcing_a_unit_gain_on_the_understeering_truck_is_refused_with_a_hint() -> None:
-    # At 90 km/h the truck reaches 78% of the kinematic curvature; Eq. 5 alone can only mimic that by zeta -> inf.
+    # At 90 km/h the truck reaches 78% of the kinematic curvature; Eq. 5 alone can only mimic that by zeta -> inf
+    # on the steps and the dlc. (With the chirp too it settles at zeta 2.1, NRMSE 0.056: a poor fit, not refused.)
     truck = make_vehicle("tractor-semitrailer")
+    logs = identification_logs(truck, 90.0, maneuvers=("dlc", "step-series"))
     with pytest.raises(WorkbenchInputError, match=r"ran to the bound of zeta .* drop --unit-gain"):
-        fit_lag(identification_logs(truck, 90.0), truck.geometry, LagFitOptions(unit_gain=True))
+        fit_lag(logs, truck.geometry, LagFitOptions(unit_gain=True))
 
 
 def test_bad_options() -> None:

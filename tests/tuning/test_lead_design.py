@@ -12,7 +12,8 @@ from hypothesis import strategies as st
 from synthetic_logs import GEOMETRY, synthetic_frame
 
 from controllers.clothoid.lead_filter import LeadFilterParams
-from tuning.lead_design import design_lead, validate
+from controllers.clothoid.loop_analysis import LoopSettings, Margins, PlantLags, loop_margins
+from tuning.lead_design import design_lead, design_lead_for_margins, margin_score, validate
 from tuning.log_file import VehicleLog
 from workbench.errors import WorkbenchInputError
 from workbench.vehicles.steering_lag import SteeringLag
@@ -133,3 +134,44 @@ def test_a_lag_damped_beyond_3_8_needs_a_bound_above_3() -> None:
     with pytest.raises(WorkbenchInputError, match="no lead filter meets the bounds; raise max_lead_gain"):
         design_lead(SteeringLag(4.0, 4.0), max_lead_gain=3.0)
     assert design_lead(SteeringLag(4.0, 4.0)).lead_peak_gain == pytest.approx(6.0, rel=1e-6)
+
+
+# --- the margins design ----------------------------------------------------------------------------------------
+
+#: The loaded truck's lags at 60 km/h (`tuning schedule --delay`): to the path and to the measured curvature.
+TRUCK_60 = PlantLags(
+    SteeringLag(8.18, 2.0, 0.176, steady_state_gain=0.836), SteeringLag(13.15, 2.0, 0.073, steady_state_gain=0.835)
+)
+SETTINGS = LoopSettings(sample_time_s=0.02, prediction_time_s=0.2)
+ARC_60 = 0.4 * 9.80665 / (60 / 3.6) ** 2
+
+
+def test_the_margins_design_shortens_the_floor_and_keeps_the_margins_there() -> None:
+    """Measured: a floor of 17.5 m with the lead (omega_z 4.76, psi 1.40, omega_p 17.0 rad/s, peak gain 5.5), none
+    up to 40 m without one; about 2 s."""
+    result = design_lead_for_margins(TRUCK_60, 60 / 3.6, SETTINGS, path_curvatures_1pm=(0.0, ARC_60))
+    params = result.design.params
+    assert result.floor_m == pytest.approx(17.5, abs=1.0) and math.isnan(result.floor_without_lead_m)
+    assert math.isnan(result.margin_score) and result.design.method == "margins"
+    assert params.peak_gain <= 6.0 * (1 + 1e-9) and result.candidates > 100
+    with_lead = LoopSettings(sample_time_s=0.02, prediction_time_s=0.2, lead=params)
+    for kr in (0.0, ARC_60):
+        assert loop_margins(TRUCK_60, with_lead, 60 / 3.6, result.floor_m, kr).meets()
+        assert not loop_margins(TRUCK_60, with_lead, 60 / 3.6, result.floor_m - 1.0, kr).meets() or kr == ARC_60
+    # the bound on the peak gain holds
+    tight = design_lead_for_margins(TRUCK_60, 60 / 3.6, SETTINGS, path_curvatures_1pm=(0.0,), max_lead_gain=2.0)
+    assert tight.design.params.peak_gain <= 2.0 * (1 + 1e-9) and not tight.floor_m < result.floor_m
+
+
+def test_where_no_lookahead_keeps_the_margins_the_least_bad_filter_is_chosen() -> None:
+    result = design_lead_for_margins(TRUCK_60, 60 / 3.6, SETTINGS, max_lookahead_m=8.0, path_curvatures_1pm=(0.0,))
+    assert math.isnan(result.floor_m) and math.isnan(result.floor_without_lead_m)
+    assert 0.0 < result.margin_score < 1.0
+    assert margin_score(loop_margins(TRUCK_60, SETTINGS, 60 / 3.6, 8.0), 45.0, 6.0) < result.margin_score
+
+
+def test_margin_score() -> None:
+    ok = Margins(50.0, 8.0, -9.0, 2.0, 5.0, True, 0.9)
+    assert margin_score(ok, 45.0, 6.0) == pytest.approx(min(50 / 45, 8 / 6, 9 / 6))
+    assert margin_score(Margins(20.0, 8.0, -9.0, 2.0, 5.0, True, 0.9), 45.0, 6.0) == pytest.approx(20 / 45)
+    assert margin_score(Margins(50.0, 8.0, -9.0, 2.0, 5.0, False, 1.1), 45.0, 6.0) == -math.inf

@@ -6,7 +6,9 @@ from pathlib import Path
 
 import pytest
 
-from controllers.clothoid.filter_file import read_filter_file
+from controllers.clothoid.filter_file import read_filter_file, write_filter_file
+from controllers.clothoid.vehicle_tuning import LEAD_FILE, shipped_tuning_root
+from tuning.lag_fit import DELAY_FIT_MAX_ZETA, LagFitOptions
 from tuning.schedule import (
     ClosedLoopRow,
     FilterVerdict,
@@ -31,10 +33,11 @@ def result(truck):
 
 
 def test_the_trucks_lag_slows_with_speed(result) -> None:
-    # Measured omega_n 4.29 / 3.37 / 2.54 rad/s, zeta 0.78 / 1.20 / 1.33 at 30 / 60 / 90 km/h.
+    # Measured omega_n 4.40 / 3.22 / 2.55 rad/s, zeta 0.70 / 1.05 / 1.29 at 30 / 60 / 90 km/h (dlc, step series and
+    # chirp; without a delay).
     wn = [e.fit.lag.omega_n_rad_s for e in result.entries]
     assert wn[0] > wn[1] > wn[2]
-    assert wn == pytest.approx([4.29, 3.37, 2.54], rel=0.03)
+    assert wn == pytest.approx([4.40, 3.22, 2.55], rel=0.03)
     for e in result.entries:  # x1.56 / x2.64 / x2.91 under the default bound of 3 on the peak gain
         assert e.design.cascade_bandwidth_rad_s >= 1.5 * e.design.plant_bandwidth_rad_s
         assert e.fit.lag.speed_range_mps[0] == pytest.approx(e.speed_kmh / 3.6, rel=1e-3)
@@ -64,31 +67,35 @@ def test_fixed_and_scheduled_files_for_the_closed_loop_comparison(truck, result,
 
 
 def test_closed_loop_comparison_runs_the_clothoid_controller(truck, result, tmp_path: Path) -> None:
-    # Measured on the dlc at 60 km/h (0.3 g speed profile): max |CTE| 0.28 m with the 30 km/h filter, 2.5 m
-    # without a lead filter.
+    # Measured on the dlc at 60 km/h (0.3 g speed profile): max |CTE| 2.33 m with the 30 km/h filter (cancelling,
+    # no delay), 2.80 m without a lead filter: the controller keeps its margins by the lookahead floor it computes
+    # from the truck's lags at 60 km/h and the filter it runs, and a 30 km/h filter there needs long lookaheads.
     files = {"fixed": fixed_and_scheduled_filters(truck, result, 30.0, tmp_path)["fixed 30 km/h"], "off": None}
     rows = compare_closed_loop(lambda: make_vehicle("tractor-semitrailer"), files, [60.0])
     by_filter = {row.filter: row for row in rows}
     assert all(row.completed and row.speed_kmh == 60.0 for row in rows)
-    assert by_filter["fixed"].max_abs_cte_m < 0.5 * by_filter["off"].max_abs_cte_m
+    assert by_filter["fixed"].max_abs_cte_m < by_filter["off"].max_abs_cte_m
     # The 0.3 g profile asks for 60 km/h on the straights and slows the truck for the lane changes.
     assert by_filter["fixed"].max_speed_kmh == pytest.approx(60.0, abs=0.5)
     assert by_filter["fixed"].min_speed_kmh < 45.0
 
 
-def test_the_scheduled_filter_tracks_better_than_the_30_kmh_filter_at_60_and_80_kmh(truck, tmp_path: Path) -> None:
-    """Issue 6, item 5: `tuning schedule --speeds 20,30,...,90`, then the dlc at 60 and 80 km/h with the clothoid
-    controller's defaults. Measured: max |CTE| 0.116 / 0.119 m scheduled, 0.276 / 0.287 m with the 30 km/h
-    filter (-58 %, -59 %); 2.5 m without a filter."""
-    schedule = identify_schedule(truck, [20.0, 30.0, 40.0, 50.0, 60.0, 70.0, 80.0, 90.0])
-    files = fixed_and_scheduled_filters(truck, schedule, 30.0, tmp_path)
+def test_the_scheduled_filter_tracks_better_than_the_30_kmh_filter_at_60_and_80_kmh(tmp_path: Path) -> None:
+    """Issue 6, item 5, on the truck's shipped schedule (`python -m tuning.preset_tuning`: `tuning schedule --speeds
+    10,20,...,100 --delay --design margins`) against its own 30 km/h filter held fixed, the dlc at 60 and 80 km/h
+    with the clothoid controller's defaults. Measured: max |CTE| 0.175 / 0.172 m scheduled, 2.33 / 2.32 m with the
+    30 km/h filter (-93 %); 2.80 m without a filter."""
+    lead = shipped_tuning_root() / "tractor-semitrailer" / LEAD_FILE
+    schedule = read_filter_file(lead)
+    fixed = write_filter_file(tmp_path / "fixed.json", schedule.at_speed(30.0), source="test", speed_kmh=30.0)
+    files = {"scheduled": lead, "fixed 30 km/h": fixed}
     rows = compare_closed_loop(lambda: make_vehicle("tractor-semitrailer"), files, [60.0, 80.0])
     assert len(rows) == 4 and all(row.completed for row in rows)
     verdicts = scheduled_against_fixed(rows, "fixed 30 km/h")
     assert [v.speed_kmh for v in verdicts] == [60.0, 80.0]
     for verdict in verdicts:
         assert verdict.scheduled_better, verdict.line()
-        assert verdict.scheduled_max_abs_cte_m < 0.7 * verdict.fixed_max_abs_cte_m, verdict.line()
+        assert verdict.scheduled_max_abs_cte_m < 0.3 * verdict.fixed_max_abs_cte_m, verdict.line()
         assert verdict.scheduled_max_abs_cte_m < 0.3, verdict.line()
 
 
@@ -114,3 +121,44 @@ def test_identification_amplitude_gives_the_asked_lateral_acceleration(truck) ->
     assert steer_amplitude_deg(truck, 60.0, 0.1) == pytest.approx(25.1, abs=0.1)
     with pytest.raises(WorkbenchInputError, match="speeds must increase strictly"):
         identify_schedule(truck, [60.0, 30.0])
+
+
+@pytest.fixture(scope="module")
+def margins_result(truck):
+    return identify_schedule(truck, [30.0, 60.0], fit_options=LagFitOptions(fit_delay=True), design="margins")
+
+
+def test_the_margins_design_records_both_lags_and_the_floors(margins_result, tmp_path: Path) -> None:
+    """Measured on the loaded truck: path lag (omega_n, zeta, delay) 34.5 / 2.0 / 0.25 s at 30 km/h, 8.2 / 2.0 /
+    0.18 s at 60 km/h (zeta at its bound: a first-order lag behind a delay); measured (yaw-rate) lag 10.0 / 0.93 /
+    0.064 s and 13.1 / 2.0 / 0.073 s; floors with the lead 8.5 m and 17.5 m, none up to 40 m without one."""
+    result = margins_result
+    assert result.design == "margins" and result.fit_delay and not result.dropped
+    for e in result.entries:
+        path, measured = e.fit.lag, e.measured_fit.lag
+        assert 0.1 < path.delay_s < 0.3 and path.zeta <= DELAY_FIT_MAX_ZETA
+        assert measured.delay_s < path.delay_s  # the yaw rate leads the path curvature
+        assert e.design.method == "margins" and e.design.lead_peak_gain <= 6.0 * (1 + 1e-6)
+        assert e.margins is not None and 3.0 <= e.margins.floor_m <= 40.0
+        assert not e.margins.floor_without_lead_m <= e.margins.floor_m  # nan (none) or longer
+    floors = [e.margins.floor_m for e in result.entries]
+    assert floors == pytest.approx([8.5, 17.5], abs=1.0)
+    path = result.write(tmp_path / "lead.json")
+    schedule = read_filter_file(path)
+    design = schedule.metadata["design"]
+    assert design["method"] == "margins" and "max_cascade_peak_db" not in design
+    assert design["controller_rate_hz"] == 50.0 and design["prediction_time_s"] == 0.2
+    assert design["maneuvers"] == ["dlc", "step-series", "chirp"]
+    for row, e in zip(design["per_speed"], result.entries, strict=True):
+        assert row["measured_omega_n_rad_s"] == e.measured_fit.lag.omega_n_rad_s
+        assert row["measured_delay_s"] == e.measured_fit.lag.delay_s
+        assert row["lookahead_floor_m"] == e.margins.floor_m
+        assert "floor_without_lead_m" not in row  # none up to 40 m: left out
+    assert "floor" in result.table().splitlines()[0]
+
+
+def test_design_and_loop_options_are_checked(truck) -> None:
+    with pytest.raises(WorkbenchInputError, match="design must be one of cancel, margins"):
+        identify_schedule(truck, [30.0], design="loop")
+    with pytest.raises(WorkbenchInputError, match="controller_rate_hz must be in"):
+        identify_schedule(truck, [30.0], design="margins", controller_rate_hz=0.0)

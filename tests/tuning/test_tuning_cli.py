@@ -125,6 +125,28 @@ def test_schedule_writes_a_scheduled_filter_file_and_compares_in_closed_loop(tmp
     assert "60 km/h: max |CTE| scheduled " in table and ", fixed 30 km/h " in table
 
 
+def test_schedule_designs_for_the_margins_from_both_lags(tmp_path: Path, capsys) -> None:
+    """--design margins --delay (what the presets are made with): per speed the path and the measured lag and the
+    lookahead floors with and without the lead; the loop options recorded. (The kinematic bicycle at 40 km/h:
+    a 0.05 s first-order actuator, the same lag to both curvatures; floors 3 m with the lead, 5.5 m without.)"""
+    out = tmp_path / "lead.json"
+    argv = ["schedule", "--vehicle", "kinematic-bicycle", "--speeds", "40", "--delay", "--design", "margins"]
+    argv += ["--controller-rate-hz", "50", "--prediction-time-s", "0.2", "--out", str(out)]
+    assert main(argv) == 0
+    design = json.loads(out.read_text())["design"]
+    assert design["method"] == "margins" and design["fit_delay"] is True
+    assert (design["controller_rate_hz"], design["prediction_time_s"]) == (50.0, 0.2)
+    (row,) = design["per_speed"]
+    assert row["measured_omega_n_rad_s"] == pytest.approx(row["omega_n_rad_s"], rel=0.02)
+    assert row["lookahead_floor_m"] == pytest.approx(3.0) and row["floor_without_lead_m"] == pytest.approx(5.5)
+    captured = capsys.readouterr()
+    assert "floor_m  floor_no_lead_m" in captured.out
+    assert "lookahead floor 3 m with the lead, 5.5 m without" in captured.err
+    with pytest.raises(SystemExit) as info:  # argparse: invalid choice
+        main([*argv[:-2], "--design", "loop", "--out", str(out)])
+    assert info.value.code == 2
+
+
 # --- bad input ------------------------------------------------------------------------------------------------
 
 

@@ -37,6 +37,7 @@ from workbench.studies.runner import build_controller_config
 from workbench.studies.spec import LEAD_FILTER_SCALES, StudySpec
 from workbench.studies.store import RunStore, write_results
 from workbench.studies.sweep import execute_runs
+from workbench.vehicles.presets import load_vehicle
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -221,7 +222,7 @@ def _write_best(spec: StudySpec, out: Path, best: dict[str, Any], params: dict[s
     """DIR/best.toml (and DIR/best_lead_filter.json when the trial scaled the filter) and DIR/best.json."""
     controller = spec.controllers[0]
     run = spec.plan(params)[0]  # the options are the same in every run of the trial
-    config = build_controller_config(run, out / BEST_FILTER)
+    config = build_controller_config(run, out / BEST_FILTER, load_vehicle(run.vehicle))
     scales = {k: v for k, v in run.options if k in LEAD_FILTER_SCALES}
     header = (
         f"The best of {spec.optimise.trials if spec.optimise else '?'} trials of `workbench optimise`: trial "

@@ -26,6 +26,7 @@ from pathlib import Path
 from typing import Any
 
 from controllers import CONTROLLERS, make_controller
+from controllers.clothoid.vehicle_tuning import tuning_for
 from controllers.config_file import read_controller_config
 from workbench.metrics import METRIC_KEYS
 from workbench.result import SimulationResult
@@ -33,6 +34,7 @@ from workbench.scenarios import ScenarioOptions, make_scenario
 from workbench.simulator import Simulation, SimulationConfig
 from workbench.studies.lead_filter_scaling import write_scaled_filter
 from workbench.studies.spec import EXTRA_RUN_PARAMETERS, LEAD_FILTER_SCALES, PlannedRun
+from workbench.vehicles.base import VehicleModel
 from workbench.vehicles.presets import load_vehicle
 
 #: The status of a run that raised.
@@ -56,9 +58,12 @@ def option_text(value: Any) -> str:
     return str(value)
 
 
-def build_controller_config(run: PlannedRun, filter_path: Path | None = None) -> Any:
+def build_controller_config(
+    run: PlannedRun, filter_path: Path | None = None, vehicle: VehicleModel | None = None
+) -> Any:
     """The run's controller config: the controller-config file's table, then the run's options. With lead-filter
-    scales other than 1, the scaled filter is written to filter_path (required then) and named as `filter_file`."""
+    scales other than 1, the scaled filter (of the config's filter_file, else of the vehicle's own tuning) is
+    written to filter_path (required then) and named as `filter_file`."""
     options = dict(run.options)
     scales = {k: options.pop(k) for k in LEAD_FILTER_SCALES if k in options}
     config_type = CONTROLLERS[run.controller].config_type
@@ -68,7 +73,8 @@ def build_controller_config(run: PlannedRun, filter_path: Path | None = None) ->
     if zero != 1.0 or pole != 1.0:
         if filter_path is None:
             raise ValueError("lead-filter scales need a path for the scaled filter file")
-        path = write_scaled_filter(filter_path, config.filter_file, zero, pole)
+        base = tuning_for(vehicle).filter_schedule if vehicle is not None and config.filter_file is None else None
+        path = write_scaled_filter(filter_path, config.filter_file, zero, pole, base)
         config = dataclasses.replace(config, filter_file=path)
     return config
 
@@ -85,7 +91,7 @@ def simulate(run: PlannedRun, progress: bool = False) -> SimulationResult:
         extra["initial_offset_m"], None if heading_deg is None else math.radians(heading_deg)
     )
     with tempfile.TemporaryDirectory(prefix="workbench-run-") as tmp:
-        options = build_controller_config(run, Path(tmp) / "lead_filter.json")
+        options = build_controller_config(run, Path(tmp) / "lead_filter.json", vehicle)
         controller = make_controller(run.controller, vehicle.geometry, options, vehicle=vehicle)
     return Simulation(scenario, vehicle, controller, config).run(progress=progress)
 

@@ -60,6 +60,11 @@ class SteeringLag:
         for name in ("omega_n_rad_s", "zeta", "delay_s", "steady_state_gain", "nrmse"):
             object.__setattr__(self, name, float(getattr(self, name)))
 
+    @property
+    def group_delay_s(self) -> float:
+        """The low-frequency delay of Eq. 5 (s), -d(phase)/d(omega) at omega = 0: the pure delay plus 2 zeta / wn."""
+        return self.delay_s + 2.0 * self.zeta / self.omega_n_rad_s
+
     def to_dict(self) -> dict:
         out: dict = {
             "format": FORMAT_TAG,

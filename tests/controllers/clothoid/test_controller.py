@@ -23,7 +23,8 @@ from workbench.errors import WorkbenchInputError
 from workbench.path import ReferencePath
 from workbench.vehicles import KinematicBicycle, make_vehicle
 
-GEOMETRY = make_vehicle("tractor-semitrailer").geometry
+TRUCK = make_vehicle("tractor-semitrailer")
+GEOMETRY = TRUCK.geometry
 BEND = ClothoidChain().straight(30.0).clothoid_to(1 / 30, 20.0).arc(60.0).to_path("bend")
 STRAIGHT = ReferencePath.from_xy(np.linspace(0.0, 100.0, 11), np.zeros(11), name="straight")
 
@@ -128,7 +129,8 @@ def test_lead_filter_leads_and_can_be_switched_off() -> None:
     Eq. 6 (DC gain 1, phase lead) it runs ahead of the ramp once the filter has settled."""
     commands = {}
     for use in (False, True):
-        controller = ClothoidController(GEOMETRY, ClothoidConfig(use_lead_filter=use, lookahead_mode="fixed"))
+        config = ClothoidConfig(use_lead_filter=use, lookahead_mode="fixed", path_feedforward=False)
+        controller = ClothoidController(GEOMETRY, config, vehicle=TRUCK)
         controller.reset(STRAIGHT, 0.02)
         commands[use] = [controller.step(_m(10.0, 1.0, 0.0, 8.0), STRAIGHT) for _ in range(25)]
         raw = controller.diagnostics["steer_unfiltered_rad"]
@@ -145,8 +147,13 @@ def test_filter_file_is_read_and_a_schedule_follows_speed(tmp_path: Path) -> Non
     controller.reset(STRAIGHT, 0.02)
     controller.step(_m(10.0, 0.0, 0.0, 50.0 / 3.6), STRAIGHT)
     assert controller._filter.params == schedule.at_speed(50.0)
-    # Without a file: the documented default.
-    assert ClothoidController(GEOMETRY).filter_schedule.params == (DEFAULT_FILTER,)
+    # Without a file: the steered vehicle's own (the truck's shipped schedule), none without a vehicle, and never
+    # DEFAULT_FILTER, the truck's old filter, for another vehicle.
+    own = ClothoidController(GEOMETRY, vehicle=TRUCK).filter_schedule
+    assert own is not None and len(own.speeds_kmh) > 1 and own.params != (DEFAULT_FILTER,)
+    assert ClothoidController(GEOMETRY).filter_schedule is None
+    car = make_vehicle("dynamic-bicycle")
+    assert ClothoidController(car.geometry, vehicle=car).filter_schedule.params != own.params
 
 
 @pytest.mark.parametrize(
@@ -162,8 +169,13 @@ def test_filter_file_is_read_and_a_schedule_follows_speed(tmp_path: Path) -> Non
         ({"min_preview_time_s": -0.1}, "min_preview_time_s must be in [0.0, 10.0] s"),
         (
             {"max_lookahead_growth_m_per_m": 0.0},
-            "max_lookahead_growth_m_per_m must be None (unlimited) or a number in (0, 100] m per m travelled; got 0.0",
+            "max_lookahead_growth_m_per_m must be None (unlimited) or a number in (0, 100] m per m; got 0.0",
         ),
+        ({"max_lookahead_shrink_m_per_m": -1.0}, "max_lookahead_shrink_m_per_m must be None (unlimited)"),
+        ({"lookahead_hysteresis_m": -0.5}, "lookahead_hysteresis_m must be in [0.0, 50.0] m"),
+        ({"min_phase_margin_deg": 95.0}, "min_phase_margin_deg must be in [0.0, 89.0] deg"),
+        ({"feedforward_time_s": -0.1}, "feedforward_time_s must be in [0.0, 5.0]"),
+        ({"feedforward_window_m": 0.0}, "feedforward_window_m must be in [0.1, 100.0] m"),
         ({"max_lookahead_growth_m_per_m": True}, "max_lookahead_growth_m_per_m must be None (unlimited)"),
         ({"max_lookahead_growth_m_per_m": "fast"}, "got 'fast'"),
     ],
@@ -174,37 +186,35 @@ def test_bad_options_are_refused_with_the_value_and_what_is_allowed(options: dic
     assert needle in str(info.value)
 
 
-def test_the_lookahead_floor_is_a_preview_time_above_30_kmh() -> None:
-    """In the bend's entry the search picks the bottom of the range: 5 m at 8 m/s; at 25 m/s the default floor
-    is 0.6 s x 25 m/s = 15 m, where the paper's 5 m floor lets it pick 6.5 m (a 0.26 s preview)."""
+def test_the_lookahead_floor_is_a_preview_time_when_asked() -> None:
+    """In the bend's entry the search picks the bottom of the range: 5 m at 8 m/s without a vehicle (no analysis
+    floor); at 25 m/s min_preview_time_s = 0.6 makes the floor 0.6 s x 25 m/s = 15 m."""
     entry = _m(40.0, 0.0, 0.0, 8.0)
     fast = _m(40.0, 0.0, 0.0, 25.0)
     assert _step(entry)[1].diagnostics["lookahead_m"] == 5.0
-    assert _step(fast)[1].diagnostics["lookahead_m"] == pytest.approx(0.6 * 25.0, abs=1e-12)
-    assert _step(fast, min_preview_time_s=0.0)[1].diagnostics["lookahead_m"] == 6.5
+    assert _step(fast, min_preview_time_s=0.6)[1].diagnostics["lookahead_m"] == pytest.approx(15.0, abs=1e-12)
+    assert _step(fast)[1].diagnostics["lookahead_m"] == 6.5
 
 
-@pytest.mark.parametrize("growth", [0.3, 1.0, None])
-def test_the_lookahead_shortens_at_once_and_grows_per_metre_travelled(growth: float | None) -> None:
-    """From the bend's entry (5 m) to the straight before it, where the search picks 20 m: the lookahead grows by
-    growth x speed x dt per step (None: at once, as in the paper); back in the bend it is 5 m again at once."""
-    dt, speed = 0.02, 8.0
-    controller = ClothoidController(GEOMETRY, ClothoidConfig(max_lookahead_growth_m_per_m=growth))
-    controller.reset(BEND, dt)
-    controller.step(_m(40.0, 0.0, 0.0, speed), BEND)
-    assert controller.diagnostics["lookahead_m"] == 5.0
-    used = []
-    for _ in range(10):
-        controller.step(_m(10.0, 0.0, 0.0, speed), BEND)
-        assert controller.diagnostics["searched_lookahead_m"] == 20.0
-        used.append(controller.diagnostics["lookahead_m"])
-    if growth is None:
-        assert used == [20.0] * 10
-    else:
-        step = growth * speed * dt
-        assert used == pytest.approx([5.0 + step * k for k in range(1, 11)], abs=1e-12)
-    controller.step(_m(40.0, 0.0, 0.0, speed), BEND)
-    assert controller.diagnostics["lookahead_m"] == 5.0
+def test_the_analysis_floor_keeps_the_margins_at_every_lookahead_the_controller_may_pick() -> None:
+    """With the truck's tuning the controller never picks a lookahead below the floor the loop analysis gives, and
+    at that floor the loop keeps 45 deg and 6 dB; with the margins set to 0 there is no floor."""
+    from controllers.clothoid.loop_analysis import loop_margins
+
+    controller = ClothoidController(GEOMETRY, vehicle=TRUCK)
+    controller.reset(BEND, 0.02)
+    controller.step(_m(40.0, 0.0, 0.0, 8.0), BEND)
+    floor = controller.diagnostics["lookahead_floor_m"]
+    assert controller.diagnostics["lookahead_m"] >= floor > 5.0
+    assert floor <= 20.0  # the tuned lead filter leaves a range with margins
+    speed_kmh = controller._floors and 5.0 * next(iter(controller._floors))
+    lags, settings = controller.plant_lags(speed_kmh), controller.loop_settings(speed_kmh)
+    for lookahead in np.arange(floor, 20.0 + 1e-9, 1.0):
+        assert loop_margins(lags, settings, speed_kmh / 3.6, float(lookahead)).meets(45.0, 6.0)
+    free = ClothoidController(GEOMETRY, ClothoidConfig(min_phase_margin_deg=0.0, min_gain_margin_db=0.0), vehicle=TRUCK)
+    free.reset(BEND, 0.02)
+    free.step(_m(40.0, 0.0, 0.0, 8.0), BEND)
+    assert free.diagnostics["lookahead_floor_m"] == 5.0
 
 
 def test_missing_filter_file_names_it(tmp_path: Path) -> None:

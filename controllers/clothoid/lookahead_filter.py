@@ -1,0 +1,71 @@
+"""How the clothoid controller follows the adaptive search's choice of lookahead: never below the floor that keeps
+the loop's margins, with hysteresis, and at a limited rate in both directions.
+
+Why. The Fréchet search (section 3) re-chooses the lookahead every step and, left alone, jumps between the ends of
+its range from one step to the next (on the loaded truck's Zandvoort lap between 5 and 20 m every few steps, which
+drove its limit cycle). The loop's gain goes as L^-3 (`loop_analysis.py`), so each jump is a step change of the
+loop; margins computed for a frozen lookahead only hold while it varies slowly against the loop's own time scale,
+L / V. So:
+
+- the floor (`loop_analysis.lookahead_floor`, per speed) is a hard lower bound, applied at once;
+- a change of choice smaller than the hysteresis is ignored (the search's grid jitter);
+- the lookahead moves towards the choice by at most `max_growth_m_per_m` (longer) or `max_shrink_m_per_m`
+  (shorter) metres per metre travelled, i.e. d ln L / dt at most that times V / L, the loop's crossover scale.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from workbench.errors import WorkbenchInputError, require_in_range
+
+
+def require_rate(name: str, value: float | None) -> None:
+    """A rate limit in metres of lookahead per metre travelled: None (unlimited) or a number in (0, 100]."""
+    if value is not None and (isinstance(value, bool) or not isinstance(value, int | float) or not 0 < value <= 100):
+        raise WorkbenchInputError(f"{name} must be None (unlimited) or a number in (0, 100] m per m; got {value!r}")
+
+
+@dataclass(frozen=True)
+class LookaheadFilterSettings:
+    """hysteresis_m: changes of the search's choice smaller than this are ignored (m, >= 0); max_growth_m_per_m,
+    max_shrink_m_per_m: the most the lookahead lengthens / shortens per metre travelled (m/m; None: at once)."""
+
+    hysteresis_m: float = 0.5
+    max_growth_m_per_m: float | None = 0.3
+    max_shrink_m_per_m: float | None = 1.0
+
+    def __post_init__(self) -> None:
+        require_in_range("hysteresis_m", self.hysteresis_m, 0.0, 50.0, "m")
+        require_rate("max_growth_m_per_m", self.max_growth_m_per_m)
+        require_rate("max_shrink_m_per_m", self.max_shrink_m_per_m)
+
+
+class LookaheadFilter:
+    """The lookahead actually used, from the search's choice step by step (module docstring)."""
+
+    __slots__ = ("_current", "settings")
+
+    def __init__(self, settings: LookaheadFilterSettings) -> None:
+        self.settings = settings
+        self._current: float | None = None
+
+    def reset(self) -> None:
+        self._current = None
+
+    def step(self, choice_m: float, floor_m: float, ceiling_m: float, distance_m: float) -> float:
+        """The lookahead (m) for this step: choice_m filtered, within [floor_m, ceiling_m]; distance_m: travelled
+        since the last step (m)."""
+        s = self.settings
+        current = self._current
+        if current is None or abs(choice_m - current) <= s.hysteresis_m:
+            target = choice_m if current is None else current
+        else:
+            target = choice_m
+        if current is not None:
+            if target > current and s.max_growth_m_per_m is not None:
+                target = min(target, current + s.max_growth_m_per_m * distance_m)
+            elif target < current and s.max_shrink_m_per_m is not None:
+                target = max(target, current - s.max_shrink_m_per_m * distance_m)
+        self._current = min(max(target, floor_m), max(ceiling_m, floor_m))
+        return self._current

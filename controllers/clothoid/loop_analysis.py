@@ -1,0 +1,453 @@
+"""Linear analysis of the clothoid controller's loop: loop transfer function, gain and phase margins, closed-loop
+poles, and the limit cycle the curvature-rate limit sustains where a margin is gone.
+
+The loop (Figure 2), linearised about a straight path or a constant-curvature arc (curvature kappa_r) at speed V,
+in deviations from it: lateral offset y, heading error psi, curvature kappa.
+
+- Plant: the steering sent (as kinematic curvature u) -> the identified lag of Eq. 5 (K wn^2 / (s^2 + 2 zeta wn s +
+  wn^2), with its pure delay) -> path curvature kappa; psi' = V kappa - V kappa_r^2 y, y' = V psi (Frenet);
+  discretised with a zero-order hold at the controller period, plus any measurement delay (whole periods).
+- Controller, exactly as `controller.py` steps it: the start pose predicted over the prediction time on kappa(0)
+  (the measured curvature, yaw rate / speed, or the integrator's command); kappa' of Eq. 3 at that pose as
+  feedback on (y, psi, kappa), its gains taken by finite differences of the compiled hyper-clothoid fit to a target
+  on the path at the lookahead (so the arc's geometry is in them); kappa' V integrated by forward Euler; the lead
+  filter of Eq. 6 (Tustin). The controller's state-space is read off its own linear step function by unit probes.
+- The loop is broken at the steering sent: L(z) = -C(z) P(z), negative-feedback convention.
+
+Margins: phase margin at every gain crossover (the least reported); gain margin (how much the loop gain may rise,
+at phase crossovers where |L| < 1) and gain-reduction margin (how much it may fall, where |L| > 1: the loop is of
+type 3, integrator and double integrator, so it always has one at low frequency). The curvature-rate limit
+saturates kappa' V before the integrator: its describing function N(A) = (2 / pi) (asin(1 / a) + sqrt(1 - 1 / a^2)
+/ a), a = A / limit, a real gain in (0, 1]. Where the linear loop is unstable (|L| > 1 at a phase crossover above
+the crossover), the saturated loop oscillates at that frequency with N(A) = 1 / |L|: the limit cycle this module
+predicts, and the one the truck showed (1 Hz, +-150 deg at 5 m lookahead).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+from functools import lru_cache
+
+import control
+import numpy as np
+from scipy import signal
+
+from controllers.clothoid.clothoid_fit import fit_kernel
+from controllers.clothoid.lead_filter import DiscreteLeadFilter, LeadFilterParams
+from workbench.errors import WorkbenchInputError, require_in_range, require_positive
+from workbench.vehicles.steering_lag import SteeringLag
+
+#: Design requirement the controller keeps at every lookahead it may pick (issue 15): phase margin (deg), and gain
+#: margin (dB) both ways (rise and reduction).
+REQUIRED_PHASE_MARGIN_DEG = 45.0
+REQUIRED_GAIN_MARGIN_DB = 6.0
+#: kappa(0) choices the analysis models (the controller's "steering" is not).
+INITIAL_CURVATURES = ("yaw-rate", "command")
+#: Finite-difference step of the clothoid-law gains (m, rad and 1/m x 1 m).
+_PROBE = 1e-4
+#: Spacing (m) of the check above a bisected floor.
+_FLOOR_CHECK_M = 10.0
+#: Frequency grid points of the margin search (log-spaced up to the Nyquist frequency).
+_GRID_POINTS = 2000
+
+
+@dataclass(frozen=True)
+class LoopSettings:
+    """What the controller does, for the analysis: sample_time_s (controller period, s), prediction_time_s (pose
+    prediction, s), initial_curvature (kappa(0) of Eq. 3: "yaw-rate", the measured curvature, or "command", the
+    integrator's), lead (Eq. 6 filter, None: off), measurement_delay_s (s, rounded to whole periods)."""
+
+    sample_time_s: float = 0.02
+    prediction_time_s: float = 0.2
+    initial_curvature: str = "yaw-rate"
+    lead: LeadFilterParams | None = None
+    measurement_delay_s: float = 0.0
+
+    def __post_init__(self) -> None:
+        require_in_range("sample_time_s", self.sample_time_s, 1e-4, 1.0, "s")
+        require_in_range("prediction_time_s", self.prediction_time_s, 0.0, 2.0, "s")
+        require_in_range("measurement_delay_s", self.measurement_delay_s, 0.0, 2.0, "s")
+        if self.initial_curvature not in INITIAL_CURVATURES:
+            raise WorkbenchInputError(
+                f"initial_curvature must be one of {', '.join(INITIAL_CURVATURES)} for the analysis; got "
+                f"{self.initial_curvature!r}"
+            )
+
+
+@dataclass(frozen=True)
+class Margins:
+    """Stability margins of one loop. phase_margin_deg: least over gain crossovers (inf without one);
+    gain_margin_db: how far the loop gain may rise (> 0; inf without a phase crossover below |L| = 1);
+    gain_reduction_margin_db: how far it may fall (< 0; -inf without one); crossover_rad_s: the highest gain
+    crossover; phase_crossover_rad_s: the frequency of the gain margin (nan without one); stable: all closed-loop
+    poles inside the unit circle; spectral_radius: their largest magnitude."""
+
+    phase_margin_deg: float
+    gain_margin_db: float
+    gain_reduction_margin_db: float
+    crossover_rad_s: float
+    phase_crossover_rad_s: float
+    stable: bool
+    spectral_radius: float
+
+    def meets(
+        self, phase_margin_deg: float = REQUIRED_PHASE_MARGIN_DEG, gain_margin_db: float = REQUIRED_GAIN_MARGIN_DB
+    ) -> bool:
+        """Stable, with at least this phase margin and this gain margin both ways."""
+        return (
+            self.stable
+            and self.phase_margin_deg >= phase_margin_deg
+            and self.gain_margin_db >= gain_margin_db
+            and self.gain_reduction_margin_db <= -gain_margin_db
+        )
+
+
+@dataclass(frozen=True)
+class LimitCyclePrediction:
+    """The describing-function prediction for the saturated curvature rate: frequency_hz, rate_amplitude_1pm_s
+    (amplitude of kappa' V at the saturation's input), curvature_amplitude_1pm (of the integrated command),
+    steer_wheel_amplitude_deg (of the steering sent, with the geometry given; nan without)."""
+
+    frequency_hz: float
+    rate_amplitude_1pm_s: float
+    curvature_amplitude_1pm: float
+    steer_wheel_amplitude_deg: float
+
+
+@lru_cache(maxsize=8192)
+def clothoid_law_gains(lookahead_m: float, path_curvature_1pm: float = 0.0) -> tuple[float, float, float]:
+    """d kappa' / d (y, psi, kappa) (1/m^3, 1/m^2, 1/m) of Eq. 3's hyper-clothoid at a pose on an arc of curvature
+    path_curvature_1pm (a straight for 0) to the path point at Euclidean distance lookahead_m, by central
+    differences of the compiled fit (`clothoid_fit.fit_kernel`). About a straight they are -6 / L^3 (1, L, L^2 / 2)
+    (small angles), the law the module docstring of `controller.py` derives."""
+    require_positive("lookahead_m", lookahead_m)
+    kr = float(path_curvature_1pm)
+    if abs(kr) * lookahead_m >= 1.9:
+        raise WorkbenchInputError(
+            f"lookahead_m x |path_curvature_1pm| must be < 1.9 (a target on the arc ahead); got {lookahead_m!r} x "
+            f"{kr!r}"
+        )
+
+    def kdot(y: float, psi: float, kappa: float) -> float:
+        # The pose: on the arc's normal at the origin, y to the left, heading psi; the arc x = sin(kr s) / kr ...
+        px, py = 0.0, y
+        if kr == 0.0:
+            tx, ty = px + math.sqrt(max(lookahead_m**2 - py**2, 0.0)), 0.0
+        else:  # the arc point at distance lookahead_m from the pose: solve on the circle's angle by bisection
+            lo, hi = 0.0, 2.0 * math.asin(min(1.0, abs(kr) * lookahead_m / 2.0) + 1e-12) / abs(kr) + 1.0
+            for _ in range(60):
+                mid = 0.5 * (lo + hi)
+                ax, ay = math.sin(kr * mid) / kr, (1.0 - math.cos(kr * mid)) / kr
+                if math.hypot(ax - px, ay - py) < lookahead_m:
+                    lo = mid
+                else:
+                    hi = mid
+            s = 0.5 * (lo + hi)
+            tx, ty = math.sin(kr * s) / kr, (1.0 - math.cos(kr * s)) / kr
+        value, *_ = fit_kernel(px, py, psi, kr + kappa, tx, ty, 1e6)
+        return value
+
+    h = _PROBE
+    return (
+        (kdot(h, 0.0, 0.0) - kdot(-h, 0.0, 0.0)) / (2 * h),
+        (kdot(0.0, h, 0.0) - kdot(0.0, -h, 0.0)) / (2 * h),
+        (kdot(0.0, 0.0, h * 1e-2) - kdot(0.0, 0.0, -h * 1e-2)) / (2 * h * 1e-2),
+    )
+
+
+def _delay_steps(seconds: float, dt: float) -> int:
+    return round(seconds / dt)
+
+
+@dataclass(frozen=True)
+class PlantLags:
+    """The vehicle as the loop sees it: path (Eq. 5 from the steering sent to the path curvature, which turns the
+    course and moves the rear axle; `tuning fit-lag --curvature-from path`) and measured (to the curvature the
+    controller measures, yaw rate / speed, which leads the path curvature by the sideslip's rate; `--curvature-from
+    yaw-rate`; None: the path curvature itself)."""
+
+    path: SteeringLag
+    measured: SteeringLag | None = None
+
+
+def _plant_parts(
+    lags: PlantLags, speed_mps: float, path_curvature_1pm: float, settings: LoopSettings
+) -> tuple[control.StateSpace, tuple[int, int]]:
+    """The plant without its delays: two inputs (the steering reaching the path lag, the measured lag), outputs (y,
+    psi, kappa measured); and each input's delay in whole periods."""
+    require_positive("speed_mps", speed_mps)
+    dt, v, kr = settings.sample_time_s, float(speed_mps), float(path_curvature_1pm)
+    path, measured = lags.path, lags.measured or lags.path
+    wn, zeta, gain = path.omega_n_rad_s, path.zeta, path.steady_state_gain
+    mn, mz, mk = measured.omega_n_rad_s, measured.zeta, measured.steady_state_gain
+    # states: path lag (2), psi, y, measured lag (2)
+    a_c = np.zeros((6, 6))
+    a_c[0, 1], a_c[1, 0], a_c[1, 1] = 1.0, -(wn**2), -2.0 * zeta * wn
+    a_c[2, 0], a_c[2, 3], a_c[3, 2] = v * gain, -v * kr * kr, v
+    a_c[4, 5], a_c[5, 4], a_c[5, 5] = 1.0, -(mn**2), -2.0 * mz * mn
+    b_c = np.zeros((6, 2))
+    b_c[1, 0], b_c[5, 1] = wn**2, mn**2
+    c_c = np.zeros((3, 6))
+    c_c[0, 3], c_c[1, 2], c_c[2, 4] = 1.0, 1.0, mk
+    a, b, c, d, _ = signal.cont2discrete((a_c, b_c, c_c, np.zeros((3, 2))), dt, method="zoh")
+    extra = settings.measurement_delay_s
+    taps = (_delay_steps(path.delay_s + extra, dt), _delay_steps(measured.delay_s + extra, dt))
+    return control.ss(a, b, c, d, dt), taps
+
+
+def plant(lags: PlantLags, speed_mps: float, path_curvature_1pm: float, settings: LoopSettings) -> control.StateSpace:
+    """The plant, discrete at the controller period: input the steering sent as kinematic curvature (1/m), outputs
+    (y m, psi rad, kappa 1/m) as the controller measures them (module docstring); the delays as a delay line."""
+    parts, taps = _plant_parts(lags, speed_mps, path_curvature_1pm, settings)
+    a, b, c = np.asarray(parts.A), np.asarray(parts.B), np.asarray(parts.C)
+    n = max(taps)
+    # a delay line u -> d1 -> ... -> dn in front; input j of the lags takes tap taps[j] (0: u itself)
+    a_full = np.zeros((6 + n, 6 + n))
+    a_full[:6, :6] = a
+    b_full = np.zeros((6 + n, 1))
+    for j, tap in enumerate(taps):
+        if tap:
+            a_full[:6, 6 + tap - 1] += b[:, j]
+        else:
+            b_full[:6, 0] += b[:, j]
+    if n:
+        b_full[6, 0] = 1.0
+        for i in range(1, n):
+            a_full[6 + i, 6 + i - 1] = 1.0
+    return control.ss(a_full, b_full, np.hstack([c, np.zeros((3, n))]), np.zeros((3, 1)), parts.dt)
+
+
+def _controller_step(
+    settings: LoopSettings, speed_mps: float, gains: tuple[float, float, float]
+) -> tuple[int, Callable[[np.ndarray, np.ndarray], tuple[np.ndarray, float]]]:
+    """(state size, step(state, [y, psi, kappa]) -> (next state, curvature sent)): the controller's step in deviation
+    variables, linear, in the order `controller.py` runs it. State: [kappa_cmd, lead filter (3)]."""
+    dt, v = settings.sample_time_s, float(speed_mps)
+    g_y, g_psi, g_k = gains
+    if settings.lead is not None:
+        a_f, b_f, c_f, d_f = DiscreteLeadFilter(settings.lead, dt).state_space
+        a_f, b_f, c_f = np.array(a_f), np.array(b_f), np.array(c_f)
+    dp = v * settings.prediction_time_s
+    measured = settings.initial_curvature == "yaw-rate"
+
+    def step(s: np.ndarray, meas: np.ndarray) -> tuple[np.ndarray, float]:
+        y, psi, kappa_meas = meas
+        kappa0 = kappa_meas if measured else s[0]
+        yp, psip = y + psi * dp + 0.5 * kappa0 * dp * dp, psi + kappa0 * dp  # the chord formula, linearised
+        kappa_cmd = s[0] + dt * v * (g_y * yp + g_psi * psip + g_k * kappa0)
+        nxt = np.zeros(4)
+        nxt[0] = kappa_cmd
+        if settings.lead is None:
+            return nxt, kappa_cmd
+        f = s[1:4]
+        nxt[1:4] = a_f @ f + b_f * kappa_cmd
+        return nxt, float(c_f @ f + d_f * kappa_cmd)
+
+    return 4, step
+
+
+def controller(
+    settings: LoopSettings, lags: PlantLags, speed_mps: float, lookahead_m: float, path_curvature_1pm: float = 0.0
+) -> control.StateSpace:
+    """The controller linearised (module docstring): inputs (y, psi, kappa), output the steering sent as curvature;
+    read off its linear step by unit probes."""
+    gains = clothoid_law_gains(lookahead_m, path_curvature_1pm)
+    size, step = _controller_step(settings, speed_mps, gains)
+    a, c = np.zeros((size, size)), np.zeros((1, size))
+    b, d = np.zeros((size, 3)), np.zeros((1, 3))
+    for i in range(size):
+        e = np.zeros(size)
+        e[i] = 1.0
+        a[:, i], c[0, i] = step(e, np.zeros(3))
+    for j in range(3):
+        e = np.zeros(3)
+        e[j] = 1.0
+        b[:, j], d[0, j] = step(np.zeros(size), e)
+    return control.ss(a, b, c, d, settings.sample_time_s)
+
+
+def loop_transfer(
+    lags: PlantLags, settings: LoopSettings, speed_mps: float, lookahead_m: float, path_curvature_1pm: float = 0.0
+) -> control.StateSpace:
+    """L(z) = -C(z) P(z), broken at the steering sent (negative-feedback convention: the closed loop is
+    feedback(L, 1))."""
+    p = plant(lags, speed_mps, path_curvature_1pm, settings)
+    c = controller(settings, lags, speed_mps, lookahead_m, path_curvature_1pm)
+    return -control.series(p, c)
+
+
+def _response(loop: control.StateSpace, omega: np.ndarray) -> np.ndarray:
+    """L(e^{j omega dt}) = C (zI - A)^-1 B + D, by a batched linear solve per frequency (transfer-function
+    polynomials of this order lose the low frequencies to rounding, where the loop's integrators sit)."""
+    a, b, c, d = (np.asarray(m, dtype=float) for m in (loop.A, loop.B, loop.C, loop.D))
+    z = np.exp(1j * omega * loop.dt)
+    lhs = z[:, None, None] * np.eye(a.shape[0]) - a
+    x = np.linalg.solve(lhs, np.broadcast_to(b[:, :1], (omega.size, a.shape[0], 1)).astype(complex))
+    return (c[:1] @ x)[:, 0, 0] + d[0, 0]
+
+
+def margins(loop: control.StateSpace) -> Margins:
+    """Margins of a discrete SISO loop (see Margins), from its frequency response on a log grid up to the Nyquist
+    frequency, crossings refined by interpolation; stability from the closed-loop poles."""
+    nyquist = math.pi / loop.dt
+    omega = np.logspace(math.log10(nyquist) - 5.0, math.log10(nyquist * (1 - 1e-6)), _GRID_POINTS)
+    return _margins_from(omega, _response(loop, omega), control.feedback(loop, 1).poles())
+
+
+def _margins_from(omega: np.ndarray, resp: np.ndarray, poles: np.ndarray) -> Margins:
+    log_mag = np.log(np.abs(resp))
+    phase = np.angle(resp)
+    pm, crossover = math.inf, 0.0
+    for i in np.flatnonzero(np.sign(log_mag[:-1]) != np.sign(log_mag[1:])):
+        f = log_mag[i] / (log_mag[i] - log_mag[i + 1])
+        r = resp[i] + f * (resp[i + 1] - resp[i])
+        pm = min(pm, 180.0 - abs(math.degrees(math.atan2(r.imag, r.real))))
+        crossover = max(crossover, omega[i] + f * (omega[i + 1] - omega[i]))
+    gm_up, gm_down, w_pc = math.inf, 0.0, math.nan
+    im = resp.imag
+    for i in np.flatnonzero(np.sign(im[:-1]) != np.sign(im[1:])):
+        f = im[i] / (im[i] - im[i + 1])
+        re = resp[i].real + f * (resp[i + 1].real - resp[i].real)
+        if re >= 0.0 or not (abs(phase[i]) > math.pi / 2 and abs(phase[i + 1]) > math.pi / 2):
+            continue
+        g = 1.0 / abs(re)
+        if g > 1.0 and g < gm_up:
+            gm_up, w_pc = g, omega[i] + f * (omega[i + 1] - omega[i])
+        elif g < 1.0:
+            gm_down = max(gm_down, g)
+    radius = float(np.max(np.abs(poles))) if poles.size else 0.0
+    return Margins(
+        phase_margin_deg=pm,
+        gain_margin_db=20.0 * math.log10(gm_up) if math.isfinite(gm_up) else math.inf,
+        gain_reduction_margin_db=20.0 * math.log10(gm_down) if gm_down > 0 else -math.inf,
+        crossover_rad_s=crossover if crossover > 0 else math.nan,
+        phase_crossover_rad_s=w_pc,
+        stable=radius < 1.0,
+        spectral_radius=radius,
+    )
+
+
+def saturation_describing_function(amplitude_ratio: float | np.ndarray) -> np.ndarray:
+    """N(a) of a unit saturation for a sinusoid of amplitude a x the limit: 1 for a <= 1, else (2 / pi) (asin(1 /
+    a) + sqrt(1 - 1 / a^2) / a)."""
+    a = np.maximum(np.asarray(amplitude_ratio, dtype=float), 1.0)
+    return np.minimum((2.0 / math.pi) * (np.arcsin(1.0 / a) + np.sqrt(1.0 - 1.0 / a**2) / a), 1.0)  # <= 1 exactly
+
+
+def predicted_limit_cycle(
+    loop: control.StateSpace,
+    rate_limit_1pm_s: float,
+    lead: LeadFilterParams | None = None,
+    steer_per_curvature_rad_m: float = math.nan,
+) -> LimitCyclePrediction | None:
+    """The limit cycle the curvature-rate saturation sustains (module docstring), or None when the linear loop is
+    stable or has no phase crossover with |L| > 1 (the saturation's -1 / N lies on the negative real axis left of
+    -1, so only such a crossing can meet it; of several, the fastest). The amplitude solves
+    N(A / limit) = 1 / |L(j w)| by bisection. steer_per_curvature_rad_m: steering-wheel angle per curvature
+    (steering ratio x wheelbase) for the steering amplitude."""
+    require_positive("rate_limit_1pm_s", rate_limit_1pm_s)
+    if margins(loop).stable:
+        return None
+    nyquist = math.pi / loop.dt
+    omega = np.logspace(math.log10(nyquist) - 4.0, math.log10(nyquist * (1 - 1e-6)), _GRID_POINTS)
+    resp = _response(loop, omega)
+    mag = np.abs(resp)
+    crossings = [
+        i
+        for i in np.flatnonzero(np.sign(resp.imag[:-1]) != np.sign(resp.imag[1:]))
+        if resp[i].real < 0.0 and mag[i] > 1.0
+    ]
+    if not crossings:
+        return None
+    best = max(crossings)  # the fastest: the oscillation the saturation holds (the slower ones it passes through)
+    target = 1.0 / mag[best]
+    lo, hi = 1.0, 1e9
+    for _ in range(200):
+        mid = math.sqrt(lo * hi)
+        if saturation_describing_function(mid) > target:
+            lo = mid
+        else:
+            hi = mid
+    w = float(omega[best])
+    rate_amp = math.sqrt(lo * hi) * rate_limit_1pm_s
+    curvature_amp = target * rate_amp / w
+    lead_gain = float(lead.gain_at(w)) if lead is not None else 1.0
+    return LimitCyclePrediction(
+        frequency_hz=w / (2 * math.pi),
+        rate_amplitude_1pm_s=rate_amp,
+        curvature_amplitude_1pm=curvature_amp,
+        steer_wheel_amplitude_deg=math.degrees(curvature_amp * lead_gain * steer_per_curvature_rad_m),
+    )
+
+
+def _batched_response(system: control.StateSpace, z: np.ndarray) -> np.ndarray:
+    """C (zI - A)^-1 B + D at each z, shape (len(z), outputs, inputs)."""
+    a, b, c, d = (np.asarray(m, dtype=float) for m in (system.A, system.B, system.C, system.D))
+    lhs = z[:, None, None] * np.eye(a.shape[0]) - a
+    return c @ np.linalg.solve(lhs, np.broadcast_to(b, (z.size, *b.shape)).astype(complex)) + d
+
+
+@lru_cache(maxsize=8192)
+def loop_margins(
+    lags: PlantLags, settings: LoopSettings, speed_mps: float, lookahead_m: float, path_curvature_1pm: float = 0.0
+) -> Margins:
+    """margins(loop_transfer(...)), cached (all arguments are frozen values), with the frequency response composed
+    from the delay-free plant (6 states), its delays as z^-n and the controller (4 states): the same numbers, a
+    fraction of the work, for the controller's floor search."""
+    parts, taps = _plant_parts(lags, speed_mps, path_curvature_1pm, settings)
+    ctrl = controller(settings, lags, speed_mps, lookahead_m, path_curvature_1pm)
+    nyquist = math.pi / settings.sample_time_s
+    omega = np.logspace(math.log10(nyquist) - 5.0, math.log10(nyquist * (1 - 1e-6)), _GRID_POINTS)
+    z = np.exp(1j * omega * settings.sample_time_s)
+    p = _batched_response(parts, z)  # (n, 3, 2)
+    delays = np.stack([z ** (-tap) for tap in taps], axis=1)  # (n, 2)
+    plant_response = np.einsum("nij,nj->ni", p, delays)  # (n, 3)
+    c = _batched_response(ctrl, z)[:, 0, :]  # (n, 3)
+    response = -np.einsum("ni,ni->n", c, plant_response)
+    poles = control.feedback(-control.series(plant(lags, speed_mps, path_curvature_1pm, settings), ctrl), 1).poles()
+    return _margins_from(omega, response, poles)
+
+
+def lookahead_floor(
+    lags: PlantLags,
+    settings: LoopSettings,
+    speed_mps: float,
+    min_lookahead_m: float,
+    max_lookahead_m: float,
+    step_m: float = 0.25,
+    path_curvatures_1pm: tuple[float, ...] = (0.0,),
+    phase_margin_deg: float = REQUIRED_PHASE_MARGIN_DEG,
+    gain_margin_db: float = REQUIRED_GAIN_MARGIN_DB,
+) -> float:
+    """The shortest lookahead (m, on a grid of step_m from min_lookahead_m) from which every lookahead up to
+    max_lookahead_m keeps the required margins about each of the path curvatures; max_lookahead_m when none does.
+    A bisection on the grid (margins mostly improve with the lookahead: the loop's gain falls as L^-3), then a check
+    every _FLOOR_CHECK_M above the result; a failure there restarts the bisection above it."""
+    grid = np.arange(min_lookahead_m, max_lookahead_m + 1e-9, step_m)
+    if grid.size == 0 or grid[-1] < max_lookahead_m - 1e-9:
+        grid = np.append(grid, max_lookahead_m)
+
+    def ok(i: int) -> bool:
+        return all(
+            loop_margins(lags, settings, float(speed_mps), float(grid[i]), kr).meets(phase_margin_deg, gain_margin_db)
+            for kr in path_curvatures_1pm
+            if abs(kr) * grid[i] < 1.8
+        )
+
+    if not ok(grid.size - 1):
+        return float(grid[-1])
+    lo, hi = -1, grid.size - 1
+    while True:  # bisect for the shortest ok, then check the rest coarsely; a failure above starts over above it
+        while hi - lo > 1:
+            mid = (lo + hi) // 2
+            if ok(mid):
+                hi = mid
+            else:
+                lo = mid
+        stride = max(1, round(_FLOOR_CHECK_M / step_m))
+        failing = [i for i in range(hi + stride, grid.size - 1, stride) if not ok(i)]
+        if not failing:
+            return float(grid[hi])
+        lo, hi = failing[-1], grid.size - 1

@@ -1,0 +1,102 @@
+"""The path's own clothoid as the reference of the clothoid controller's feedback, and its curvature rate as
+feed-forward: a two-degree-of-freedom form of Eq. 3 that makes tracking independent of the lookahead.
+
+Why. Eq. 3 fits one clothoid from the vehicle's (predicted) pose to a target point at the lookahead L on the path.
+Even with the vehicle exactly on the path its curvature rate is not the path's: for a path whose curvature varies
+within L the fit through one point gives kappa' = kappa_p' + kappa_p'' L / 4 + ..., so the vehicle turns in ahead
+of the path by about L / 4 and cuts every transition; the feedback then fights that error with a gain that falls
+as L^-3. Measured on the kinematic bicycle's dlc at 30 km/h, fixed lookahead: max |CTE| 0.006 m at 3 m, 0.073 m at
+6 m, 0.227 m at 9 m. Tracking therefore asked for short lookaheads, and short lookaheads are where the loop loses
+its margins (`loop_analysis.py`): the limit cycles of issue 15.
+
+What. The same hyper-clothoid is fitted twice to the same target: from the vehicle's predicted pose (as Eq. 3)
+and from the reference pose, where a vehicle exactly on the path would be predicted to (the path's pose ahead by
+the reference lead, then moved on the path's curvature there like the vehicle's prediction). Their difference is
+zero on the path and is the feedback; the path's curvature rate, at the point the steering now commanded will be
+realised (the vehicle's lag ahead), averaged over a window, is the feed-forward:
+
+    kappa' = kappa'(vehicle pose -> target) - kappa'(reference pose -> target) + kappa_p'(s + V tau_ff) / K
+
+Linearised, the reference term depends on the path only, so the loop and its margins are those of Eq. 3 alone
+(`loop_analysis.py`); what changes is that the loop no longer has to produce the path's curvature by error. K is
+the vehicle's steady-state gain (understeer) from its identified lag. The timings come from the identified lags:
+tau_ff is the low-frequency delay of lead filter and path lag (Eq. 6 and Eq. 5), and the reference lead is how much
+the path curvature lags the yaw-rate curvature that the controller measures as kappa(0) (a truck's tandem and
+trailer make this about 0.12 s at 30 km/h; a car's is a few hundredths).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from controllers.clothoid.clothoid_fit import fit_kernel
+from workbench.errors import require_in_range
+from workbench.path import Projection, ReferencePath
+
+#: Saturation of the reference fit's kappa' (1/m^2): far above any path's, so the fit is never clipped.
+_REFERENCE_KDOT_MAX = 1e6
+
+
+@dataclass(frozen=True)
+class FeedforwardTiming:
+    """feedforward_time_s: where along the path (speed x time ahead of the vehicle's foot point) the feed-forward
+    reads the curvature rate (s, >= 0); reference_lead_s: how far ahead of the foot point the reference pose starts
+    (s, >= 0; at most the prediction time); steady_state_gain: K of Eq. 5 (> 0)."""
+
+    feedforward_time_s: float
+    reference_lead_s: float
+    steady_state_gain: float = 1.0
+
+    def __post_init__(self) -> None:
+        require_in_range("feedforward_time_s", self.feedforward_time_s, 0.0, 5.0, "s")
+        require_in_range("reference_lead_s", self.reference_lead_s, 0.0, 5.0, "s")
+        require_in_range("steady_state_gain", self.steady_state_gain, 0.05, 20.0)
+
+
+def path_curvature_rate(path: ReferencePath, s_m: float, window_m: float) -> float:
+    """dkappa/ds (1/m^2) of the path at s, averaged over [s - window / 2, s + window / 2]."""
+    half = 0.5 * window_m
+    return (path.curvature(s_m + half) - path.curvature(s_m - half)) / window_m
+
+
+def reference_pose(
+    path: ReferencePath, here: Projection, speed_mps: float, prediction_time_s: float, reference_lead_s: float
+) -> tuple[float, float, float, float]:
+    """(x, y, heading, curvature) of the reference: the path's pose reference_lead_s ahead of the foot point, moved
+    over the rest of the prediction time on the path's curvature there, by the chord of that arc (as the vehicle's
+    own prediction)."""
+    lead = min(reference_lead_s, prediction_time_s)
+    s_ref = here.s_m + speed_mps * lead
+    if lead > 0.0:
+        x, y = path.position(s_ref)
+        heading, kappa = path.heading(s_ref), path.curvature(s_ref)
+    else:
+        x, y, heading, kappa = here.x_m, here.y_m, here.heading_rad, here.curvature_1pm
+    d = speed_mps * (prediction_time_s - lead)
+    half_turn = 0.5 * kappa * d
+    chord = d * (math.sin(half_turn) / half_turn if abs(half_turn) > 1e-9 else 1.0)
+    return (
+        float(x) + chord * math.cos(heading + half_turn),
+        float(y) + chord * math.sin(heading + half_turn),
+        heading + 2.0 * half_turn,
+        kappa,
+    )
+
+
+def two_degree_of_freedom_rate(
+    vehicle_kdot: float,
+    path: ReferencePath,
+    here: Projection,
+    target_xy: tuple[float, float],
+    speed_mps: float,
+    prediction_time_s: float,
+    timing: FeedforwardTiming,
+    window_m: float,
+) -> tuple[float, float, float]:
+    """(kappa' to integrate, the reference's kappa', the feed-forward kappa') (1/m^2), module docstring."""
+    rx, ry, rh, rk = reference_pose(path, here, speed_mps, prediction_time_s, timing.reference_lead_s)
+    reference_kdot, *_ = fit_kernel(rx, ry, rh, rk, target_xy[0], target_xy[1], _REFERENCE_KDOT_MAX)
+    feedforward = path_curvature_rate(path, here.s_m + speed_mps * timing.feedforward_time_s, window_m)
+    feedforward /= timing.steady_state_gain
+    return vehicle_kdot - reference_kdot + feedforward, reference_kdot, feedforward
