@@ -67,6 +67,7 @@ from dataclasses import dataclass, replace
 
 import control
 import numpy as np
+from threadpoolctl import threadpool_limits
 
 from controllers.clothoid.lead_filter import OMEGA_RANGE_RAD_S, POLE_RATIO_RANGE, PSI_MAX, LeadFilterParams
 from controllers.clothoid.loop_analysis import (
@@ -443,7 +444,28 @@ def design_lead_for_margins(
 
     Where no candidate keeps the margins at any lookahead up to max_lookahead_m (the loaded truck at 100 km/h just
     does, at 40 m), the floor is nan and the candidate with the best `margin_score` at max_lookahead_m (the least
-    bad loop there) is chosen, its score reported. Refused (WorkbenchInputError) when no candidate meets max_lead_gain."""
+    bad loop there) is chosen, its score reported. Refused (WorkbenchInputError) when no candidate meets
+    max_lead_gain. BLAS runs single-threaded meanwhile (the loop analyses are many small matrix problems, several
+    times slower threaded on a small machine)."""
+    with threadpool_limits(limits=1, user_api="blas"):
+        return _design_lead_for_margins(
+            lags, speed_mps, settings, min_lookahead_m, max_lookahead_m, lookahead_step_m, path_curvatures_1pm,
+            max_lead_gain, phase_margin_deg, gain_margin_db,
+        )  # fmt: skip
+
+
+def _design_lead_for_margins(
+    lags: PlantLags,
+    speed_mps: float,
+    settings: LoopSettings,
+    min_lookahead_m: float,
+    max_lookahead_m: float,
+    lookahead_step_m: float,
+    path_curvatures_1pm: tuple[float, ...],
+    max_lead_gain: float,
+    phase_margin_deg: float,
+    gain_margin_db: float,
+) -> MarginsDesign:
     require_in_range("max_lead_gain", max_lead_gain, 1.0, 1000.0)
     require_in_range("speed_mps", speed_mps, 0.1, 100.0, "m/s")
     floor_args = (speed_mps, min_lookahead_m, max_lookahead_m, lookahead_step_m, path_curvatures_1pm,

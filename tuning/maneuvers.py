@@ -9,9 +9,13 @@ Why the chirp: the step responses and the dlc have little energy above about 1 H
 damping of Eq. 5 differ (both add phase lag; only the damping also bends the magnitude), so a fit of Eq. 5 with a
 delay to them alone trades one for the other (the loaded truck's zeta ran to 7-10 from 40 km/h, the delay jumping
 with it). The sweep puts equal energy in every octave up to 2 Hz (12.6 rad/s), past the loop's crossover, so the
-fit sees the frequency response there. With max_rate_deg_s its amplitude falls as 1 / frequency where the
-amplitude x 2 pi f would exceed that steering-wheel rate, so that a large low-speed amplitude does not drive the
-actuator into its rate limit (a nonlinearity the linear lag cannot describe).
+fit sees the frequency response there.
+
+max_rate_deg_s limits the steering-wheel rate of any profile (slew-rate limiting: the steps become ramps), and the
+chirp's amplitude falls as 1 / frequency where amplitude x 2 pi f would exceed it, so that the large amplitudes of
+low speeds do not drive the actuator into its rate limit (a nonlinearity the linear lag cannot describe: the
+kinematic bicycle, a 0.05 s first-order actuator, identified as omega_n 16.5 rad/s at 20 km/h against 139-154 at
+higher speeds before; 80 rad/s, zeta 2 at every speed with the limit at half the actuator's).
 """
 
 from __future__ import annotations
@@ -34,8 +38,8 @@ class Maneuver:
     step: 0 until start_s, then amplitude. step-series: steps of +amplitude, 0, -amplitude, 0 ... each held
     hold_s. dlc: amplitude * sin(2 pi (t - start) / period) for one period, a hold of hold_s, then the opposite.
     chirp: amplitude * sin(phase(t)) from start_s to duration_s, the frequency rising exponentially from start_hz
-    to end_hz; with max_rate_deg_s (deg/s, None: no cap) the amplitude at frequency f is at most
-    max_rate_deg_s / (2 pi f).
+    to end_hz, its amplitude at frequency f at most max_rate_deg_s / (2 pi f). max_rate_deg_s (deg/s, None: no
+    limit): every profile is slew-rate limited to it.
     """
 
     kind: str

@@ -134,12 +134,14 @@ def schedule_figure(result: ScheduleResult, path: str | Path) -> Path:
     rows = [e.row() for e in result.entries]
     speeds = [r["speed_kmh"] for r in rows]
     fig, (a1, a2) = plt.subplots(2, 1, figsize=(8, 6.5), sharex=True, layout="constrained")
-    a1.plot(speeds, [r["omega_n_rad_s"] for r in rows], "o-", label="ωn (lag) = ωz (filter)")
+    a1.plot(speeds, [r["omega_n_rad_s"] for r in rows], "o-", label="ωn (lag)")
+    a1.plot(speeds, [r["omega_z_rad_s"] for r in rows], "x:", label="ωz (filter)")
     a1.plot(speeds, [r["omega_p_rad_s"] for r in rows], "s-", label="ωp (filter)")
     a1.plot(speeds, [r["plant_bandwidth_rad_s"] for r in rows], "^--", label="plant bandwidth")
     a1.plot(speeds, [r["cascade_bandwidth_rad_s"] for r in rows], "v--", label="cascade bandwidth")
     a1.set_ylabel("rad/s")
-    a2.plot(speeds, [r["zeta"] for r in rows], "o-", label="ζ (lag) = ψ (filter)")
+    a2.plot(speeds, [r["zeta"] for r in rows], "o-", label="ζ (lag)")
+    a2.plot(speeds, [r["psi"] for r in rows], "x:", label="ψ (filter)")
     a2.plot(speeds, [r["steady_state_gain"] for r in rows], "s-", label="steady-state gain K")
     a2.set_xlabel("speed [km/h]")
     for ax in (a1, a2):

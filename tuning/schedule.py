@@ -44,7 +44,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-from threadpoolctl import threadpool_limits
 
 from controllers.clothoid import ClothoidConfig, ClothoidController
 from controllers.clothoid.filter_file import FilterSchedule, write_filter_file
@@ -353,15 +352,14 @@ def identify_schedule(
             if design == "cancel":
                 lead = design_lead(fit.lag, max_lead_gain=max_lead_gain, max_cascade_peak_db=max_cascade_peak_db)
             else:
-                with threadpool_limits(limits=1, user_api="blas"):
-                    margins = design_lead_for_margins(
-                        PlantLags(fit.lag, measured.lag),
-                        speed / 3.6,
-                        settings,
-                        *MARGINS_LOOKAHEAD_M,
-                        path_curvatures_1pm=(0.0, margins_arc_curvature_1pm(vehicle, speed)),
-                        max_lead_gain=max_lead_gain,
-                    )
+                margins = design_lead_for_margins(
+                    PlantLags(fit.lag, measured.lag),
+                    speed / 3.6,
+                    settings,
+                    *MARGINS_LOOKAHEAD_M,
+                    path_curvatures_1pm=(0.0, margins_arc_curvature_1pm(vehicle, speed)),
+                    max_lead_gain=max_lead_gain,
+                )
                 lead = margins.design
         except WorkbenchInputError as exc:
             if not drop_refused:

@@ -114,7 +114,7 @@ class ClothoidConfig:
     min_preview_time_s: float = 0.0
     lookahead_hysteresis_m: float = 0.5
     max_lookahead_growth_m_per_m: float | None = 0.3
-    max_lookahead_shrink_m_per_m: float | None = 1.0
+    max_lookahead_shrink_m_per_m: float | None = 0.5
     min_phase_margin_deg: float = 45.0
     min_gain_margin_db: float = 6.0
     fixed_lookahead_m: float = 10.0
@@ -235,6 +235,9 @@ class ClothoidController(Controller):
         self._filter_speed_kmh = -1
         self._choice.reset()
         self._diag: dict[str, float] = {}
+        if path.speed_mps is not None:  # the floors of the planned speeds now, not inside a step (~0.1 s per band)
+            for speed_mps in np.unique(np.round(path.speed_mps * 3.6 / FLOOR_SPEED_BAND_KMH)) * FLOOR_SPEED_BAND_KMH:
+                self.lookahead_floor_m(float(speed_mps) / 3.6)
 
     def _lead_filter(self, speed_mps: float) -> SteeringFilter:
         """The lead filter for this speed: the schedule's filter at the nearest whole km/h (discretised once per

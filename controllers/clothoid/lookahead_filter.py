@@ -33,7 +33,7 @@ class LookaheadFilterSettings:
 
     hysteresis_m: float = 0.5
     max_growth_m_per_m: float | None = 0.3
-    max_shrink_m_per_m: float | None = 1.0
+    max_shrink_m_per_m: float | None = 0.5
 
     def __post_init__(self) -> None:
         require_in_range("hysteresis_m", self.hysteresis_m, 0.0, 50.0, "m")

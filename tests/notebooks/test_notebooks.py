@@ -56,7 +56,9 @@ def check_lag_and_lead(summary: dict) -> None:
         assert compensated < lagged
     assert summary["closed_loop_completed"]
     cte = summary["closed_loop_max_abs_cte_m"]
-    assert cte["designed filter"] < cte["no filter"] and cte["designed filter"] < 0.2
+    # the shipped filter (designed for the loop's margins) tracks better than none; every variant within 0.2 m
+    assert cte["shipped (margins design)"] < cte["no filter"]
+    assert max(cte.values()) < 0.2
     # The lag slows with speed (Figure 7b).
     omega_n = summary["schedule_omega_n_rad_s"]
     assert omega_n == sorted(omega_n, reverse=True)

@@ -12,11 +12,13 @@ import pytest
 from study_helpers import SerialBackend, write_spec
 
 from controllers import CONTROLLERS
-from controllers.clothoid.filter_file import DEFAULT_FILTER, read_filter_file
+from controllers.clothoid.filter_file import read_filter_file
+from controllers.clothoid.vehicle_tuning import tuning_for
 from controllers.config_file import read_controller_config
 from workbench.cli import main
 from workbench.studies import LocalBackend, load_spec, run_optimisation
 from workbench.studies.optimise import trial_value, write_controller_config
+from workbench.vehicles import make_vehicle
 
 SPEC = """
 [study]
@@ -103,9 +105,13 @@ def test_optimise_writes_the_best_trial_as_a_config_that_workbench_run_reproduce
     config = read_controller_config(out / "best.toml", "clothoid", CONTROLLERS["clothoid"].config_type)
     assert config.frechet_threshold_m == result.best_params["frechet_threshold_m"]
     assert config.prediction_time_s == 0.1
-    (lead,) = read_filter_file(config.filter_file).params
+    scaled = read_filter_file(config.filter_file)
     assert config.filter_file == (out / "best_lead_filter.json").resolve()
-    assert lead.omega_p_rad_s == DEFAULT_FILTER.omega_p_rad_s * result.best_params["lead_filter_pole_scale"]
+    own = tuning_for(make_vehicle("kinematic-bicycle")).filter_schedule  # the vehicle's own filter is the base
+    assert scaled.speeds_kmh == own.speeds_kmh
+    for lead, base in zip(scaled.params, own.params, strict=True):
+        assert lead.omega_p_rad_s == base.omega_p_rad_s * result.best_params["lead_filter_pole_scale"]
+        assert lead.omega_z_rad_s == base.omega_z_rad_s
 
     # `workbench run` with it gives the best trial's run, bit for bit
     args = ["run", "dlc", "--controller", "clothoid", "--vehicle", "kinematic-bicycle", "--speed", "30"]
