@@ -575,7 +575,7 @@ def _margins(args: argparse.Namespace) -> int:
         from controllers.clothoid.vehicle_tuning import tuning_for
 
         tuning = tuning_for(vehicle)
-        path_at, measured_at = tuning.lag_at, getattr(tuning, "measured_lag_at", None)
+        path_at, measured_at = tuning.lag_at, tuning.measured_lag_at
         lead, limits = tuning.filter_schedule, tuning.limits
         source = f"the tuning of {vehicle.name}: {tuning.source}"
     else:

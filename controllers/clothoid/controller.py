@@ -259,8 +259,7 @@ class ClothoidController(Controller):
         """The vehicle's identified lags at this speed (None without a tuning)."""
         if self.tuning is None:
             return None
-        measured = getattr(self.tuning, "measured_lag_at", None)
-        return PlantLags(self.tuning.lag_at(speed_kmh), measured(speed_kmh) if measured else None)
+        return PlantLags(self.tuning.lag_at(speed_kmh), self.tuning.measured_lag_at(speed_kmh))
 
     def loop_settings(self, speed_kmh: float) -> LoopSettings:
         """What the controller does at this speed, for `loop_analysis`."""
