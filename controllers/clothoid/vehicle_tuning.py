@@ -62,6 +62,7 @@ from typing import TYPE_CHECKING, Any
 from controllers.clothoid.curvature_limits import CurvatureLimits
 from controllers.clothoid.filter_file import FilterSchedule, read_filter_file
 from workbench.errors import WorkbenchInputError
+from workbench.user_cache import user_cache_dir
 from workbench.vehicles.base import VehicleModel
 from workbench.vehicles.presets import MODEL_TYPES, params_from_toml, preset_text
 from workbench.vehicles.steering_lag import SteeringLag
@@ -244,11 +245,7 @@ def shipped_tuning_root() -> Path:
 
 def cache_dir() -> Path:
     """$WORKBENCH_TUNING_CACHE, else $XDG_CACHE_HOME/lateral-workbench/tuning (~/.cache/...)."""
-    env = os.environ.get(CACHE_ENV)
-    if env:
-        return Path(env)
-    base = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache")
-    return base / "lateral-workbench" / "tuning"
+    return user_cache_dir(CACHE_ENV, "tuning")
 
 
 def options_dict(options: PresetTuningOptions, model_type: str) -> dict[str, Any]:

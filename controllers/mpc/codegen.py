@@ -21,6 +21,8 @@ from pathlib import Path
 import casadi as ca
 import numpy as np
 
+from workbench.user_cache import user_cache_dir
+
 #: Environment variable naming the directory compiled libraries are cached in.
 CACHE_ENV = "WORKBENCH_MPC_CACHE"
 COMPILE_FLAGS = ("-O2", "-fPIC", "-shared")
@@ -40,11 +42,7 @@ class CompiledFunction:
 
 def cache_dir() -> Path:
     """$WORKBENCH_MPC_CACHE, else $XDG_CACHE_HOME/lateral-workbench/casadi (~/.cache/...), else a temp dir."""
-    env = os.environ.get(CACHE_ENV)
-    if env:
-        return Path(env)
-    base = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache")
-    return base / "lateral-workbench" / "casadi"
+    return user_cache_dir(CACHE_ENV, "casadi")
 
 
 def find_compiler() -> str | None:
