@@ -371,8 +371,3 @@ def lookahead_grid(low_m: float, high_m: float, step_m: float) -> tuple[float, .
             f"lookaheads {low_m:g}:{high_m:g}:{step_m:g} give {count} values; at most {MAX_LOOKAHEADS} (a larger step)"
         )
     return tuple(float(low_m + i * step_m) for i in range(count))  # as lookahead_floor's grid
-
-
-def floors_table(result: MarginResult) -> Sequence[tuple[float, float]]:
-    """(speed km/h, floor m) rows, speeds increasing."""
-    return sorted(result.floors.items())
