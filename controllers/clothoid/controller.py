@@ -63,6 +63,7 @@ from controllers.clothoid.lookahead import MAX_CURVE_POINTS, adaptive_search, ca
 from controllers.clothoid.lookahead_filter import LookaheadFilter, LookaheadFilterSettings, require_rate
 from controllers.clothoid.loop_analysis import LoopSettings, PlantLags, lookahead_floor
 from controllers.clothoid.path_feedforward import FeedforwardTiming, two_degree_of_freedom_rate
+from controllers.clothoid.pose_prediction import along_arc
 from controllers.clothoid.vehicle_tuning import VehicleTuning, tuning_for
 from workbench.errors import WorkbenchInputError, require_in_range, require_positive
 from workbench.path import PathTracker, ReferencePath
@@ -322,15 +323,9 @@ class ClothoidController(Controller):
         heading = m.yaw_rad
         if cfg.heading == "course" and m.vx_mps > MIN_SPEED_MPS:
             heading += math.atan2(m.vy_mps, m.vx_mps)
-        x, y = m.x_m, m.y_m
-        if cfg.prediction_time_s > 0.0:  # an arc of curvature kappa0 and length d, by its chord
-            d = m.speed_mps * cfg.prediction_time_s
-            half_turn = 0.5 * kappa0 * d
-            chord = d * (math.sin(half_turn) / half_turn if abs(half_turn) > 1e-9 else 1.0)
-            x += chord * math.cos(heading + half_turn)
-            y += chord * math.sin(heading + half_turn)
-            heading += 2.0 * half_turn
-        return x, y, heading
+        if cfg.prediction_time_s > 0.0:
+            return along_arc(m.x_m, m.y_m, heading, kappa0, m.speed_mps * cfg.prediction_time_s)
+        return m.x_m, m.y_m, heading
 
     def _lookahead(self, path: ReferencePath, foot_index: float, cte_m: float, pose, kappa0: float, speed_mps: float):
         """(lookahead m, the adaptive search's choice m, the floor m, number of candidates evaluated)."""

@@ -27,10 +27,10 @@ trailer make this about 0.12 s at 30 km/h; a car's is a few hundredths).
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 from controllers.clothoid.clothoid_fit import fit_kernel
+from controllers.clothoid.pose_prediction import along_arc
 from workbench.errors import require_in_range
 from workbench.path import Projection, ReferencePath
 
@@ -73,15 +73,7 @@ def reference_pose(
         heading, kappa = path.heading(s_ref), path.curvature(s_ref)
     else:
         x, y, heading, kappa = here.x_m, here.y_m, here.heading_rad, here.curvature_1pm
-    d = speed_mps * (prediction_time_s - lead)
-    half_turn = 0.5 * kappa * d
-    chord = d * (math.sin(half_turn) / half_turn if abs(half_turn) > 1e-9 else 1.0)
-    return (
-        float(x) + chord * math.cos(heading + half_turn),
-        float(y) + chord * math.sin(heading + half_turn),
-        heading + 2.0 * half_turn,
-        kappa,
-    )
+    return (*along_arc(float(x), float(y), heading, kappa, speed_mps * (prediction_time_s - lead)), kappa)
 
 
 def two_degree_of_freedom_rate(
