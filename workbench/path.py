@@ -27,6 +27,8 @@ from workbench.waypoints import Waypoints
 #: Default spacing of the path's samples along s (m). Linear interpolation between samples is then exact to
 #: kappa * h^2 / 8, i.e. 0.06 mm at a 20 m radius.
 DEFAULT_SAMPLE_SPACING_M = 0.1
+#: A path sampled into more points than this is refused: 500 km at the default 0.1 m spacing, 200 MB of samples.
+MAX_PATH_SAMPLES = 5_000_000
 #: Gauss-Legendre nodes used to integrate the spline's speed |r'(t)| into arc length.
 _GL_NODES, _GL_WEIGHTS = np.polynomial.legendre.leggauss(6)
 #: Degree of the interpolating spline and how often it is re-parameterised by its own arc length.
@@ -103,7 +105,11 @@ class Projection:
     s_m: arc length of the foot point in [0, length]; progress_m: arc length travelled since the tracker started,
     counting laps of a closed loop; x_m, y_m: foot point; heading_rad: path heading there (unwrapped along the
     path); curvature_1pm: path curvature there (left turn positive); cte_m: signed cross-track error, positive when
-    the position is left of the path; at_end: the foot point is the end of an open path.
+    the position is left of the path (past an end of an open path: the offset from that end's tangent line);
+    at_end: the foot point is the end of an open path; past_end_m: how far the position lies beyond an end of an
+    open path, along that end's tangent (0 when it is not beyond either end); distance_m: the distance from the
+    position to the foot point, which beyond an open path's end is the distance to the end point (|CTE| is only
+    its sideways part).
     """
 
     s_m: float
@@ -114,6 +120,13 @@ class Projection:
     curvature_1pm: float
     cte_m: float
     at_end: bool
+    past_end_m: float = 0.0
+    distance_m: float = 0.0
+
+    @property
+    def signed_distance_m(self) -> float:
+        """The distance from the path, signed as the CTE (left positive): the CTE that counts beyond the ends."""
+        return math.copysign(self.distance_m, self.cte_m)
 
 
 class ReferencePath:
@@ -165,6 +178,12 @@ class ReferencePath:
         x, y = waypoints.x_m, waypoints.y_m
         if waypoints.closed:
             x, y = np.append(x, x[0]), np.append(y, y[0])
+        chord_length = float(np.sum(np.hypot(np.diff(x), np.diff(y))))  # a lower bound on the arc length
+        if chord_length / spacing_m > MAX_PATH_SAMPLES:
+            raise WorkbenchInputError(
+                f"{waypoints.source}: a path of at least {chord_length:.4g} m sampled every {spacing_m:g} m needs more "
+                f"than {MAX_PATH_SAMPLES:,} samples; split it or sample it more coarsely"
+            )
         spline_x, spline_y, t_knots = _arc_length_spline(x, y, waypoints.closed)
 
         # Arc length s(t) on a fine grid (t is already close to s after the re-parameterisation).
@@ -314,7 +333,8 @@ class PathTracker:
         self.path = path
         self.min_window_m = float(min_window_m)
         self._n_seg = path.x_m.size - 1
-        self._initial_s = initial_s_m
+        #: The diagonal of the path's bounding box (m): a move longer than this can land anywhere on the path.
+        self._extent_m = float(math.hypot(np.ptp(path.x_m), np.ptp(path.y_m)))
         self.reset(initial_s_m)
 
     def reset(self, initial_s_m: float | None = None) -> None:
@@ -332,11 +352,14 @@ class PathTracker:
         path = self.path
         if not (math.isfinite(x_m) and math.isfinite(y_m)):
             raise WorkbenchInputError(f"position must be finite to project onto {path.name}; got ({x_m}, {y_m})")
+        moved = 0.0 if self._last_xy is None else math.hypot(x_m - self._last_xy[0], y_m - self._last_xy[1])
         if self._s is None:
             s_new = path.project_global(x_m, y_m)
             self._progress = s_new
+        elif moved > self._extent_m:  # a jump past the path's whole extent: progress is lost, search it all
+            s_new = path.project_global(x_m, y_m)
+            self._progress += s_new - self._s
         else:
-            moved = 0.0 if self._last_xy is None else math.hypot(x_m - self._last_xy[0], y_m - self._last_xy[1])
             s_new = self._windowed_search(x_m, y_m, self._s, max(self.min_window_m, 2.0 * moved))
             delta = s_new - self._s
             if path.closed:  # shortest way round the seam
@@ -352,15 +375,21 @@ class PathTracker:
         heading = float(path.heading_rad[i] + frac * (path.heading_rad[i + 1] - path.heading_rad[i]))
         curvature = float(path.curvature_1pm[i] + frac * (path.curvature_1pm[i + 1] - path.curvature_1pm[i]))
         # Signed CTE: component of (position - foot) along the path's left normal.
-        cte = -(x_m - fx) * math.sin(heading) + (y_m - fy) * math.cos(heading)
-        at_end = (not path.closed) and s_new >= path.length_m - 1e-9
-        return Projection(s_new, self._progress, fx, fy, heading, curvature, cte, at_end)
+        cos_h, sin_h = math.cos(heading), math.sin(heading)
+        cte = -(x_m - fx) * sin_h + (y_m - fy) * cos_h
+        along = (x_m - fx) * cos_h + (y_m - fy) * sin_h  # 0 beside the path; beyond an end, how far beyond
+        at_end, past_end = False, 0.0
+        if not path.closed:
+            at_end = s_new >= path.length_m - 1e-9
+            if at_end or s_new <= 1e-9:
+                past_end = max(along if at_end else -along, 0.0)
+        distance = math.hypot(cte, along)
+        return Projection(s_new, self._progress, fx, fy, heading, curvature, cte, at_end, past_end, distance)
 
     def _windowed_search(self, x_m: float, y_m: float, s_center: float, half_width_m: float) -> float:
         path = self.path
         ds = path.spacing_m
-        index = windowed_projection(
-            path.x_m, path.y_m, x_m, y_m, int(s_center / ds), math.ceil(half_width_m / ds), path.closed
-        )
+        half = min(math.ceil(half_width_m / ds), self._n_seg)  # no window needs more than the whole path
+        index = windowed_projection(path.x_m, path.y_m, x_m, y_m, int(s_center / ds), half, path.closed)
         s_m = index * ds
         return s_m % path.length_m if path.closed else min(s_m, path.length_m)  # [0, L) on a loop

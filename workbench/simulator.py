@@ -4,8 +4,10 @@ Fixed steps: the controller (and the speed controller) run at `controller_rate_h
 steps the plant integrates `plant_rate_hz / controller_rate_hz` RK4 steps with the commands held (zero-order
 hold). One row of the trace is logged per controller step. The run ends when the vehicle reaches the end of an
 open path or completes the requested laps of a closed one; it stops early, keeping its partial trace and saying
-why, on a time-out, when the vehicle leaves the path by more than `max_abs_cte_m`, when the plant state stops
-being finite, or when the controller fails.
+why, on a time-out, when the vehicle leaves the path (further than `max_abs_cte_m` from it, or beyond either end
+of an open path by more than `max_past_end_m`), when the plant state stops being finite, or when the controller
+fails. The logged CTE is the signed distance from the path, so beyond an open path's ends it is the distance to
+the end point, never the sideways offset from the end's tangent alone.
 """
 
 from __future__ import annotations
@@ -38,7 +40,8 @@ class SimulationConfig:
     lateral acceleration bound (the paper: 0.3 g); max_accel_mps2, max_decel_mps2: its longitudinal bounds;
     controller_rate_hz, plant_rate_hz: step rates (the plant rate must be a whole multiple); laps: laps of a
     closed path; max_time_s: time-out (None: three times the planned lap time plus 30 s); max_abs_cte_m: a run
-    whose |CTE| exceeds this has left the path and stops; speed_feedforward: the speed controller feeds the
+    whose |CTE| exceeds this has left the path and stops; max_past_end_m: so has a run whose reference point goes
+    this far beyond either end of an open path (along the end's tangent); speed_feedforward: the speed controller feeds the
     planned speed's rate of change forward (speed x dv_ref/ds) besides its PI action (False: PI only).
     """
 
@@ -51,6 +54,7 @@ class SimulationConfig:
     laps: int = 1
     max_time_s: float | None = None
     max_abs_cte_m: float = 30.0
+    max_past_end_m: float = 5.0
     speed_feedforward: bool = True
 
     def __post_init__(self) -> None:
@@ -71,6 +75,7 @@ class SimulationConfig:
         if self.max_time_s is not None:
             require_positive("max_time_s", self.max_time_s)
         require_positive("max_abs_cte_m", self.max_abs_cte_m)
+        require_positive("max_past_end_m", self.max_past_end_m)
         if not isinstance(self.speed_feedforward, bool):
             raise WorkbenchInputError(f"speed_feedforward must be True or False; got {self.speed_feedforward!r}")
 
@@ -104,6 +109,13 @@ def plan_path_speed(path: ReferencePath, config: SimulationConfig) -> ReferenceP
         s_plan, planned = np.append(s_plan, path.length_m), np.append(planned, planned[0])
     speed = np.interp(path.s_m, s_plan, planned)
     if path.speed_mps is not None:
+        stopped = np.flatnonzero(~(path.speed_mps > 0.0))
+        if stopped.size:
+            i = int(stopped[0])
+            raise WorkbenchInputError(
+                f"{path.name}: the path's speed must be > 0 m/s everywhere (a run follows it without stopping); "
+                f"it is {float(path.speed_mps[i]):g} m/s at s = {float(path.s_m[i]):.1f} m"
+            )
         speed = np.minimum(speed, path.speed_mps)
     return path.with_speed(speed)
 
@@ -124,13 +136,27 @@ class Simulation:
         self.config = config or SimulationConfig()
         self.path = plan_path_speed(scenario.path, self.config)
 
+    @property
+    def total_length_m(self) -> float:
+        """The distance the run is asked to cover: the path, times the laps of a closed one."""
+        return self.path.length_m * (self.config.laps if self.path.closed else 1)
+
+    @property
+    def max_time_s(self) -> float:
+        """Simulated time before the run times out: the config's, or three times the planned time plus 30 s."""
+        mean_speed = float(np.mean(self.path.speed_mps))
+        return self.config.max_time_s or 3.0 * self.total_length_m / mean_speed + 30.0
+
+    @property
+    def max_steps(self) -> int:
+        """Controller steps the run may take before its time-out: the trace's row capacity."""
+        return math.ceil(self.max_time_s * self.config.controller_rate_hz) + 1
+
     def run(self, progress: bool = False) -> SimulationResult:
         cfg, path, vehicle, controller = self.config, self.path, self.vehicle, self.controller
         dt = 1.0 / cfg.controller_rate_hz
-        total_length = path.length_m * (cfg.laps if path.closed else 1)
-        mean_speed = float(np.mean(path.speed_mps))
-        max_time = cfg.max_time_s or 3.0 * total_length / mean_speed + 30.0
-        max_steps = math.ceil(max_time / dt) + 1
+        total_length = self.total_length_m
+        max_time, max_steps = self.max_time_s, self.max_steps
 
         x0, y0, yaw0 = self.scenario.initial_pose()
         state = vehicle.initial_state(x0, y0, yaw0, float(path.speed_mps[0]))
@@ -147,10 +173,18 @@ class Simulation:
             out = vehicle.outputs(state, steer_cmd, accel_cmd)
             x, y, yaw, vx, vy, yaw_rate, steer_wheel = out[:7]
             foot = tracker.update(x, y)
-            if abs(foot.cte_m) > cfg.max_abs_cte_m:
+            if foot.past_end_m > cfg.max_past_end_m:
+                end = "end" if foot.at_end else "start"
                 status = Status.LEFT_PATH
                 message = (
-                    f"|CTE| = {abs(foot.cte_m):.1f} m exceeds max_abs_cte_m = {cfg.max_abs_cte_m} m at t = {t:.2f} s"
+                    f"went {foot.past_end_m:.1f} m past the {end} of the path (max_past_end_m = "
+                    f"{cfg.max_past_end_m:g} m) at t = {t:.2f} s, {foot.distance_m:.1f} m from it"
+                )
+                break
+            if foot.distance_m > cfg.max_abs_cte_m:
+                status = Status.LEFT_PATH
+                message = (
+                    f"|CTE| = {foot.distance_m:.1f} m exceeds max_abs_cte_m = {cfg.max_abs_cte_m:g} m at t = {t:.2f} s"
                 )
                 break
             if (foot.at_end and not path.closed) or foot.progress_m >= total_length:
@@ -208,15 +242,26 @@ class Simulation:
 
 
 class _TraceLog:
-    """Preallocated columns for the trace, one row per controller step."""
+    """Columns for the trace, one row per controller step; they double when full, so memory follows the steps
+    actually run, not the time-out's capacity."""
 
     def __init__(self, output_names: tuple[str, ...], capacity: int) -> None:
         self.output_names = output_names
-        self.outputs = np.empty((capacity, len(output_names)))
-        self.signals = np.empty((capacity, 11))
+        self.capacity = min(capacity, 1 << 14)
+        self.outputs = np.empty((self.capacity, len(output_names)))
+        self.signals = np.empty((self.capacity, len(self.SIGNALS)))
         self.diagnostics: dict[str, np.ndarray] = {}
-        self.capacity = capacity
         self.n = 0
+
+    def _grow(self) -> None:
+        def doubled(column: np.ndarray, fill: float) -> np.ndarray:
+            extra = np.full((self.capacity, *column.shape[1:]), fill)
+            return np.concatenate((column, extra))
+
+        self.outputs = doubled(self.outputs, np.nan)
+        self.signals = doubled(self.signals, np.nan)
+        self.diagnostics = {key: doubled(column, np.nan) for key, column in self.diagnostics.items()}
+        self.capacity *= 2
 
     SIGNALS = (
         "t_s",
@@ -234,6 +279,8 @@ class _TraceLog:
 
     def append(self, t, out, steer_cmd, accel_cmd, speed, speed_ref, foot, heading_error, step_time, diagnostics):
         i = self.n
+        if i == self.capacity:
+            self._grow()
         self.outputs[i] = out
         self.signals[i] = (
             t,
@@ -243,7 +290,7 @@ class _TraceLog:
             speed_ref,
             foot.s_m,
             foot.progress_m,
-            foot.cte_m,
+            foot.signed_distance_m,
             heading_error,
             foot.curvature_1pm,
             step_time,

@@ -10,6 +10,7 @@ ignoring surrounding spaces (and a leading ``#``):
   projected to east/north metres centred on the first point (see `geodetic_to_local_en`). If a file has
   both x/y and latitude/longitude columns, x/y are used.
 - optional speed: ``v``/``v_mps``/``speed_mps`` in m/s, or ``v_kmh``/``speed_kmh`` in km/h (converted to m/s).
+  Any other column that reads as a speed (``speed``, ``velocity``, ``v_kph``, ...) is refused, unit unknown.
 
 A path whose last point repeats its first (within `MIN_WAYPOINT_SPACING_M`) is a closed loop: the repeated
 point is dropped and ``closed=True``. Bad input raises `WorkbenchInputError` naming the file.
@@ -64,6 +65,8 @@ def read_waypoints(path: str | os.PathLike[str]) -> Waypoints:
 
     speed = None
     speed_col = _find(table, SPEED_MPS_NAMES + SPEED_KMH_NAMES, name)
+    if speed_col is None:
+        _refuse_unknown_speed_unit(table, name)
     if speed_col:
         speed = _numbers(table, speed_col, name)
         if _normalise(speed_col) in SPEED_KMH_NAMES:
@@ -144,6 +147,17 @@ def _find(table: pd.DataFrame, names: tuple[str, ...], file_name: str) -> str | 
     if len(found) > 1:
         raise WorkbenchInputError(f"{file_name}: columns {found} all mean the same quantity; keep one of them")
     return found[0] if found else None
+
+
+def _refuse_unknown_speed_unit(table: pd.DataFrame, file_name: str) -> None:
+    """A column that reads as a speed but names no unit would be ignored, and the path planned at another speed."""
+    for column in table.columns:
+        label = _normalise(column)
+        if "speed" in label or "vel" in label or label.startswith("v_"):
+            raise WorkbenchInputError(
+                f"{file_name}: column {str(column).strip()!r} looks like a speed, but its unit is not known; name it "
+                f"one of {SPEED_MPS_NAMES} (m/s) or {SPEED_KMH_NAMES} (km/h)"
+            )
 
 
 def _require_rows(table: pd.DataFrame, file_name: str) -> None:

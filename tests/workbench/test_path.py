@@ -631,3 +631,102 @@ def test_bad_spacing() -> None:
     wps = Waypoints(np.arange(5.0), np.zeros(5))
     with pytest.raises(WorkbenchInputError, match=r"spacing_m must be a finite number > 0; got -0\.1"):
         ReferencePath.from_waypoints(wps, spacing_m=-0.1)
+
+
+# ---------------------------------------------------------------------------------------------- beyond the ends
+@pytest.mark.parametrize("along", [0.5, 3.0, 400.0])
+@pytest.mark.parametrize("side", [-2.0, 0.0, 2.0])
+def test_beyond_the_end_the_distance_is_to_the_end_point(along: float, side: float) -> None:
+    path = straight_path(50.0)  # along +x from (0, 0) to (50, 0)
+    tracker = path.tracker(45.0)
+    foot = tracker.update(50.0 + along, side)
+    assert foot.at_end and foot.past_end_m == pytest.approx(along, abs=1e-9)
+    assert foot.distance_m == pytest.approx(math.hypot(along, side), abs=1e-9)
+    assert foot.cte_m == pytest.approx(side, abs=1e-9)  # the sideways part, as before
+    assert abs(foot.signed_distance_m) == pytest.approx(foot.distance_m) and foot.signed_distance_m * side >= 0
+
+
+@pytest.mark.parametrize("behind", [0.5, 3.0, 400.0])
+def test_before_the_start_the_distance_is_to_the_start_point(behind: float) -> None:
+    path = straight_path(50.0)
+    foot = path.tracker(0.0).update(-behind, -1.0)
+    assert not foot.at_end and foot.s_m == 0.0
+    assert foot.past_end_m == pytest.approx(behind, abs=1e-9)
+    assert foot.signed_distance_m == pytest.approx(-math.hypot(behind, 1.0), abs=1e-9)
+
+
+def test_beside_the_path_nothing_is_past_an_end_and_the_distance_is_the_cte() -> None:
+    path = straight_path(50.0)
+    tracker = path.tracker(0.0)
+    for x in (0.0, 10.0, 49.9):
+        foot = tracker.update(x, 1.5)
+        assert foot.past_end_m == 0.0
+        assert foot.distance_m == pytest.approx(1.5, abs=1e-9)
+    loop = even_circle(25.0)
+    foot = loop.tracker(0.0).update(27.0, 0.0)
+    assert foot.past_end_m == 0.0 and foot.distance_m == pytest.approx(2.0, abs=1e-3)
+
+
+@pytest.mark.parametrize("jump", [1e6, 1e9, 1e12, 1e300, -1e300])
+def test_a_huge_jump_is_projected_by_a_global_search(jump: float) -> None:
+    """A move beyond the path's extent searches the whole path once, at a cost bounded by its size (a windowed
+    search grown step by step took 0.31 s for 1e6 m, 212 s for 1e9 m, and hung or overflowed beyond)."""
+    for path in (straight_path(50.0), even_circle(25.0)):
+        tracker = path.tracker(0.0)
+        tracker.update(0.0, 0.0)
+        foot = tracker.update(jump, 0.5 * jump)
+        assert all(math.isfinite(v) for v in (foot.s_m, foot.progress_m, foot.x_m, foot.y_m, foot.heading_rad))
+        assert 0.0 <= foot.s_m <= path.length_m
+        if abs(jump) < 1e200:  # the distance itself overflows at 1e300, which is right: it is that far
+            assert foot.distance_m == pytest.approx(math.hypot(jump - foot.x_m, 0.5 * jump - foot.y_m), rel=1e-9)
+        back = tracker.update(float(path.x_m[10]), float(path.y_m[10]))  # and back onto the path
+        assert back.distance_m < 1e-6
+
+
+# ---------------------------------------------------------------------------------------------- unfollowable paths
+def test_a_path_that_doubles_back_is_refused_naming_the_waypoint() -> None:
+    x = np.array([0.0, 10.0, 20.0, 30.0, 40.0, 30.0, 20.0, 10.0])
+    with pytest.raises(WorkbenchInputError, match=r"doubles back on itself .*180 deg.* at waypoint 4 \(40, 0\)"):
+        Waypoints(x, np.zeros_like(x), source="r.csv")
+    # A sharp but forward corner is a path: a 90 deg turn between 10 m legs.
+    Waypoints(np.array([0.0, 10.0, 10.0]), np.array([0.0, 0.0, 10.0]))
+
+
+def test_a_zig_zag_tighter_than_any_vehicle_turns_is_refused_naming_the_places() -> None:
+    x = np.arange(0.0, 2.0, 0.01)
+    y = np.where(np.arange(x.size) % 2 == 0, 0.0, 0.01)  # 0.01 m zig-zag: 591 1/m in the fitted spline
+    with pytest.raises(WorkbenchInputError, match=r"turn tighter than any vehicle.*at waypoint 1 \(0\.01, 0\.01\)"):
+        Waypoints(x, y)
+
+
+def test_a_closed_loop_checks_the_turn_across_its_seam() -> None:
+    # A square loop turns 90 deg at each corner, including the seam: fine.
+    Waypoints(np.array([0.0, 10.0, 10.0, 0.0]), np.array([0.0, 0.0, 10.0, 10.0]), closed=True)
+    # A loop whose closing segment doubles back on the first one reverses at waypoint 0.
+    with pytest.raises(WorkbenchInputError, match=r"doubles back.*waypoint 0 \(0, 0\)"):
+        Waypoints(np.array([0.0, 20.0, 20.0, 30.0]), np.array([0.0, 0.0, 10.0, 0.5]), closed=True)
+
+
+@pytest.mark.parametrize("coordinate", [1e308, -1e308, 2e8])
+def test_coordinates_beyond_a_local_frame_are_refused(coordinate: float) -> None:
+    with pytest.raises(WorkbenchInputError, match=rf"waypoint 1 has x = {re.escape(f'{coordinate:g}')} m; .*within \+-1e\+08 m"):
+        Waypoints(np.array([0.0, coordinate, 0.0]), np.array([0.0, 1.0, 2.0]))
+
+
+def test_a_path_needing_too_many_samples_is_refused_before_allocating() -> None:
+    waypoints = Waypoints(np.array([0.0, 1e7, 2e7]), np.zeros(3))
+    with pytest.raises(WorkbenchInputError, match=r"at least 2e\+07 m sampled every 0\.1 m needs more than 5,000,000"):
+        ReferencePath.from_waypoints(waypoints)
+
+
+def test_all_identical_points_are_named_as_repeated_not_as_an_unclosed_loop() -> None:
+    with pytest.raises(WorkbenchInputError, match=r"waypoints 0 and 1 repeat the same point") as info:
+        Waypoints(np.ones(4), np.ones(4), closed=True)
+    assert "closed loop" not in str(info.value)
+
+
+@pytest.mark.parametrize("speeds", [[0.0, 0.0, 0.0, 0.0], [0.0, 5.0, 5.0, 5.0], [5.0, 5.0, 5.0, 0.0]])
+def test_a_zero_waypoint_speed_is_refused(speeds: list[float]) -> None:
+    i = speeds.index(0.0)
+    with pytest.raises(WorkbenchInputError, match=rf"speed must be > 0 m/s at every waypoint; waypoint {i} has 0"):
+        Waypoints(np.arange(4.0), np.zeros(4), speed_mps=np.array(speeds))

@@ -198,7 +198,7 @@ def test_leaving_the_path_stops_the_run() -> None:
         scenario, vehicle, _Failing(vehicle.geometry, "nan", after=10**9), SimulationConfig(max_abs_cte_m=5.0)
     ).run()
     assert result.status is Status.LEFT_PATH
-    assert "max_abs_cte_m = 5.0" in result.message
+    assert "max_abs_cte_m = 5 m" in result.message
 
 
 @pytest.mark.parametrize(
