@@ -41,8 +41,8 @@ class SimulationConfig:
     controller_rate_hz, plant_rate_hz: step rates (the plant rate must be a whole multiple); laps: laps of a
     closed path; max_time_s: time-out (None: three times the planned lap time plus 30 s); max_abs_cte_m: a run
     whose |CTE| exceeds this has left the path and stops; max_past_end_m: so has a run whose reference point goes
-    this far beyond either end of an open path (along the end's tangent); speed_feedforward: the speed controller feeds the
-    planned speed's rate of change forward (speed x dv_ref/ds) besides its PI action (False: PI only).
+    this far beyond either end of an open path (along the end's tangent); speed_feedforward: the speed controller
+    feeds the planned speed's rate of change forward (speed x dv_ref/ds) besides its PI action (False: PI only).
     """
 
     speed_kmh: float = 30.0

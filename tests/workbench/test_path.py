@@ -709,7 +709,8 @@ def test_a_closed_loop_checks_the_turn_across_its_seam() -> None:
 
 @pytest.mark.parametrize("coordinate", [1e308, -1e308, 2e8])
 def test_coordinates_beyond_a_local_frame_are_refused(coordinate: float) -> None:
-    with pytest.raises(WorkbenchInputError, match=rf"waypoint 1 has x = {re.escape(f'{coordinate:g}')} m; .*within \+-1e\+08 m"):
+    shown = re.escape(f"{coordinate:g}")
+    with pytest.raises(WorkbenchInputError, match=rf"waypoint 1 has x = {shown} m; .*within \+-1e\+08 m"):
         Waypoints(np.array([0.0, coordinate, 0.0]), np.array([0.0, 1.0, 2.0]))
 
 

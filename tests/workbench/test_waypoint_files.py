@@ -272,7 +272,10 @@ BAD_FILES = {
         "x,y,speed_mps\n0,0,1\n1,0,fast\n2,0,1\n",
         r"num\.csv: column 'speed_mps', line 3: 'fast'",
     ),
-    "negative speed": ("x,y,v\n0,0,1\n1,0,-2\n2,0,1\n", r"rows\.csv: speed must be > 0 m/s at every waypoint; waypoint 1 has -2"),
+    "negative speed": (
+        "x,y,v\n0,0,1\n1,0,-2\n2,0,1\n",
+        r"rows\.csv: speed must be > 0 m/s at every waypoint; waypoint 1 has -2",
+    ),
     "header only": ("x,y\n", r"rows\.csv: a path needs at least 3 waypoint rows; the file has 0"),
     "two rows": ("x,y\n0,0\n1,1\n", r"rows\.csv: a path needs at least 3 waypoint rows; the file has 2"),
     "closed with two points": (
