@@ -136,6 +136,27 @@ class Simulation:
         self.config = config or SimulationConfig()
         self.path = plan_path_speed(scenario.path, self.config)
 
+    def path_warnings(self) -> list[str]:
+        """What about the path this vehicle cannot do, to say before the run: stretches curving tighter than its
+        steering lock turns it (Ackermann, tan(max road-wheel angle) / wheelbase)."""
+        geometry = self.vehicle.geometry
+        reach = math.tan(geometry.max_road_wheel_angle_rad) / geometry.wheelbase_m
+        path = self.path
+        beyond = np.abs(path.curvature_1pm) > reach
+        if not beyond.any():
+            return []
+        edges = np.flatnonzero(np.diff(np.concatenate(([0], beyond.astype(np.int8), [0])))).reshape(-1, 2)
+        places = [
+            f"s = {path.s_m[first]:.1f}-{path.s_m[stop - 1]:.1f} m "
+            f"(peak {np.max(np.abs(path.curvature_1pm[first:stop])):.3g} 1/m)"
+            for first, stop in edges[:3]
+        ]
+        more = f" and {len(edges) - 3} more" if len(edges) > 3 else ""
+        return [
+            f"{path.name} curves tighter than the {self.vehicle.name} can turn at full lock ({reach:.3g} 1/m, a "
+            f"radius of {1.0 / reach:.2f} m) at {', '.join(places)}{more}: expect it to run wide there"
+        ]
+
     @property
     def total_length_m(self) -> float:
         """The distance the run is asked to cover: the path, times the laps of a closed one."""

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import replace
 from typing import ClassVar
 
@@ -216,3 +217,15 @@ def test_leaving_the_path_stops_the_run() -> None:
 def test_bad_configuration_is_rejected(kwargs: dict, needle: str) -> None:
     with pytest.raises(WorkbenchInputError, match=needle):
         SimulationConfig(**kwargs)
+
+
+def test_a_path_tighter_than_the_vehicle_turns_is_named_before_the_run() -> None:
+    vehicle = KinematicBicycle()
+    reach = math.tan(vehicle.geometry.max_road_wheel_angle_rad) / vehicle.geometry.wheelbase_m
+    chain = ClothoidChain().straight(20.0).clothoid_to(1.5 * reach, 2.0).arc(5.0).clothoid_to(0.0, 2.0)
+    tight = chain.straight(20.0).to_path("hairpin")
+    simulation = Simulation(_scenario(tight), vehicle, PurePursuit(vehicle.geometry))
+    (warning,) = simulation.path_warnings()
+    assert "hairpin curves tighter than the kinematic-bicycle can turn" in warning
+    assert re.search(r"at s = 21\.[34]-27\.[67] m \(peak 1\.05 1/m\)", warning), warning
+    assert Simulation(_scenario(_circle()), vehicle, PurePursuit(vehicle.geometry)).path_warnings() == []
