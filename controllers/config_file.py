@@ -18,14 +18,14 @@ float, int, bool, str, Path or `Path | None` (written "none" to clear).
 from __future__ import annotations
 
 import dataclasses
-import tomllib
 import types
 import typing
 from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import Any
 
-from workbench.errors import WorkbenchInputError
+from workbench.errors import WorkbenchInputError, value_text
+from workbench.input_files import read_toml
 
 _TRUE = ("true", "yes", "on", "1")
 _FALSE = ("false", "no", "off", "0")
@@ -74,7 +74,7 @@ def _coerce(name: str, value: Any, annotation: Any, base_dir: Path | None) -> An
     except ValueError:
         pass
     kind = getattr(annotation, "__name__", str(annotation)) + (" or none" if optional else "")
-    raise WorkbenchInputError(f"option {name!r} must be a {kind}; got {value!r}")
+    raise WorkbenchInputError(f"option {name!r} must be a {kind}; got {value_text(value)}")
 
 
 def build_config(
@@ -110,12 +110,7 @@ def read_controller_config(
     base_dir = None
     if path is not None:
         path = Path(path)
-        try:
-            document = tomllib.loads(path.read_text())
-        except FileNotFoundError:
-            raise WorkbenchInputError(f"controller config file {str(path)!r} does not exist") from None
-        except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
-            raise WorkbenchInputError(f"controller config file {str(path)!r} is not valid TOML: {exc}") from None
+        document = read_toml(path, f"controller config file {str(path)!r}")
         table = document.get(controller_name, {})
         if not isinstance(table, dict):
             raise WorkbenchInputError(
@@ -146,5 +141,5 @@ def config_template(controller_name: str, config_type: type) -> str:
         elif isinstance(value, str | Path):
             lines.append(f'{f.name} = "{value}"')
         else:
-            lines.append(f"{f.name} = {value!r}")
+            lines.append(f"{f.name} = {value_text(value)}")
     return "\n".join(lines) + "\n"

@@ -10,6 +10,10 @@
     tuning margins          the clothoid loop's margins against lookahead per speed and the lookahead floor,
                             write margins.csv
 
+Every input file and output file is checked before any work (`workbench.input_files`, `workbench.output_dir`):
+a missing or unreadable input, a folder where a file is wanted, a parent that is a file, an unwritable folder or
+file are refused.
+
 Exit codes: 0 done; 2 bad input (one line on stderr naming the value and what is allowed).
 """
 
@@ -46,12 +50,25 @@ from tuning.steering_limits import steering_limits
 from tuning.steering_limits import table as steering_table
 from tuning.steering_limits import to_curvature_limits as steering_curvature_limits
 from workbench.errors import WorkbenchInputError
+from workbench.input_files import check_input_file, read_json
+from workbench.output_dir import check_output_file
 from workbench.vehicles import make_vehicle
 from workbench.vehicles.base import VehicleModel
 from workbench.vehicles.steering_lag import read_lag_file, write_lag_file
 
 EXIT_INPUT_ERROR = 2
 FORMATS = ("json", "toml")
+#: The input-file options of the commands: argparse dest -> (the option, or None for a positional; what it is).
+INPUT_FILES: dict[str, tuple[str | None, str]] = {
+    "logs": (None, "vehicle log"),
+    "validate": ("--validate", "vehicle log"),
+    "vehicle_file": ("--vehicle-file", "vehicle file"),
+    "lag": ("--lag", "steering-lag file"),
+    "measured_lag": ("--measured-lag", "steering-lag file"),
+    "lead": ("--lead", "lead filter file"),
+}
+#: The output-file options: argparse dest -> the option.
+OUTPUT_FILES = {"out": "--out", "plot": "--plot", "validate_plot": "--validate-plot"}
 
 
 def _vehicle_options(parser: argparse.ArgumentParser, required: bool = True) -> None:
@@ -280,6 +297,36 @@ def _prepare(path: Path) -> Path:
     return path
 
 
+def _check_paths(args: argparse.Namespace) -> None:
+    """Every input file must be a readable file and every output file writable (INPUT_FILES, OUTPUT_FILES; and the
+    default place of design-lead's validation figure): checked before any work."""
+    for dest, (flag, what) in INPUT_FILES.items():
+        value = getattr(args, dest, None)
+        for path in value if isinstance(value, list) else [] if value is None else [value]:
+            check_input_file(path, f"{what} {str(path)!r}" + (f" ({flag})" if flag else ""))
+    for dest, flag in OUTPUT_FILES.items():
+        value = getattr(args, dest, None)
+        if value is not None:
+            check_output_file(value, flag)
+    if getattr(args, "validate", None) and getattr(args, "validate_plot", None) is None:
+        check_output_file(_validation_plot(args.out), "the --validate figure")
+
+
+def _validation_plot(out: Path) -> Path:
+    """Where design-lead draws Figure 9 without --validate-plot: beside --out."""
+    return out.with_name(f"{out.stem}_validation.png")
+
+
+def _read_lag(flag: str, path: Path):
+    """A steering-lag file; its JSON read safely first (deep nesting, not JSON), then checked as a lag."""
+    label = f"steering-lag file {str(path)!r} ({flag})"
+    read_json(path, label)
+    try:
+        return read_lag_file(path)
+    except (OSError, RecursionError) as exc:
+        raise WorkbenchInputError(f"{label}: cannot be read ({exc})") from None
+
+
 def _generate_data(args: argparse.Namespace) -> int:
     vehicle = _vehicle(args)
     amplitude = args.amplitude_deg if args.amplitude_deg is not None else 90.0
@@ -343,7 +390,7 @@ def _fit_lag(args: argparse.Namespace) -> int:
 
 def _design_lead(args: argparse.Namespace) -> int:
     out = _filter_path(args)
-    lag = read_lag_file(args.lag)
+    lag = _read_lag("--lag", args.lag)
     design = design_lead(
         lag,
         max_lead_gain=args.max_lead_gain,
@@ -380,7 +427,7 @@ def _design_lead(args: argparse.Namespace) -> int:
         if args.plot:
             print(f"wrote {bode_figure(design, args.plot)}")
         if traces:
-            target = args.validate_plot or out.with_name(f"{out.stem}_validation.png")
+            target = args.validate_plot or _validation_plot(out)
             print(f"wrote {validation_figure(traces, target)}")
     return 0
 
@@ -558,12 +605,6 @@ def _margins(args: argparse.Namespace) -> int:
         raise WorkbenchInputError(f"--speeds {args.speeds!r}: {exc}") from None
     lookaheads = _margin_lookaheads(args.lookahead)
 
-    def lag_file(flag: str, path: Path):
-        try:
-            return read_lag_file(path)
-        except OSError as exc:
-            raise WorkbenchInputError(f"{flag} {str(path)!r} cannot be read: {exc}") from None
-
     vehicle = _vehicle(args) if args.vehicle is not None or args.vehicle_file is not None else None
     limits = None
     if args.lag is None:
@@ -579,14 +620,14 @@ def _margins(args: argparse.Namespace) -> int:
         lead, limits = tuning.filter_schedule, tuning.limits
         source = f"the tuning of {vehicle.name}: {tuning.source}"
     else:
-        path_lag = lag_file("--lag", args.lag)
+        path_lag = _read_lag("--lag", args.lag)
 
         def path_at(_speed: float):
             return path_lag
 
         measured_at, lead, source = None, None, f"lag {args.lag}"
     if args.measured_lag is not None:
-        measured_lag = lag_file("--measured-lag", args.measured_lag)
+        measured_lag = _read_lag("--measured-lag", args.measured_lag)
 
         def measured_at(_speed: float):
             return measured_lag
@@ -647,6 +688,7 @@ COMMANDS = {
 def main(argv: Sequence[str] | None = None) -> int:
     args = _parser().parse_args(argv)
     try:
+        _check_paths(args)
         return COMMANDS[args.command](args)
     except WorkbenchInputError as exc:
         print(f"tuning: error: {exc}", file=sys.stderr)

@@ -23,13 +23,15 @@ MIN_SAMPLE_RATE_HZ, is refused.
 from __future__ import annotations
 
 import math
+import os
 from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
-from workbench.errors import WorkbenchInputError
+from workbench.errors import WorkbenchInputError, value_text
+from workbench.input_files import check_input_file
 
 #: Columns `generate-data` writes, in this order.
 LOG_COLUMNS = ("t_s", "steer_wheel_deg", "speed_mps", "x_m", "y_m", "yaw_rad", "yaw_rate_rad_s")
@@ -102,8 +104,8 @@ class VehicleLog:
             if bad.any():
                 row = int(np.flatnonzero(bad)[0])
                 raise WorkbenchInputError(
-                    f"{name}: column {col} row {row + 1} is {raw.iloc[row]!r}; every value must be a finite number "
-                    f"(NaN, inf and text are refused: drop or fill such rows first)"
+                    f"{name}: column {col} row {row + 1} is {value_text(raw.iloc[row])}; every value must be a finite "
+                    "number (NaN, inf and text are refused: drop or fill such rows first)"
                 )
             values[col] = numeric
         t = values["t_s"]
@@ -113,7 +115,8 @@ class VehicleLog:
         if np.any(steps <= 0):
             row = int(np.flatnonzero(steps <= 0)[0]) + 1
             raise WorkbenchInputError(
-                f"{name}: t_s must increase strictly; row {row + 1} has t_s = {t[row]!r} after {t[row - 1]!r}"
+                f"{name}: t_s must increase strictly; row {row + 1} has t_s = {value_text(t[row])} after "
+                f"{value_text(t[row - 1])}"
             )
         dt = float(np.median(steps))
         if 1.0 / dt < MIN_SAMPLE_RATE_HZ:
@@ -153,10 +156,14 @@ class VehicleLog:
 def read_log(path: str | Path) -> VehicleLog:
     """Read and validate a vehicle log CSV; WorkbenchInputError naming the file and the problem otherwise."""
     path = Path(path)
-    if not path.is_file():
-        raise WorkbenchInputError(f"vehicle log {str(path)!r} does not exist")
+    label = f"vehicle log {str(path)!r}"
+    if not os.path.lexists(path):
+        raise WorkbenchInputError(f"{label} does not exist")
+    check_input_file(path, label)  # a folder, a parent that is a file, not readable
     try:
         frame = pd.read_csv(path, comment="#", skipinitialspace=True)
+    except OSError as exc:
+        raise WorkbenchInputError(f"{label}: not readable ({exc.strerror or exc})") from None
     except (ValueError, UnicodeDecodeError) as exc:  # pandas' EmptyDataError and ParserError are ValueErrors
         raise WorkbenchInputError(f"{path.name}: not a readable CSV file ({exc})") from None
     return VehicleLog.from_frame(frame, name=path.name)

@@ -1,27 +1,41 @@
 """The `workbench` command line: list scenarios, vehicles and controllers; run a closed-loop simulation; compare
 controllers side by side (`compare`, and the paper's Figure 17 set-up, `fig17`); run parameter sweeps and tune
-controllers from a study spec (`sweep`, `optimise`; `workbench.studies`)."""
+controllers from a study spec (`sweep`, `optimise`; `workbench.studies`).
+
+Every input file and output folder is checked before any work starts (`workbench.input_files`,
+`workbench.output_dir`): a missing or unreadable file, a folder where a file is wanted or a file where a folder is,
+a parent that is a file, an unwritable folder, and a non-empty output folder without --overwrite are refused with
+`workbench: error: ...` and exit code 2.
+
+Exit codes: 0 done; 1 a run did not complete (run, compare, fig17), a sweep run raised an error, no optimisation
+trial completed, or a study's worker died; 2 bad input; 130 interrupted.
+"""
 
 from __future__ import annotations
 
 import argparse
 import math
+import os
 import shutil
 import signal
 import sys
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
+from contextlib import contextmanager
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 from controllers import CONTROLLERS, make_controller
 from controllers.config_file import config_template, read_controller_config
-from workbench.comparison import Comparison, RunSpec, compare
+from workbench.comparison import Comparison, RunSpec, compare, long_run_warning, warn_on_stderr
 from workbench.errors import WorkbenchInputError
 from workbench.fig17 import run_fig17
+from workbench.input_files import check_input_file
 from workbench.limit_cycle import detect_limit_cycle
+from workbench.output_dir import MANIFEST, OutputDir, check_study_dir
 from workbench.report import ReportSection, write_report
-from workbench.scenarios import ScenarioOptions, describe_scenarios, make_scenario
+from workbench.scenarios import SCENARIOS, ScenarioOptions, describe_scenarios, make_scenario
 from workbench.simulator import Simulation, SimulationConfig
+from workbench.studies.spec import DEFAULT_MAX_RUNS
 from workbench.vehicles import VEHICLES, list_presets, make_vehicle, preset_text
 
 if TYPE_CHECKING:
@@ -31,6 +45,14 @@ if TYPE_CHECKING:
 EXIT_INPUT_ERROR = 2
 EXIT_RUN_FAILED = 1
 EXIT_INTERRUPTED = 130
+
+#: The input-file options of the commands (argparse dest -> what the message calls it).
+INPUT_FILES = {
+    "track": "--track",
+    "controller_config": "--controller-config",
+    "vehicle_file": "--vehicle-file",
+    "spec": "the spec",
+}
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -73,6 +95,7 @@ def _parser() -> argparse.ArgumentParser:
     run.add_argument("--plant-rate-hz", type=float, default=1000.0, help="plant integration rate (default 1 kHz)")
     run.add_argument("--lat-accel-g", type=float, default=0.3, help="speed-profile lateral bound (default 0.3 g)")
     run.add_argument("--no-plots", action="store_true", help="write the trace and metrics only")
+    _overwrite_option(run)
 
     cmp = sub.add_parser("compare", help="run several controllers (and vehicles) on one scenario; write a report")
     cmp.add_argument("scenario", help="a scenario name (see `workbench scenarios`) or a waypoint CSV file")
@@ -93,16 +116,19 @@ def _parser() -> argparse.ArgumentParser:
     )
     cmp.add_argument("--out", type=Path, required=True, metavar="DIR", help="output directory")
     _sim_options(cmp)
+    _overwrite_option(cmp)
 
     fig = sub.add_parser(
         "fig17", help="the paper's Figure 17/18 comparison: clothoid vs NMPC, as published and each on each plant"
     )
     fig.add_argument("--out", type=Path, required=True, metavar="DIR", help="output directory (report.html in it)")
     fig.add_argument("--speed", type=float, default=30.0, metavar="KMH", help="target speed, km/h (default 30)")
+    _overwrite_option(fig)
 
     paper = sub.add_parser("paper", help="regenerate the paper's figures 4b-16 and a table of ours against its numbers")
     paper.add_argument("--out", type=Path, required=True, metavar="DIR", help="output directory")
     paper.add_argument("--track", type=Path, help="Zandvoort track CSV (Figures 15-16)")
+    _overwrite_option(paper)
 
     swp = sub.add_parser(
         "sweep", help="run every run a study spec plans (grids, random draws); resumes; DIR/results.parquet"
@@ -120,6 +146,15 @@ def _parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _overwrite_option(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--overwrite",
+        action="store_true",
+        help="write into a non-empty DIR: first remove the files an earlier workbench output there wrote (listed in "
+        f"its {MANIFEST}); other files are kept",
+    )
+
+
 def _backend_options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--backend", choices=("local", "dask"), default="local", help="local process pool (default) or dask"
@@ -129,6 +164,13 @@ def _backend_options(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument(
         "--workers", type=int, metavar="N", help="worker processes (local pool or LocalCluster; default: the CPUs)"
+    )
+    parser.add_argument(
+        "--max-runs",
+        type=int,
+        metavar="N",
+        help=f"refuse a study of more runs than N (an optimisation: trials x runs; default: the spec's "
+        f"study.max_runs, else {DEFAULT_MAX_RUNS:,})",
     )
 
 
@@ -146,6 +188,36 @@ def _names(text: str, what: str) -> list[str]:
     return names
 
 
+def _check_inputs(args: argparse.Namespace) -> None:
+    """Every input file the command names (INPUT_FILES, and a waypoint file given as the scenario) must be a
+    readable file: checked before any work."""
+    for dest, flag in INPUT_FILES.items():
+        value = getattr(args, dest, None)
+        if value is not None:
+            check_input_file(value, f"{flag} {str(value)!r}" if flag.startswith("--") else f"spec file {str(value)!r}")
+    scenario = getattr(args, "scenario", None)
+    if scenario is not None and scenario not in SCENARIOS:
+        if os.path.lexists(scenario) or Path(scenario).suffix.lower() in (".csv", ".txt"):
+            check_input_file(scenario, f"waypoint file {scenario!r}")
+
+
+@contextmanager
+def _writing(out: OutputDir) -> Iterator[None]:
+    """Write a command's output into its folder (`OutputDir.writing`: the earlier output removed first, a
+    manifest of what was written); an OSError while writing is reported as an error naming the folder; files the
+    workbench did not write, kept there, are named."""
+    try:
+        with out.writing():
+            yield
+    except OSError as exc:
+        raise WorkbenchInputError(f"--out {str(out.path)!r}: cannot write the output ({exc})") from None
+    if out.foreign:
+        shown = ", ".join(out.foreign[:5]) + (f" and {len(out.foreign) - 5} more" if len(out.foreign) > 5 else "")
+        what = "an entry" if len(out.foreign) == 1 else f"{len(out.foreign)} entries"
+        note = f"workbench: note: {out.path} also holds {what} the workbench did not write, kept: {shown}"
+        print(note, file=sys.stderr)
+
+
 def _print_summary(comparison: Comparison) -> None:
     table = comparison.summary()
     columns = ["controller", "vehicle", "status", "max_abs_cte_m", "rms_cte_m", "converge_distance_m"]
@@ -157,19 +229,22 @@ def _print_summary(comparison: Comparison) -> None:
 
 
 def _compare(args: argparse.Namespace) -> int:
+    out = OutputDir(args.out, "compare", args.overwrite)
+    _check_inputs(args)
     runs = [
         RunSpec(controller, vehicle, config_file=args.controller_config)
         for vehicle in _names(args.vehicle, "vehicle")
         for controller in _names(args.controllers, "controllers")
     ]
     config = SimulationConfig(speed_kmh=args.speed, laps=args.laps, max_lateral_accel_g=args.lat_accel_g)
-    comparison = compare(args.scenario, runs, config, ScenarioOptions(track_file=args.track))
-    comparison.save(args.out)
-    report = write_report(
-        args.out / "report.html",
-        f"{comparison.scenario.name}: {', '.join(dict.fromkeys(r.controller for r in runs))}",
-        [ReportSection("Side by side", "", comparison)],
-    )
+    comparison = compare(args.scenario, runs, config, ScenarioOptions(track_file=args.track), warn=warn_on_stderr)
+    with _writing(out):
+        comparison.save(args.out)
+        report = write_report(
+            args.out / "report.html",
+            f"{comparison.scenario.name}: {', '.join(dict.fromkeys(r.controller for r in runs))}",
+            [ReportSection("Side by side", "", comparison)],
+        )
     _print_summary(comparison)
     print(f"wrote {report} and summary.csv, figures and runs/ beside it")
     return 0 if all(r.completed for r in comparison.results) else EXIT_RUN_FAILED
@@ -178,7 +253,13 @@ def _compare(args: argparse.Namespace) -> int:
 def _paper(args: argparse.Namespace) -> int:
     from workbench.paper import reproduce_paper
 
-    result = reproduce_paper(args.out, ScenarioOptions(track_file=args.track))
+    out = OutputDir(args.out, "paper", args.overwrite)
+    _check_inputs(args)
+    options = ScenarioOptions(track_file=args.track)
+    if args.track is not None:
+        make_scenario("zandvoort", options)  # a track that cannot be used is refused before any work
+    with _writing(out):
+        result = reproduce_paper(args.out, options)
     print(result.table.to_string(index=False, float_format=lambda v: f"{v:.3g}"))
     for reason in result.skipped:
         print(f"skipped: {reason}")
@@ -187,8 +268,10 @@ def _paper(args: argparse.Namespace) -> int:
 
 
 def _fig17(args: argparse.Namespace) -> int:
+    out = OutputDir(args.out, "fig17", args.overwrite)
     result = run_fig17(SimulationConfig(speed_kmh=args.speed))
-    written = result.save(args.out)
+    with _writing(out):
+        written = result.save(args.out)
     print("Figure 17, fair set (each controller on each plant):")
     _print_summary(result.fair)
     print(f"report: {written[-1]}")
@@ -213,14 +296,23 @@ def _interruptible(study: Callable[[], int], out: Path) -> int:
 
 
 def _start_study(args: argparse.Namespace, kind: str) -> tuple[StudySpec, Backend]:
+    """Check the output folder (a study's resumable store: `check_study_dir`) and the spec (every file it names,
+    the study's size), start nothing yet but the folder and the spec's copy in it."""
     from workbench.studies import load_spec, make_backend
 
-    spec = load_spec(args.spec, kind)
+    check_study_dir(args.out)
+    _check_inputs(args)
+    if args.max_runs is not None and args.max_runs < 1:
+        raise WorkbenchInputError(f"--max-runs must be a whole number >= 1; got {args.max_runs}")
+    spec = load_spec(args.spec, kind, max_runs=args.max_runs)
     backend = make_backend(args.backend, args.scheduler, args.workers)
-    args.out.mkdir(parents=True, exist_ok=True)
     copy = args.out / "spec.toml"
-    if not copy.exists() or not copy.samefile(args.spec):
-        shutil.copyfile(args.spec, copy)
+    try:
+        args.out.mkdir(parents=True, exist_ok=True)
+        if not copy.exists() or not copy.samefile(args.spec):
+            shutil.copyfile(args.spec, copy)
+    except OSError as exc:
+        raise WorkbenchInputError(f"--out {str(args.out)!r}: cannot write the spec's copy ({exc})") from None
     return spec, backend
 
 
@@ -228,7 +320,7 @@ def _sweep(args: argparse.Namespace) -> int:
     from workbench.studies import run_sweep
 
     spec, backend = _start_study(args, "sweep")
-    n = len(spec.plan())
+    n = spec.run_count()
 
     def study() -> int:
         print(f"{n} runs; running those not yet in {args.out} on the {backend.describe()}")
@@ -237,9 +329,17 @@ def _sweep(args: argparse.Namespace) -> int:
         counts = ", ".join(f"{v} {k}" for k, v in result.status_counts().items())
         print(f"{n} runs ({n - result.ran} already done, {result.ran} run now): {counts}")
         print(result.summary().to_string(index=False, float_format=lambda v: f"{v:.3g}"))
-        for message in list(dict.fromkeys(result.errors()["message"]))[:3]:
+        errors = result.errors()
+        for message in list(dict.fromkeys(errors["message"]))[:3]:
             print(f"  error: {message}")
         print(f"wrote {', '.join(str(p) for p in written)}")
+        if len(errors):
+            print(
+                f"workbench: {len(errors)} of {n} runs raised an error (status error; the first messages above, each "
+                f"run's message and traceback in {args.out / 'results.parquet'}): exit code {EXIT_RUN_FAILED}",
+                file=sys.stderr,
+            )
+            return EXIT_RUN_FAILED
         return 0
 
     return _interruptible(study, args.out)
@@ -254,7 +354,7 @@ def _optimise(args: argparse.Namespace) -> int:
 
     def study() -> int:
         print(
-            f"{trials} trials of {len(spec.plan())} runs each, minimising {objective_text(spec)}, "
+            f"{trials} trials of {spec.run_count()} runs each, minimising {objective_text(spec)}, "
             f"on the {backend.describe()}"
         )
         result = run_optimisation(spec, args.out, backend, progress=sys.stderr.isatty())
@@ -273,6 +373,8 @@ def _optimise(args: argparse.Namespace) -> int:
 
 
 def _run(args: argparse.Namespace) -> int:
+    out = OutputDir(args.out, "run", args.overwrite)
+    _check_inputs(args)
     name = args.vehicle if args.vehicle or args.vehicle_file else "kinematic-bicycle"
     vehicle = make_vehicle(name, payload_kg=args.payload_kg, vehicle_file=args.vehicle_file)
     if args.controller not in CONTROLLERS:
@@ -291,8 +393,13 @@ def _run(args: argparse.Namespace) -> int:
         plant_rate_hz=args.plant_rate_hz,
         max_lateral_accel_g=args.lat_accel_g,
     )
-    result = Simulation(scenario, vehicle, controller, config).run(progress=sys.stderr.isatty())
-    written = result.save(args.out, with_plots=not args.no_plots)
+    simulation = Simulation(scenario, vehicle, controller, config)
+    long_run = long_run_warning(simulation, f"{scenario.name}: {controller.name} on {vehicle.name}")
+    for warning in [*simulation.path_warnings(), *([long_run] if long_run is not None else [])]:
+        warn_on_stderr(warning)
+    result = simulation.run(progress=sys.stderr.isatty())
+    with _writing(out):
+        written = result.save(args.out, with_plots=not args.no_plots)
     m = result.metrics
 
     def fmt(value: float | None, unit: str) -> str:
@@ -324,6 +431,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = _parser().parse_args(argv)
     try:
         if args.command == "scenarios":
+            _check_inputs(args)
             for name, description in describe_scenarios(ScenarioOptions(track_file=args.track)):
                 print(f"{name:<12} {description}")
         elif args.command == "vehicles":

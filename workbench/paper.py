@@ -17,6 +17,7 @@ Zandvoort (Figures 15, 16 and its table row) needs the TUMFTM track file and is 
 from __future__ import annotations
 
 import math
+import os
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -26,10 +27,9 @@ import numpy as np
 import pandas as pd
 
 from workbench import plots
-from workbench.errors import WorkbenchInputError
 from workbench.lookahead_study import frechet_vs_lookahead, min_frechet_vs_cte
 from workbench.result import SimulationResult
-from workbench.scenarios import ScenarioOptions, make_scenario
+from workbench.scenarios import ZANDVOORT_ENV, ScenarioOptions, make_scenario
 from workbench.simulator import Simulation, SimulationConfig
 from workbench.vehicles import make_vehicle
 
@@ -186,15 +186,16 @@ def _table(runs: dict[str, SimulationResult]) -> pd.DataFrame:
 def reproduce_paper(out_dir: str | Path, options: ScenarioOptions | None = None) -> PaperResult:
     """Write every figure to out_dir and the comparison table as paper_vs_ours.csv; return what was written."""
     out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
     options = options or ScenarioOptions()
-    files = _lookahead_figures(out) + _tuning_figures(out)
     skipped = []
     scenarios = ["figure8", "dlc"]
-    if _scenario_available("zandvoort", options):
+    if _track_given(options):  # a track given must be usable: a broken one is refused before any work
+        make_scenario("zandvoort", options)
         scenarios.append("zandvoort")
     else:
         skipped.append("Figures 15-16 and the Zandvoort row: no track file (give --track or $WORKBENCH_ZANDVOORT_CSV)")
+    out.mkdir(parents=True, exist_ok=True)
+    files = _lookahead_figures(out) + _tuning_figures(out)
     runs = {name: _tracking(name, options) for name in scenarios}
     for number, scenario, draw, suffix in TRACKING_FIGURES:
         if scenario in runs:
@@ -206,13 +207,9 @@ def reproduce_paper(out_dir: str | Path, options: ScenarioOptions | None = None)
     return PaperResult(files, table, skipped)
 
 
-def _scenario_available(name: str, options: ScenarioOptions) -> bool:
-    """Whether the named scenario can be built (Zandvoort needs its track file)."""
-    try:
-        make_scenario(name, options)
-    except WorkbenchInputError:
-        return False
-    return True
+def _track_given(options: ScenarioOptions) -> bool:
+    """Whether a Zandvoort track file is given (`--track` or $WORKBENCH_ZANDVOORT_CSV)."""
+    return options.track_file is not None or bool(os.environ.get(ZANDVOORT_ENV))
 
 
 __all__ = ["PAPER_REPORTS", "PaperResult", "reproduce_paper", "speed_at_largest_curvature_rate_mps"]

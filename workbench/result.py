@@ -85,9 +85,13 @@ class SimulationResult:
         return plots.speed_vs_distance(self, ax)
 
     def save(self, out_dir: str | Path, with_plots: bool = True) -> list[Path]:
-        """Write trace.parquet, metrics.json (plus status and message) and the PNG plots; return the paths."""
+        """Write trace.parquet, metrics.json (plus status and message) and the PNG plots; return the paths. The
+        files a run writes that are already in out_dir (an earlier run's, the plots included when with_plots is
+        False) are removed first, so the folder never holds files of two runs."""
         out = Path(out_dir)
         out.mkdir(parents=True, exist_ok=True)
+        for name in ("trace.parquet", "metrics.json", *plots.RUN_PLOTS):
+            (out / name).unlink(missing_ok=True)
         written = [out / "trace.parquet", out / "metrics.json"]
         self.to_pandas().to_parquet(written[0], index=False)
         document = self.metrics.to_dict() | {"status": self.status.value, "message": self.message}

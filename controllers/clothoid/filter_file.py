@@ -20,7 +20,6 @@ import itertools
 import json
 import math
 import re
-import tomllib
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -29,6 +28,7 @@ from typing import Any
 
 from controllers.clothoid.lead_filter import LeadFilterParams
 from workbench.errors import WorkbenchInputError, require_in_range
+from workbench.input_files import read_json, read_toml
 
 FORMAT_TAG = "lead-filter/1"
 PARAM_KEYS = ("omega_z_rad_s", "psi", "omega_p_rad_s")
@@ -137,16 +137,8 @@ def read_filter_file(path: str | Path) -> FilterSchedule:
     problem for anything it cannot use."""
     path = Path(path)
     suffix = _suffix(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise _fail(path, "no such file") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise _fail(path, f"cannot be read: {exc}") from None
-    try:
-        doc = json.loads(text) if suffix == ".json" else tomllib.loads(text)
-    except (json.JSONDecodeError, tomllib.TOMLDecodeError) as exc:
-        raise _fail(path, f"not valid {suffix[1:].upper()}: {exc}") from None
+    label = f"lead filter file {path}"
+    doc = read_json(path, label) if suffix == ".json" else read_toml(path, label)
     if isinstance(doc, Mapping) and "format" in doc and doc["format"] != FORMAT_TAG:
         raise _fail(path, f"format is {doc['format']!r}; expected {FORMAT_TAG!r}")
     doc = _check_keys(path, "top level", doc, REQUIRED_KEYS, OPTIONAL_KEYS)

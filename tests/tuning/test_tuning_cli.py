@@ -180,7 +180,7 @@ def test_fit_lag_refuses_bad_logs(logs, tmp_path: Path, capsys, edit, needle: st
         (["fit-lag", "{dlc}", "--vehicle", "zeppelin", "--out", "{tmp}/l.json"], "unknown vehicle 'zeppelin'"),
         (["fit-lag", "{dlc}", "--out", "{tmp}/l.json"], "the kinematic curvature needs the vehicle"),
         (["fit-lag", "{dlc}", "--wheelbase-m", "5", "--out", "{tmp}/l.json"], "go together; give both"),
-        (["fit-lag", "{tmp}/none.csv", *TRUCK, "--out", "{tmp}/l.json"], "none.csv' does not exist"),
+        (["fit-lag", "{tmp}/none.csv", *TRUCK, "--out", "{tmp}/l.json"], "vehicle log '{tmp}/none.csv': no such file"),
         (["design-lead", "--lag", "{tmp}/none.json", "--out", "{tmp}/f.json"], "steering-lag file"),
         (["design-lead", "--lag", "{lag}", "--out", "{tmp}/f.json", "--format", "toml"], "must end in .toml"),
         (["design-lead", "--lag", "{lag}", "--out", "{tmp}/f.yaml"], "must end in .json or .toml"),
@@ -201,7 +201,51 @@ def test_bad_input_exits_2_naming_the_problem(logs, lag_file, tmp_path: Path, ca
     fields = {"dlc": logs["dlc"], "lag": lag_file, "tmp": tmp_path}
     assert main([a.format(**fields) for a in argv]) == 2
     err = capsys.readouterr().err
-    assert err.startswith("tuning: error: ") and needle in err
+    assert err.startswith("tuning: error: ") and needle.format(**fields) in err
+
+
+GENERATE = ["generate-data", "--vehicle", "kinematic-bicycle", "--maneuver", "step", "--speed", "30"]
+
+
+@pytest.mark.parametrize(
+    ("argv", "needle"),
+    [
+        ([*GENERATE, "--out", "{tmp}"], "--out '{tmp}' is a folder, not a file"),
+        ([*GENERATE, "--out", "{tmp}/file/log.csv"], "--out '{tmp}/file/log.csv': '{tmp}/file' is a file, not a"),
+        (["generate-data", "--vehicle-file", "{tmp}", "--maneuver", "dlc", "--speed", "30", "--out", "{tmp}/g.csv"],
+         "vehicle file '{tmp}' (--vehicle-file): a folder, not a file"),
+        (["fit-lag", "{tmp}", *TRUCK, "--out", "{tmp}/l.json"], "vehicle log '{tmp}': a folder, not a file"),
+        (["fit-lag", "{dlc}", *TRUCK, "--out", "{tmp}/l.json", "--plot", "{tmp}"], "--plot '{tmp}' is a folder"),
+        (["design-lead", "--lag", "{tmp}", "--out", "{tmp}/f.json"], "steering-lag file '{tmp}' (--lag): a folder"),
+        (["design-lead", "--lag", "{tmp}/deep.json", "--out", "{tmp}/f.json"],
+         "steering-lag file '{tmp}/deep.json' (--lag): nested deeper than 64 levels"),
+        (["design-lead", "--lag", "{lag}", "--out", "{tmp}/f.json", "--validate", "{tmp}/file/x.csv", *TRUCK],
+         "vehicle log '{tmp}/file/x.csv' (--validate): no such file ('{tmp}/file' is a file, not a folder)"),
+        (["design-lead", "--lag", "{lag}", "--out", "{tmp}/f.json", "--validate-plot", "{tmp}"], "--validate-plot"),
+        (["margins", "--lag", "{lag}", "--lead", "{tmp}", "--speeds", "30", "--out", "{tmp}/m.csv"],
+         "lead filter file '{tmp}' (--lead): a folder, not a file"),
+        (["margins", "--lag", "{lag}", "--measured-lag", "{tmp}/none.json", "--speeds", "30", "--out", "{tmp}/m.csv"],
+         "steering-lag file '{tmp}/none.json' (--measured-lag): no such file"),
+        (["rollover-limits", *TRUCK, "--speeds", "40", "--out", "{tmp}/file/r.csv"], "'{tmp}/file' is a file"),
+        (["schedule", *TRUCK, "--speeds", "40", "--out", "{tmp}/s.json", "--plot", "{tmp}/file/p.png"], "--plot"),
+    ],
+)  # fmt: skip
+def test_unusable_files_and_folders_are_refused_before_any_work(
+    logs, lag_file, tmp_path: Path, capsys, argv, needle: str
+) -> None:
+    (tmp_path / "file").write_text("x")
+    (tmp_path / "deep.json").write_text("[" * 5000 + "]" * 5000)
+    fields = {"dlc": logs["dlc"], "lag": lag_file, "tmp": tmp_path}
+    assert main([a.format(**fields) for a in argv]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("tuning: error: ") and needle.format(**fields) in err and err.count("\n") == 1, err
+
+
+def test_an_unwritable_output_folder_is_refused(tmp_path: Path, capsys, monkeypatch) -> None:
+    monkeypatch.setattr("workbench.output_dir.os.access", lambda *_args, **_kw: False)  # as without permission
+    assert main([*GENERATE, "--out", str(tmp_path / "new" / "log.csv")]) == 2
+    assert f"the folder {str(tmp_path)!r} is not writable (permission denied)" in capsys.readouterr().err
+    assert not (tmp_path / "new").exists()
 
 
 def test_amplitude_and_lateral_acceleration_exclude_each_other(tmp_path: Path) -> None:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import os
 import re
 import subprocess
 import sys
@@ -13,6 +14,7 @@ import pandas as pd
 import pytest
 
 from workbench.cli import main
+from workbench.errors import WorkbenchInputError
 from workbench.metrics import METRIC_KEYS
 
 
@@ -53,7 +55,7 @@ def test_run_dlc_writes_trace_metrics_and_plots(tmp_path: Path, capsys: pytest.C
         (["run", "dlc", "--speed", "0", "--out", "X"], "speed_kmh"),
         (["run", "dlc", "--speed", "-10", "--out", "X"], "speed_kmh"),
         (["run", "dlc", "--speed", "nan", "--out", "X"], "speed_kmh"),
-        (["run", "missing.csv", "--out", "X"], "does not exist"),
+        (["run", "missing.csv", "--out", "X"], "waypoint file 'missing.csv': no such file"),
     ],
 )
 def test_bad_input_exits_2_with_a_message(args: list[str], needle: str, capsys, tmp_path: Path) -> None:
@@ -147,8 +149,10 @@ def test_clothoid_options_from_a_config_file_and_set(tmp_path: Path, capsys) -> 
     assert main([*args, "--set", "fixed_lookahead_m=7", "--no-plots"]) == 0
     trace = pd.read_parquet(out / "trace.parquet")
     assert (trace["ctrl_lookahead_m"] == 7.0).all()
-    assert main([*args, "--set", "fixed_lookahead_m=-7"]) == 2
-    assert "fixed_lookahead_m must be in [0.5, 200.0] m; got -7.0" in capsys.readouterr().err
+    assert main([*args, "--set", "fixed_lookahead_m=-7", "--overwrite"]) == 2
+    err = capsys.readouterr().err
+    assert "[clothoid]: fixed_lookahead_m must be" in err and "got -7.0" in err
+    assert (out / "trace.parquet").is_file()  # a refused run leaves the earlier output as it was
 
 
 def test_compare_writes_report_summary_and_runs(tmp_path: Path, capsys) -> None:
@@ -215,3 +219,162 @@ def test_fig17_writes_the_published_and_fair_sets(tmp_path: Path, capsys) -> Non
     html = (out / "report.html").read_text(encoding="utf-8")
     assert html.count("<h2>") == 2 and html.count("data:image/png;base64,") == 8
     assert str(out / "report.html") in capsys.readouterr().out
+
+
+# --- output folders and input files: refused before any work ---------------------------------------------------
+
+QUICK_RUN = ["run", "dlc", "--controller", "pure-pursuit", "--vehicle", "kinematic-bicycle"]
+
+
+def test_a_reused_output_folder_is_refused_or_replaced_whole(tmp_path: Path, capsys) -> None:
+    out = tmp_path / "dlc"
+    assert main([*QUICK_RUN, "--out", str(out)]) == 0
+    (out / "notes.txt").write_text("my notes")
+    capsys.readouterr()
+    assert main([*QUICK_RUN, "--no-plots", "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"workbench: error: --out {str(out)!r} holds the output of an earlier `workbench run`")
+    assert "give --overwrite" in err
+    assert main([*QUICK_RUN, "--no-plots", "--overwrite", "--out", str(out)]) == 0
+    # the PNGs of the earlier run are gone, the new trace and metrics are there, the user's file is kept and named
+    assert sorted(p.name for p in out.iterdir()) == [
+        ".workbench-manifest.json",
+        "metrics.json",
+        "notes.txt",
+        "trace.parquet",
+    ]
+    assert "kept: notes.txt" in capsys.readouterr().err
+    manifest = json.loads((out / ".workbench-manifest.json").read_text())
+    assert manifest["command"] == "run" and manifest["files"] == ["metrics.json", "trace.parquet"]
+
+
+def test_compare_replaces_its_own_output_only(tmp_path: Path, capsys) -> None:
+    out = tmp_path / "cmp"
+    args = ["compare", "dlc", "--vehicle", "kinematic-bicycle", "--out", str(out)]
+    assert main([*args, "--controllers", "pure-pursuit,stanley"]) == 0
+    assert main([*args, "--controllers", "stanley"]) == 2
+    assert "holds the output of an earlier `workbench compare`" in capsys.readouterr().err
+    assert main([*args, "--controllers", "stanley", "--overwrite"]) == 0
+    assert sorted(p.name for p in (out / "runs").iterdir()) == ["stanley-kinematic-bicycle"]
+
+
+COMMANDS_WITH_OUT = {
+    "run": QUICK_RUN,
+    "compare": ["compare", "dlc", "--controllers", "stanley", "--vehicle", "kinematic-bicycle"],
+    "fig17": ["fig17"],
+    "paper": ["paper"],
+    "sweep": ["sweep", "{spec}"],
+    "optimise": ["optimise", "{spec}"],
+}
+
+
+@pytest.fixture
+def spec_file(tmp_path: Path) -> Path:
+    path = tmp_path / "spec.toml"
+    path.write_text('[study]\nscenarios = ["dlc"]\ncontrollers = ["pure-pursuit"]\nvehicles = ["kinematic-bicycle"]\n')
+    return path
+
+
+@pytest.mark.parametrize("command", COMMANDS_WITH_OUT)
+@pytest.mark.parametrize("case", ["a file", "parent a file", "not writable"])
+def test_an_unusable_output_folder_is_refused_before_any_work(
+    command: str, case: str, tmp_path: Path, spec_file: Path, capsys, monkeypatch
+) -> None:
+    (tmp_path / "file").write_text("x")
+    out = {"a file": tmp_path / "file", "parent a file": tmp_path / "file" / "out"}.get(case, tmp_path / "new")
+    if case == "not writable":  # simulated: root may write anyway
+        monkeypatch.setattr("workbench.output_dir.os.access", lambda *_args, **_kw: False)
+    argv = [a.format(spec=spec_file) for a in COMMANDS_WITH_OUT[command]]
+    assert main([*argv, "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    expected = {
+        "a file": "is a file, not a folder",
+        "parent a file": f"{str(tmp_path / 'file')!r} is a file, not a folder",
+        "not writable": "is not writable (permission denied)",
+    }[case]
+    assert err.startswith(f"workbench: error: --out {str(out)!r}") and expected in err and err.count("\n") == 1
+    assert not (tmp_path / "new").exists()
+
+
+@pytest.mark.skipif(os.geteuid() == 0, reason="root may write anywhere")
+def test_a_read_only_output_folder_is_refused(tmp_path: Path, capsys) -> None:
+    folder = tmp_path / "ro"
+    folder.mkdir()
+    folder.chmod(0o500)
+    try:
+        assert main([*QUICK_RUN, "--out", str(folder / "out")]) == 2
+        assert "is not writable (permission denied)" in capsys.readouterr().err
+    finally:
+        folder.chmod(0o700)
+
+
+@pytest.mark.parametrize(
+    ("option", "label"),
+    [
+        ("--controller-config", "--controller-config"),
+        ("--vehicle-file", "--vehicle-file"),
+        ("--track", "--track"),
+        ("scenario", "waypoint file"),
+    ],
+)
+@pytest.mark.parametrize("command", ["run", "compare"])
+def test_an_input_file_that_is_a_folder_or_missing_is_refused(
+    option: str, label: str, command: str, tmp_path: Path, capsys
+) -> None:
+    folder = tmp_path / "inputs.csv"
+    folder.mkdir()
+    if command == "compare" and option == "--vehicle-file":
+        pytest.skip("compare takes preset names only")
+    base = COMMANDS_WITH_OUT[command]
+    for path, problem in ((folder, "a folder, not a file"), (tmp_path / "file" / "x.csv", "is a file, not a folder")):
+        (tmp_path / "file").write_text("x")
+        argv = [*base[:1], str(path), *base[2:]] if option == "scenario" else [*base, option, str(path)]
+        assert main([*argv, "--out", str(tmp_path / "out")]) == 2
+        err = capsys.readouterr().err
+        assert err.startswith(f"workbench: error: {label} {str(path)!r}: ") and problem in err, err
+    assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize("option", ["--controller-config", "--vehicle-file"])
+def test_a_toml_nested_5000_deep_is_refused(option: str, tmp_path: Path, capsys) -> None:
+    deep = tmp_path / "deep.toml"
+    deep.write_text("[pure-pursuit]\nx = " + "[" * 5000 + "]" * 5000 + "\n")
+    assert main([*QUICK_RUN, option, str(deep), "--out", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err
+    assert "nested deeper than 64 levels" in err and str(deep) in err and "Traceback" not in err
+
+
+def test_a_very_long_run_is_announced_before_it_starts(tmp_path: Path, capsys, monkeypatch) -> None:
+    """--speed 0.001: a warning with the simulated time, steps and trace size, before anything is simulated."""
+
+    def stop(*_args, **_kwargs):
+        raise WorkbenchInputError("stopped before simulating")
+
+    monkeypatch.setattr("workbench.cli.Simulation.run", stop)
+    assert main([*QUICK_RUN, "--speed", "0.001", "--out", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err
+    warning, error = err.splitlines()
+    assert warning.startswith("workbench: warning: dlc: pure-pursuit on kinematic-bicycle may simulate up to ")
+    assert re.search(r"\(\d{3},\d{3},\d{3} controller steps at 50 Hz\)", warning)
+    assert re.search(r"about \d+\.\d GB at 8 bytes a value", warning) and "A higher --speed (now 0.001 km/h)" in warning
+    assert error == "workbench: error: stopped before simulating"
+
+
+def test_compare_announces_a_long_run(tmp_path: Path, capsys, monkeypatch) -> None:
+    monkeypatch.setattr("workbench.comparison.LONG_RUN_STEPS", 1000)  # a dlc at 30 km/h may take ~5 700 steps
+    args = COMMANDS_WITH_OUT["compare"]
+    assert main([*args, "--out", str(tmp_path / "cmp")]) == 0
+    err = capsys.readouterr().err
+    assert "workbench: warning: stanley on kinematic-bicycle may simulate up to 99 s (4,933 controller steps" in err
+
+
+def test_a_path_tighter_than_the_vehicle_turns_is_named_before_the_run(tmp_path: Path, capsys, monkeypatch) -> None:
+    def stop(*_args, **_kwargs):
+        raise WorkbenchInputError("stopped before simulating")
+
+    monkeypatch.setattr("workbench.cli.Simulation.run", stop)
+    angles = np.linspace(0.0, 2 * np.pi, 60)  # a 1 m circle: the car turns no tighter than a 1.42 m radius
+    pd.DataFrame({"x": 1.0 * np.cos(angles), "y": 1.0 * np.sin(angles)}).to_csv(tmp_path / "tight.csv", index=False)
+    assert main([*QUICK_RUN[:1], str(tmp_path / "tight.csv"), *QUICK_RUN[2:], "--out", str(tmp_path / "o")]) == 2
+    warning = capsys.readouterr().err.splitlines()[0]
+    assert warning.startswith("workbench: warning: ") and "tighter than the kinematic-bicycle can turn" in warning

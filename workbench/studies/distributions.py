@@ -22,7 +22,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from workbench.errors import WorkbenchInputError
+from workbench.errors import WorkbenchInputError, value_text
 
 if TYPE_CHECKING:
     import optuna
@@ -41,7 +41,7 @@ SEARCHABLE = ("uniform", "log_uniform", "integers", "choice")
 
 def _number(where: str, value: object) -> float:
     if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
-        raise WorkbenchInputError(f"{where} must hold finite numbers; got {value!r}")
+        raise WorkbenchInputError(f"{where} must hold finite numbers; got {value_text(value)}")
     return float(value)
 
 
@@ -63,7 +63,7 @@ class Distribution:
                 raise WorkbenchInputError(f"{where} needs at least one value; got []")
             for v in values:
                 if isinstance(v, float) and not math.isfinite(v):
-                    raise WorkbenchInputError(f"{where} values must be finite; got {v!r}")
+                    raise WorkbenchInputError(f"{where} values must be finite; got {value_text(v)}")
                 if isinstance(v, dict | list):
                     raise WorkbenchInputError(f"{where} values must be numbers, text or booleans; got {v!r}")
             if len({repr(v) for v in values}) != len(values):

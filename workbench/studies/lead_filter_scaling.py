@@ -17,12 +17,12 @@ from pathlib import Path
 
 from controllers.clothoid.filter_file import DEFAULT_FILTER, FilterSchedule, read_filter_file, write_filter_file
 from controllers.clothoid.lead_filter import LeadFilterParams
-from workbench.errors import WorkbenchInputError
+from workbench.errors import WorkbenchInputError, value_text
 
 
 def _require_scale(name: str, value: float) -> None:
     if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value) or value <= 0:
-        raise WorkbenchInputError(f"{name} must be a finite number > 0; got {value!r}")
+        raise WorkbenchInputError(f"{name} must be a finite number > 0; got {value_text(value)}")
 
 
 def scale_schedule(schedule: FilterSchedule, zero_scale: float = 1.0, pole_scale: float = 1.0) -> FilterSchedule:
@@ -35,8 +35,8 @@ def scale_schedule(schedule: FilterSchedule, zero_scale: float = 1.0, pole_scale
         )
     except WorkbenchInputError as exc:
         raise WorkbenchInputError(
-            f"lead_filter_zero_scale = {zero_scale!r}, lead_filter_pole_scale = {pole_scale!r} give a filter Eq. 6 "
-            f"does not allow: {exc}"
+            f"lead_filter_zero_scale = {value_text(zero_scale)}, lead_filter_pole_scale = {value_text(pole_scale)} "
+            f"give a filter Eq. 6 does not allow: {exc}"
         ) from None
     return FilterSchedule(schedule.speeds_kmh, params, schedule.source)
 

@@ -30,7 +30,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import pandas as pd
 
-from workbench.errors import WorkbenchInputError
+from workbench.errors import WorkbenchInputError, value_text
 from workbench.studies.backends import Backend, LocalBackend
 from workbench.studies.results import SweepResult
 from workbench.studies.runner import build_controller_config
@@ -70,7 +70,8 @@ def trial_value(rows: list[dict[str, Any]], weights: dict[str, float], aggregate
         for key, weight in weights.items():
             value = row.get(key)
             if value is None or not math.isfinite(value):
-                return None, f"metric {key} is {value!r} for run {row['run_id']} ({row['vehicle']}, {row['scenario']})"
+                where = f"run {row['run_id']} ({row['vehicle']}, {row['scenario']})"
+                return None, f"metric {key} is {value_text(value)} for {where}"
             total += weight * value
         values.append(total)
     return float(np.mean(values) if aggregate == "mean" else np.max(values)), ""

@@ -9,6 +9,7 @@ and seeded random draws; for `workbench optimise` also the objective and the sea
     # track_file = "Zandvoort.csv"          # for the zandvoort scenario
     # seed = 0                              # of the random draws
     # samples = 20                          # random draws; required with [random], not allowed without
+    # max_runs = 100000                     # refuse a larger study (default DEFAULT_MAX_RUNS; `--max-runs N`)
 
     [grid]                                  # run parameters: a list is an axis, a single value is fixed
     speed_kmh = [20, 30, 40]
@@ -36,8 +37,13 @@ axes and the random samples (draw i of every key together). Each run's id is a h
 and a restarted or extended study finds the runs it already has.
 
 The spec is checked before any run starts: unknown tables and keys, unknown names, missing files, empty lists,
-NaN, wrong types and misplaced keys are WorkbenchInputError naming the key and what is allowed. A value that a
-run's vehicle, scenario, simulation or controller refuses (out of range, inconsistent) is that run's error.
+NaN, wrong types and misplaced keys are WorkbenchInputError naming the key and what is allowed. Every file the
+spec names is read as the runs will read it (`_check_files`): the controller-config file (its keys and values, for
+each controller), vehicle files, waypoint files, the track file, and the files the controllers' options name
+(lead filters, limits, lags, vehicle files, from the config file or the grid). A study planning more runs than
+max_runs (counted from the axes' sizes, `run_count`, before anything is planned; an optimisation: trials x runs)
+is refused saying how many. A value that a run's vehicle, scenario, simulation or controller refuses only in
+combination (out of range, inconsistent) is that run's error.
 """
 
 from __future__ import annotations
@@ -48,7 +54,6 @@ import itertools
 import json
 import math
 import os
-import tomllib
 import types
 import typing
 from collections.abc import Mapping, Sequence
@@ -58,9 +63,10 @@ from types import MappingProxyType
 from typing import Any
 
 from controllers import CONTROLLERS
-from workbench.errors import WorkbenchInputError
+from workbench.errors import WorkbenchInputError, value_text
+from workbench.input_files import check_input_file, read_json, read_toml
 from workbench.metrics import METRIC_KEYS
-from workbench.scenarios import SCENARIOS, ZANDVOORT_ENV, ZANDVOORT_SOURCE
+from workbench.scenarios import SCENARIOS, ZANDVOORT_ENV, ZANDVOORT_SOURCE, ScenarioOptions
 from workbench.simulator import SimulationConfig
 from workbench.studies.distributions import SEARCHABLE, Distribution, key_rng
 from workbench.vehicles import VEHICLES
@@ -97,10 +103,14 @@ STUDY_KEYS = (
     "seed",
     "samples",
     "description",
+    "max_runs",
 )
 OPTIMISE_KEYS = ("trials", "batch_size", "seed", "startup_trials", "aggregate", "objective", "search")
 SCENARIO_FILE_SUFFIXES = (".csv", ".txt")
 RUN_FORMAT = "workbench-run/1"
+#: The most runs a study may plan (an optimisation: trials x runs per trial) unless study.max_runs or
+#: `--max-runs N` allows more: 100 000 runs take hours on a workstation (about 0.2 s each on one core).
+DEFAULT_MAX_RUNS = 100_000
 
 
 def controller_parameters(controller: str) -> dict[str, Any]:
@@ -137,7 +147,7 @@ def typed_value(where: str, value: Any, annotation: Any, base_dir: Path) -> Any:
         return None
     if base is float and isinstance(value, int | float) and not isinstance(value, bool):
         if not math.isfinite(value):
-            raise WorkbenchInputError(f"{where} must be a finite number; got {value!r}")
+            raise WorkbenchInputError(f"{where} must be a finite number; got {value_text(value)}")
         return float(value)
     if base is int and isinstance(value, int) and not isinstance(value, bool):
         return value
@@ -148,7 +158,7 @@ def typed_value(where: str, value: Any, annotation: Any, base_dir: Path) -> Any:
     if base is Path and isinstance(value, str | Path) and str(value):
         path = Path(value).expanduser()
         return path if path.is_absolute() else base_dir / path
-    raise WorkbenchInputError(f"{where} must be a {_type_name(annotation)}; got {value!r}")
+    raise WorkbenchInputError(f"{where} must be a {_type_name(annotation)}; got {value_text(value)}")
 
 
 def _check_distribution(where: str, dist: Distribution, annotation: Any, base_dir: Path) -> Distribution:
@@ -184,10 +194,10 @@ def _resolve_name(key: str, name: str, known: Sequence[str], suffixes: tuple[str
         return name
     path = Path(name).expanduser()
     path = path if path.is_absolute() else base_dir / path
-    if path.suffix.lower() in suffixes or path.is_file():
-        if not path.is_file():
+    if path.suffix.lower() in suffixes or os.path.lexists(path):
+        if not os.path.lexists(path):
             raise WorkbenchInputError(f"study.{key}: file {name!r} does not exist (looked for {path})")
-        return str(path)
+        return str(check_input_file(path, f"study.{key}: file {name!r} ({path})"))
     kinds = " or ".join(f"a {s} file" for s in suffixes)
     raise WorkbenchInputError(f"study.{key}: unknown name {name!r}; choose one of {', '.join(known)} or give {kinds}")
 
@@ -311,9 +321,9 @@ class OptimiseSettings:
         for name, low in (("trials", 1), ("batch_size", 1), ("startup_trials", 0)):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, int) or value < low:
-                raise WorkbenchInputError(f"optimise.{name} must be a whole number >= {low}; got {value!r}")
+                raise WorkbenchInputError(f"optimise.{name} must be a whole number >= {low}; got {value_text(value)}")
         if self.seed is not None and (isinstance(self.seed, bool) or not isinstance(self.seed, int) or self.seed < 0):
-            raise WorkbenchInputError(f"optimise.seed must be a whole number >= 0; got {self.seed!r}")
+            raise WorkbenchInputError(f"optimise.seed must be a whole number >= 0; got {value_text(self.seed)}")
         if self.aggregate not in AGGREGATES:
             raise WorkbenchInputError(
                 f"optimise.aggregate must be one of {', '.join(AGGREGATES)}; got {self.aggregate!r}"
@@ -370,7 +380,8 @@ class OptimiseSettings:
 class StudySpec:
     """A study: see the module docstring. base_dir: the folder relative paths are taken from (the spec file's).
     grid / random: run-parameter axes / distributions; controller_grid / controller_random: the same per
-    controller. Values are checked and typed on construction (paths made absolute)."""
+    controller; max_runs: the most runs the study may plan (an optimisation: trials x runs per trial). Values are
+    checked and typed on construction (paths made absolute, the files they name read)."""
 
     scenarios: Sequence[str]
     controllers: Sequence[str]
@@ -386,6 +397,7 @@ class StudySpec:
     description: str = ""
     base_dir: Path = field(default_factory=Path.cwd)
     optimise: OptimiseSettings | None = None
+    max_runs: int = DEFAULT_MAX_RUNS
 
     def __post_init__(self) -> None:
         base = Path(self.base_dir).resolve()
@@ -417,13 +429,13 @@ class StudySpec:
             value = getattr(self, name)
             if value is not None:
                 path = typed_value(f"study.{name}", value, Path, base)
-                if not path.is_file():
+                if not os.path.lexists(path):
                     raise WorkbenchInputError(f"study.{name}: file {str(value)!r} does not exist (looked for {path})")
-                object.__setattr__(self, name, path)
+                object.__setattr__(self, name, check_input_file(path, f"study.{name}: file {str(value)!r}"))
         if not isinstance(self.description, str):
             raise WorkbenchInputError(f"study.description must be text; got {self.description!r}")
         if isinstance(self.seed, bool) or not isinstance(self.seed, int) or self.seed < 0:
-            raise WorkbenchInputError(f"study.seed must be a whole number >= 0; got {self.seed!r}")
+            raise WorkbenchInputError(f"study.seed must be a whole number >= 0; got {value_text(self.seed)}")
 
         grid = _axes("grid", self.grid, RUN_PARAMETERS, base)
         random = _draws("random", self.random, RUN_PARAMETERS, base)
@@ -447,9 +459,9 @@ class StudySpec:
                 raise WorkbenchInputError(
                     f"{', '.join(both)} is both in [grid{where}] and in [random{where}]; keep one"
                 )
+        models = _vehicle_models(vehicles)  # reads the vehicle files: a file a run cannot use is refused now
         if "payload_kg" in grid or "payload_kg" in random:
-            carriers = [v for v in vehicles if v in VEHICLES and _has_payload(v)]
-            others = [v for v in vehicles if v not in carriers and v in VEHICLES]
+            others = [v for v in vehicles if not _has_payload(models[v])]
             if others:
                 raise WorkbenchInputError(
                     f"payload_kg is given but vehicle(s) {', '.join(others)} have no payload; a payload applies to "
@@ -462,13 +474,96 @@ class StudySpec:
         has_draws = bool(random) or any(controller_random.values())
         if self.samples is not None:
             if isinstance(self.samples, bool) or not isinstance(self.samples, int) or self.samples < 1:
-                raise WorkbenchInputError(f"study.samples must be a whole number >= 1; got {self.samples!r}")
+                raise WorkbenchInputError(f"study.samples must be a whole number >= 1; got {value_text(self.samples)}")
             if not has_draws:
                 raise WorkbenchInputError(f"study.samples = {self.samples} but [random] draws nothing; drop samples")
         elif has_draws:
             raise WorkbenchInputError("[random] draws parameters: give study.samples, the number of draws")
         if self.optimise is not None:
             object.__setattr__(self, "optimise", self._checked_optimise(self.optimise))
+        if isinstance(self.max_runs, bool) or not isinstance(self.max_runs, int) or self.max_runs < 1:
+            raise WorkbenchInputError(f"study.max_runs must be a whole number >= 1; got {value_text(self.max_runs)}")
+        self._check_size()
+        self._check_files(models)
+
+    # ------------------------------------------------------------------------------------------- checks
+    def run_count(self) -> int:
+        """How many runs `plan()` gives, counted from the axes' sizes without planning them: per scenario and
+        vehicle, the sum over controllers of the product of the run-parameter axes, that controller's axes and
+        the samples. (An optimisation runs this many per trial.)"""
+        runs_per_controller = sum(self._runs_per_controller().values())
+        return len(self.scenarios) * len(self.vehicles) * runs_per_controller
+
+    def _runs_per_controller(self) -> dict[str, int]:
+        grid = math.prod(len(values) for values in self.grid.values())
+        samples = self.samples or 1
+        return {
+            c: grid * math.prod(len(v) for v in self.controller_grid.get(c, {}).values()) * samples
+            for c in self.controllers
+        }
+
+    def total_runs(self) -> int:
+        """The runs the whole study executes: run_count(), times the trials of an optimisation."""
+        return self.run_count() * (self.optimise.trials if self.optimise is not None else 1)
+
+    def _check_size(self) -> None:
+        total = self.total_runs()
+        if total <= self.max_runs:
+            return
+        axes = [f"{len(self.scenarios)} scenario(s)", f"{len(self.vehicles)} vehicle(s)"]
+        per_controller = self._runs_per_controller()
+        axes.append(
+            " + ".join(f"{c} {n:,}" for c, n in per_controller.items()) + " runs per scenario and vehicle"
+            if len(per_controller) > 1
+            else f"{next(iter(per_controller.values())):,} runs per scenario and vehicle"
+        )
+        sizes = [f"{k} {len(v)}" for k, v in self.grid.items()]
+        sizes += [f"{c}.{k} {len(v)}" for c, axes_c in self.controller_grid.items() for k, v in axes_c.items()]
+        if self.samples:
+            sizes.append(f"samples {self.samples:,}")
+        trials = f" x {self.optimise.trials:,} trials" if self.optimise is not None else ""
+        raise WorkbenchInputError(
+            f"the study plans {total:,} runs ({' x '.join(axes)}{trials}; axes: {', '.join(sizes) or 'none'}), "
+            f"more than the limit of {self.max_runs:,}: shrink the grid, the samples or the trials, or raise the "
+            "limit with study.max_runs or --max-runs N"
+        )
+
+    def _check_files(self, models: Mapping[str, Any]) -> None:
+        """Read every file the runs will read, as they will: the controller-config file for each controller
+        (its keys and values), waypoint and track files, and each file a controller option names (in the config
+        file, the grid or a choice). A WorkbenchInputError names the key and the file."""
+        from controllers.config_file import read_controller_config
+        from workbench.scenarios import make_scenario
+
+        for scenario in self.scenarios:
+            if scenario not in SCENARIOS:
+                try:
+                    make_scenario(scenario)
+                except WorkbenchInputError as exc:
+                    raise WorkbenchInputError(f"study.scenarios: {exc}") from None
+        if "zandvoort" in self.scenarios:
+            try:
+                make_scenario("zandvoort", ScenarioOptions(track_file=self.track_file))
+            except WorkbenchInputError as exc:
+                raise WorkbenchInputError(f"study.track_file: {exc}") from None
+        geometry = next(iter(models.values())).geometry
+        checked: set[Path] = set()
+        for controller in self.controllers:
+            params = controller_parameters(controller)
+            file_options = [k for k, t in params.items() if _unwrap(t)[0] is Path]
+            config = read_controller_config(self.controller_config, controller, CONTROLLERS[controller].config_type)
+            named = [(f"{controller}.{k} in study.controller_config", k, getattr(config, k)) for k in file_options]
+            for where, table in (("grid", self.controller_grid), ("random", self.controller_random)):
+                for key, values in table.get(controller, {}).items():
+                    if key in file_options:
+                        values = values.values if isinstance(values, Distribution) else values
+                        named += [(f"{where}.{controller}.{key}", key, v) for v in values]
+            search = self.optimise.search if self.optimise is not None else {}
+            named += [(f"optimise.search.{k}", k, v) for k, d in search.items() if k in file_options for v in d.values]
+            for where, key, path in named:
+                if path is not None and path not in checked:
+                    _check_option_file(where, key, path, geometry)
+                    checked.add(path)
 
     def _checked_optimise(self, optimise: OptimiseSettings) -> OptimiseSettings:
         """The [optimise] settings checked against the study (one controller, its options fixed or searched), with
@@ -585,31 +680,69 @@ class StudySpec:
         )
 
 
-def _has_payload(vehicle: str) -> bool:
+def _has_payload(vehicle: Any) -> bool:
+    """Whether a vehicle (a model, or a preset name) carries a payload."""
     from workbench.vehicles.presets import MODEL_TYPES
 
-    return "payload_kg" in MODEL_TYPES[vehicle][1].__dataclass_fields__
+    name = vehicle if isinstance(vehicle, str) else vehicle.name
+    return "payload_kg" in MODEL_TYPES[name][1].__dataclass_fields__
 
 
-def load_spec(path: str | Path, kind: str = "sweep") -> StudySpec:
-    """Read a study spec from a TOML file. kind: "sweep" (no [optimise] table) or "optimise" (one required).
-    WorkbenchInputError naming the file, the key and what is allowed for anything it cannot use."""
+def _vehicle_models(vehicles: Sequence[str]) -> dict[str, Any]:
+    """Each vehicle (preset name or file) built from its preset or file: a file a run cannot use is refused now,
+    naming it."""
+    from workbench.vehicles.presets import load_vehicle
+
+    models = {}
+    for vehicle in vehicles:
+        try:
+            models[vehicle] = load_vehicle(vehicle)
+        except WorkbenchInputError as exc:
+            raise WorkbenchInputError(f"study.vehicles: {exc}") from None
+    return models
+
+
+def _check_option_file(where: str, key: str, path: Path, geometry: Any) -> None:
+    """Read a file a controller option names, as the controller will (lead filters, curvature limits, steering
+    lags, vehicle files); any other file must at least be readable."""
+    from controllers.clothoid.curvature_limits import CurvatureLimits
+    from controllers.clothoid.filter_file import read_filter_file
+    from workbench.vehicles.presets import load_vehicle
+    from workbench.vehicles.steering_lag import read_lag_file
+
+    label = f"{where}: {path}"
+    check_input_file(path, label)
+    if path.suffix.lower() == ".json":
+        read_json(path, label)  # deep nesting, bad JSON: refused here, whatever reads it next
+    readers = {
+        "filter_file": read_filter_file,
+        "limits_file": lambda p: CurvatureLimits.read_csv(p, geometry),
+        "lag_file": read_lag_file,
+        "vehicle_file": lambda p: load_vehicle(str(p)),
+    }
+    if key in readers:
+        try:
+            readers[key](path)
+        except WorkbenchInputError as exc:
+            raise WorkbenchInputError(f"{where}: {exc}") from None
+
+
+def load_spec(path: str | Path, kind: str = "sweep", max_runs: int | None = None) -> StudySpec:
+    """Read a study spec from a TOML file. kind: "sweep" (no [optimise] table) or "optimise" (one required);
+    max_runs: the limit on the study's runs, over the spec's study.max_runs (None: the spec's, else
+    DEFAULT_MAX_RUNS). WorkbenchInputError naming the file, the key and what is allowed for anything it cannot
+    use."""
     if kind not in ("sweep", "optimise"):
         raise WorkbenchInputError(f"kind must be sweep or optimise; got {kind!r}")
     path = Path(path)
+    document = read_toml(path, f"spec file {str(path)!r}")
     try:
-        document = tomllib.loads(path.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise WorkbenchInputError(f"spec file {str(path)!r} does not exist") from None
-    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as exc:
-        raise WorkbenchInputError(f"spec file {str(path)!r} is not valid TOML: {exc}") from None
-    try:
-        return _from_document(document, kind, path.resolve().parent)
+        return _from_document(document, kind, path.resolve().parent, max_runs)
     except WorkbenchInputError as exc:
         raise WorkbenchInputError(f"spec {path}: {exc}") from None
 
 
-def _from_document(document: Mapping[str, Any], kind: str, base_dir: Path) -> StudySpec:
+def _from_document(document: Mapping[str, Any], kind: str, base_dir: Path, max_runs: int | None = None) -> StudySpec:
     tables = ("study", "grid", "random") + (("optimise",) if kind == "optimise" else ())
     unknown = [k for k in document if k not in tables]
     if unknown:
@@ -647,10 +780,12 @@ def _from_document(document: Mapping[str, Any], kind: str, base_dir: Path) -> St
         description=study.get("description", ""),
         base_dir=base_dir,
         optimise=optimise,
+        max_runs=max_runs if max_runs is not None else study.get("max_runs", DEFAULT_MAX_RUNS),
     )
 
 
 __all__ = [
+    "DEFAULT_MAX_RUNS",
     "LEAD_FILTER_SCALES",
     "OBJECTIVE_METRICS",
     "RUN_PARAMETERS",

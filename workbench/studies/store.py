@@ -46,7 +46,7 @@ class RunStore:
         for run_id in run_ids:
             try:
                 row = json.loads(self.path(run_id).read_text(encoding="utf-8"))
-            except (OSError, ValueError):
+            except (OSError, ValueError, RecursionError):  # unreadable, not JSON, nested too deep: redo the run
                 continue
             if isinstance(row, dict) and row.get("run_id") == run_id:
                 rows[run_id] = row

@@ -15,12 +15,13 @@ by the params dataclass (which names the field and its allowed range).
 from __future__ import annotations
 
 import dataclasses
-import tomllib
+import os
 from importlib import resources
 from pathlib import Path
 from typing import Any
 
-from workbench.errors import WorkbenchInputError
+from workbench.errors import WorkbenchInputError, value_text
+from workbench.input_files import parse_toml, read_text
 from workbench.vehicles.base import VehicleModel
 from workbench.vehicles.commonroad_mb import CommonRoadMB, CommonRoadMBParams
 from workbench.vehicles.dynamic_bicycle import DynamicBicycle, DynamicBicycleParams
@@ -47,7 +48,7 @@ def list_presets() -> dict[str, str]:
     found = {}
     for entry in sorted(_preset_dir().iterdir(), key=lambda e: e.name):
         if entry.name.endswith(".toml"):
-            model = tomllib.loads(entry.read_text(encoding="utf-8")).get("model", {})
+            model = parse_toml(entry.read_text(encoding="utf-8"), f"preset {entry.name}").get("model", {})
             found[entry.name.removesuffix(".toml")] = str(model.get("description", model.get("type", "")))
     return found
 
@@ -78,15 +79,12 @@ def _coerce(name: str, value: Any, annotation: Any, source: str) -> Any:
         return float(value)
     if want == "int" and isinstance(value, int) and not isinstance(value, bool):
         return value
-    raise WorkbenchInputError(f"{source}: parameter {name!r} must be a number ({want}); got {value!r}")
+    raise WorkbenchInputError(f"{source}: parameter {name!r} must be a number ({want}); got {value_text(value)}")
 
 
 def params_from_toml(text: str, source: str) -> tuple[str, Any]:
     """Parse preset TOML text into (model type, params instance). `source` names the file in messages."""
-    try:
-        doc = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise WorkbenchInputError(f"{source}: not valid TOML: {exc}") from None
+    doc = parse_toml(text, source)
     _check_keys("top-level", doc, _TOP_KEYS, source, required=True)
     model, given = doc["model"], doc["parameters"]
     if not isinstance(model, dict) or not isinstance(given, dict):
@@ -112,22 +110,19 @@ def load_vehicle(name_or_file: str, payload_kg: float | None = None) -> VehicleM
         text = _preset_dir().joinpath(f"{name_or_file}.toml").read_text(encoding="utf-8")
     else:
         path = Path(name_or_file)
-        if not path.is_file():
+        if not os.path.lexists(path):
             raise WorkbenchInputError(
                 f"unknown vehicle {name_or_file!r}: neither a preset ({', '.join(list_presets())}) "
                 "nor an existing TOML file"
             )
         source = str(path)
-        try:
-            text = path.read_text(encoding="utf-8")
-        except (OSError, UnicodeDecodeError) as exc:
-            raise WorkbenchInputError(f"{source}: cannot read vehicle file: {exc}") from None
+        text = read_text(path, f"vehicle file {source}")
     kind, params = params_from_toml(text, source)
     if payload_kg is not None:
         if "payload_kg" not in {f.name for f in dataclasses.fields(params)}:
             carriers = [k for k, (_, cls) in MODEL_TYPES.items() if "payload_kg" in cls.__dataclass_fields__]
             raise WorkbenchInputError(f"vehicle {kind!r} has no payload; a payload applies to: {', '.join(carriers)}")
         if isinstance(payload_kg, bool) or not isinstance(payload_kg, int | float):
-            raise WorkbenchInputError(f"payload_kg must be a number; got {payload_kg!r}")
+            raise WorkbenchInputError(f"payload_kg must be a number; got {value_text(payload_kg)}")
         params = dataclasses.replace(params, payload_kg=float(payload_kg))
     return MODEL_TYPES[kind][0](params)

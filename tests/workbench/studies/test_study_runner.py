@@ -62,7 +62,7 @@ def test_initial_offset_and_heading_error_are_where_the_run_starts() -> None:
 def test_an_exception_is_an_error_row_with_its_message() -> None:
     row = execute_run(_run(controller="clothoid", options=(("min_lookahead_m", 30.0),)))
     assert row["status"] == "error" and row["completed"] is False
-    assert row["message"].startswith("WorkbenchInputError: max_lookahead_m must be in [30.0, 200.0]")
+    assert row["message"].startswith("WorkbenchInputError: max_lookahead_m must be") and "30.0" in row["message"]
     assert "read_controller_config" in row["traceback"]
     assert all(row[k] is None for k in ROW_METRICS if k != "completed")
     assert row["clothoid.min_lookahead_m"] == 30.0

@@ -8,6 +8,7 @@ from pathlib import Path
 import pytest
 from study_helpers import write_spec
 
+from controllers.clothoid.filter_file import DEFAULT_FILTER, write_filter_file
 from workbench.errors import WorkbenchInputError
 from workbench.studies import load_spec
 from workbench.studies.distributions import Distribution, key_rng
@@ -194,7 +195,8 @@ def test_zandvoort_needs_its_track(tmp_path: Path, monkeypatch: pytest.MonkeyPat
     with pytest.raises(WorkbenchInputError, match="needs the TUMFTM racetrack-database file"):
         load_spec(path)
     track = tmp_path / "Zandvoort.csv"
-    track.write_text("# x_m,y_m\n0,0\n")
+    angles = [2 * math.pi * i / 200 for i in range(200)]  # a 100 m circle in the track file's format
+    track.write_text("# x_m,y_m\n" + "".join(f"{100 * math.cos(a)},{100 * math.sin(a)}\n" for a in angles))
     monkeypatch.setenv("WORKBENCH_ZANDVOORT_CSV", str(track))
     run = load_spec(path).plan()[0]
     assert run.track_file == track.resolve()
@@ -202,10 +204,126 @@ def test_zandvoort_needs_its_track(tmp_path: Path, monkeypatch: pytest.MonkeyPat
 
 def test_paths_in_a_spec_are_relative_to_it(tmp_path: Path) -> None:
     (tmp_path / "sub").mkdir()
-    (tmp_path / "sub" / "lead.json").write_text("{}")
+    write_filter_file(tmp_path / "sub" / "lead.json", DEFAULT_FILTER, source="test")
     text = HEAD + '[grid.clothoid]\nfilter_file = "lead.json"\nmax_lookahead_growth_m_per_m = "none"\n'
     runs = load_spec(write_spec(tmp_path / "sub", text)).plan()
     options = dict(runs[0].options)
     assert options["filter_file"] == (tmp_path / "sub" / "lead.json").resolve()
     assert options["max_lookahead_growth_m_per_m"] is None
     assert math.isclose(dict(runs[0].values).get("speed_kmh", 30.0), 30.0)
+
+
+# --- every file the spec names is read when it loads; the study's size is bounded -------------------------------
+
+ONE = '[study]\nscenarios = ["dlc"]\ncontrollers = ["clothoid"]\nvehicles = ["kinematic-bicycle"]\n'
+
+
+@pytest.mark.parametrize(
+    ("options", "messages"),
+    [
+        ("[clothoid]\nfrechet_treshold_m = 0.1\n", ["unknown option 'frechet_treshold_m' for ClothoidConfig"]),
+        ("[clothoid]\nfrechet_threshold_m = nan\n", ["frechet_threshold_m must be", "got nan"]),
+        (
+            "[clothoid]\nfilter_file = 'none.json'\n",
+            ["clothoid.filter_file in study.controller_config", "no such file"],
+        ),
+        ("[clothoid\n", ["not valid TOML"]),
+        ("[clothoid]\nx = " + "[" * 5000 + "]" * 5000 + "\n", ["nested deeper than 64 levels"]),
+    ],
+)
+def test_the_controller_config_is_checked_when_the_spec_loads(
+    tmp_path: Path, options: str, messages: list[str]
+) -> None:
+    (tmp_path / "options.toml").write_text(options)
+    path = write_spec(tmp_path, ONE + 'controller_config = "options.toml"\n')
+    with pytest.raises(WorkbenchInputError) as info:
+        load_spec(path)
+    for message in [str(path), *messages]:
+        assert message in str(info.value)
+
+
+def test_the_files_the_spec_names_are_read_when_it_loads(tmp_path: Path) -> None:
+    (tmp_path / "car.toml").write_text('[model]\ntype = "kinematic-bicycle"\n[parameters]\nwheelbase = 2.5\n')
+    (tmp_path / "path.csv").write_text("x,y\n0,0\n1,nan\n2,0\n")
+    (tmp_path / "deep.json").write_text('{"a": ' * 5000 + "1" + "}" * 5000)
+    (tmp_path / "lead.json").write_text('{"format": "lead-filter/1", "psi": 0.8}')
+    (tmp_path / "folder.csv").mkdir()
+    cases = [
+        (ONE.replace('"kinematic-bicycle"', '"car.toml"'), "study.vehicles: ", "car.toml"),
+        (ONE.replace('"dlc"', '"path.csv"'), "study.scenarios: ", "path.csv"),
+        (ONE.replace('"dlc"', '"folder.csv"'), "a folder, not a file", "folder.csv"),
+        (ONE + '[grid.clothoid]\nfilter_file = ["deep.json"]\n', "nested deeper than 64 levels", "deep.json"),
+        (
+            ONE + '[grid.clothoid]\nfilter_file = ["lead.json"]\n',
+            "missing keys ['omega_z_rad_s', 'omega_p",
+            "lead.json",
+        ),
+        (ONE.replace('"dlc"', '"zandvoort"') + 'track_file = "path.csv"\n', "study.track_file: ", "path.csv"),
+    ]
+    for text, message, name in cases:
+        with pytest.raises(WorkbenchInputError) as info:
+            load_spec(write_spec(tmp_path, text))
+        assert message in str(info.value) and name in str(info.value), (text, str(info.value))
+
+
+def test_a_payload_needs_a_vehicle_that_carries_one_also_from_a_file(tmp_path: Path) -> None:
+    from workbench.vehicles import preset_text
+
+    (tmp_path / "car.toml").write_text(preset_text("kinematic-bicycle"))
+    text = ONE.replace('"kinematic-bicycle"', '"car.toml"') + "[grid]\npayload_kg = [0, 1000]\n"
+    with pytest.raises(WorkbenchInputError, match=r"vehicle\(s\) .*car.toml have no payload"):
+        load_spec(write_spec(tmp_path, text))
+
+
+def test_a_deeply_nested_spec_is_refused(tmp_path: Path) -> None:
+    path = write_spec(tmp_path, ONE + "[" + ".".join(["grid"] * 5000) + "]\nx = 1\n")
+    with pytest.raises(WorkbenchInputError, match=r"spec file '.*spec\.toml': nested deeper than 64 levels"):
+        load_spec(path)
+
+
+def test_run_count_is_the_plans_length(tiny_spec: Path, tmp_path: Path) -> None:
+    drawn = (
+        HEAD.replace("]\n", "]\nsamples = 3\n", 1)
+        + "[grid]\nspeed_kmh = [20, 30]\n[random]\nlaps = {integers = [1, 2]}\n"
+        + "[grid.clothoid]\nfrechet_threshold_m = [0.1, 0.2]\n"
+    )
+    for spec in (load_spec(tiny_spec), load_spec(EXAMPLES / "sweep_dlc.toml"), load_spec(write_spec(tmp_path, drawn))):
+        assert spec.run_count() == len(spec.plan())
+    assert spec.run_count() == 2 * 3 * 2 + 2 * 3  # clothoid: speeds x samples x thresholds; pure pursuit
+
+
+@pytest.mark.parametrize(
+    ("extra", "runs"),
+    [
+        ("[grid]\n" + "\n".join(f"{k} = {list(range(1, 101))}" for k in ("speed_kmh", "laps", "controller_rate_hz"))
+         + "\n[grid.clothoid]\nmin_lookahead_m = " + str([5 + i / 100 for i in range(100)]) + "\n",
+         "100,000,000"),
+        ("samples = 100000000\n[random]\nspeed_kmh = {uniform = [10, 50]}\n", "100,000,000"),
+    ],
+)  # fmt: skip
+def test_a_study_too_large_is_refused_before_planning(tmp_path: Path, extra: str, runs: str) -> None:
+    path = write_spec(tmp_path, ONE + extra)
+    with pytest.raises(WorkbenchInputError) as info:
+        load_spec(path)
+    message = str(info.value)
+    assert f"the study plans {runs} runs" in message and "more than the limit of 100,000" in message
+    assert "study.max_runs or --max-runs N" in message
+
+
+def test_the_limit_can_be_raised(tiny_spec: Path) -> None:
+    with pytest.raises(WorkbenchInputError, match=r"plans 6 runs .* more than the limit of 5"):
+        load_spec(tiny_spec, max_runs=5)
+    assert load_spec(tiny_spec, max_runs=6).run_count() == 6
+    text = tiny_spec.read_text().replace("[study]\n", "[study]\nmax_runs = 5\n")
+    with pytest.raises(WorkbenchInputError, match="more than the limit of 5"):
+        load_spec(write_spec(tiny_spec.parent, text, "limited.toml"))
+    assert load_spec(tiny_spec.parent / "limited.toml", max_runs=10).max_runs == 10  # the command line's wins
+    with pytest.raises(WorkbenchInputError, match=r"study\.max_runs must be a whole number >= 1; got 0"):
+        load_spec(write_spec(tiny_spec.parent, text.replace("max_runs = 5", "max_runs = 0"), "zero.toml"))
+
+
+def test_an_optimisation_counts_trials_times_runs(tmp_path: Path) -> None:
+    text = OPT.replace("trials = 4", "trials = 40000") + "[grid]\nspeed_kmh = [20, 30, 40]\n"
+    with pytest.raises(WorkbenchInputError, match=r"plans 120,000 runs \(.* x 40,000 trials"):
+        load_spec(write_spec(tmp_path, text), "optimise")
+    assert load_spec(write_spec(tmp_path, text), "optimise", max_runs=120_000).total_runs() == 120_000

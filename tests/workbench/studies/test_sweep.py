@@ -56,7 +56,7 @@ def test_a_failing_run_is_recorded_with_its_error(local_sweep: tuple[Path, Sweep
     errors = result.errors()
     assert len(errors) == 2 and set(errors["clothoid.min_lookahead_m"]) == {30.0}
     for message in errors["message"]:
-        assert message.startswith("WorkbenchInputError: max_lookahead_m must be in [30.0, 200.0]")
+        assert message.startswith("WorkbenchInputError: max_lookahead_m must be") and "30.0" in message
     assert errors["completed"].eq(False).all() and errors["rms_cte_m"].isna().all()
     assert result.status_counts() == {"completed": 4, "error": 2}
     summary = result.summary().set_index("controller")
