@@ -89,10 +89,12 @@ def _max_abs(values: np.ndarray | None, scale: float = 1.0) -> float | None:
 
 
 def offtracking(path: ReferencePath, x_m: np.ndarray, y_m: np.ndarray) -> np.ndarray:
-    """Signed distance (m) of a trailer point from the path (beyond an open path's ends, from the end point),
-    projected with progress tracking."""
+    """Signed lateral distance (m) of a trailer point from the path, projected with progress tracking.
+
+    Sideways only (`Projection.cte_m`): a trailer starts behind an open path's start, where the distance to the
+    start point would count its length as offtracking."""
     tracker = path.tracker(None)
-    return np.array([tracker.update(float(x), float(y)).signed_distance_m for x, y in zip(x_m, y_m, strict=True)])
+    return np.array([tracker.update(float(x), float(y)).cte_m for x, y in zip(x_m, y_m, strict=True)])
 
 
 def compute_metrics(

@@ -24,6 +24,7 @@ from dataclasses import KW_ONLY, dataclass
 from pathlib import Path
 
 from workbench.errors import WorkbenchInputError, require_in_range
+from workbench.input_files import read_json
 
 FORMAT_TAG = "steering-lag/1"
 _REQUIRED = ("format", "omega_n_rad_s", "zeta")
@@ -92,12 +93,7 @@ def write_lag_file(lag: SteeringLag, path: str | Path) -> Path:
 def read_lag_file(path: str | Path) -> SteeringLag:
     """Read a steering-lag file, with an error naming the file and the offending key or value."""
     path = Path(path)
-    try:
-        data = json.loads(path.read_text())
-    except FileNotFoundError:
-        raise WorkbenchInputError(f"steering-lag file {str(path)!r} does not exist") from None
-    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
-        raise WorkbenchInputError(f"steering-lag file {str(path)!r} is not valid JSON: {exc}") from None
+    data = read_json(path, f"steering-lag file {str(path)!r}")
     if not isinstance(data, dict):
         raise WorkbenchInputError(f"steering-lag file {str(path)!r} must hold a JSON object; got {type(data).__name__}")
     missing = [key for key in _REQUIRED if key not in data]

@@ -51,8 +51,17 @@ def test_bad_files_get_a_clear_error(content: str, needle: str, tmp_path: Path) 
 
 
 def test_missing_file_and_nan_values() -> None:
-    with pytest.raises(WorkbenchInputError, match="does not exist"):
+    with pytest.raises(WorkbenchInputError, match=r"lag\.json': no such file"):
         read_lag_file("/nonexistent/lag.json")
     with pytest.raises(WorkbenchInputError, match="zeta"):
         SteeringLag(4.0, float("nan"))
     assert json.loads(json.dumps(SteeringLag(4.0, 0.8).to_dict()))["format"] == "steering-lag/1"
+
+
+def test_a_folder_or_a_deeply_nested_file_is_refused(tmp_path: Path) -> None:
+    with pytest.raises(WorkbenchInputError, match="a folder, not a file"):
+        read_lag_file(tmp_path)
+    deep = tmp_path / "deep.json"
+    deep.write_text("[" * 5000 + "]" * 5000)
+    with pytest.raises(WorkbenchInputError, match=r"deep\.json': nested deeper than 64 levels"):
+        read_lag_file(deep)
