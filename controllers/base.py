@@ -1,26 +1,74 @@
-"""The one small interface every lateral controller implements.
+"""The one small interface every lateral controller implements, and the contract it keeps on bad sensor frames.
 
 A controller is built once for a vehicle (its geometry and limits) and a frozen config, `reset` for a path and
 its sample time, then stepped at that rate with what GPS/IMU and the steering sensor give. It returns a
 steering-wheel angle command. Whatever it wants logged about its last step (lookahead, solver status, ...) it
 exposes as `diagnostics`, which the simulator records as `ctrl_<name>` columns. Controllers contain no plotting
 and no I/O.
+
+The contract (issue 16), kept here once for every controller: a real steering ECU holds its last command on a
+bad sensor frame, and so does every controller. `Controller.step` is a template method:
+
+  1. it screens the measurement against a plausible envelope (the constants below: every field finite, the
+     steering sensor within STEER_SENSOR_MARGIN x the mechanical lock, speed, yaw rate, position and time
+     within their bounds, time not earlier than the last accepted frame's). An implausible measurement never
+     reaches the controller: the step returns the last command it returned since `reset` (0.0 before any) and
+     the diagnostics say `measurement_rejected` = 1. Any finite yaw is plausible; one beyond
+     MAX_UNWRAPPED_YAW_RAD is wrapped to [-pi, pi) before the controller sees it.
+  2. Otherwise it calls the controller's `_command`. If that returns a non-finite number, or the controller's own
+     diagnostics are not all finite, the held command is returned and `command_rejected` = 1.
+  3. The command is saturated to the vehicle's steering-wheel limit.
+
+So `step` always returns a finite command within the limit, and an implausible measurement changes nothing in
+the controller. On a rejected step the controller's own diagnostics are those of the last accepted one;
+`diagnostics` always holds the controller's own keys plus `measurement_rejected` and `command_rejected` (1.0 or
+0.0), all finite, the same keys every step. `reset` clears the held command and the last accepted time (time
+never runs backwards within a run: once a frame stamped far in the future is accepted, every frame stamped
+before it is refused until the next reset). Subclasses implement `_reset` and `_command` (the base
+raises NotImplementedError for them) and optionally `_diagnostics`; they do not override `step`, `reset` or
+`diagnostics`. `rejection` says in words why the last rejected step was rejected.
 """
 
 from __future__ import annotations
 
 import math
 import sys
-from abc import ABC, abstractmethod
+from abc import ABC
 from collections.abc import Mapping
 from dataclasses import dataclass
 from types import MappingProxyType
 from typing import Any, ClassVar
 
-from workbench.path import ReferencePath
+from workbench.errors import require_positive
+from workbench.path import ReferencePath, wrap_angle
 from workbench.vehicles.base import VehicleGeometry
 
 _NO_DIAGNOSTICS: Mapping[str, float] = MappingProxyType({})
+
+# The plausible envelope of a measurement (`Controller.step` rejects a frame outside it). Each bound is far beyond
+# what any vehicle here can do, so that no plausible run is ever touched, and near enough that what lies beyond is
+# a sensor or transmission fault rather than a state to steer from.
+
+#: A steering-wheel reading beyond this multiple of the mechanical lock (`max_steer_wheel_angle_rad`) is a sensor
+#: fault: the wheel cannot get there. The margin above 1 leaves room for calibration offsets and compliance.
+STEER_SENSOR_MARGIN = 1.5
+#: Largest plausible speed over ground hypot(vx, vy) (m/s; 540 km/h, beyond any road vehicle).
+MAX_SPEED_MPS = 150.0
+#: Largest plausible |yaw rate| (rad/s; 573 deg/s: a car spinning out stays well below it).
+MAX_YAW_RATE_RAD_S = 10.0
+#: Largest plausible |x|, |y| (m): covers local frames as large as UTM coordinates (northings reach 1e7 m).
+MAX_POSITION_M = 1e8
+#: Largest plausible |t_s| (s): covers Unix and GPS epoch time stamps (about 2e9 s) while a double still resolves
+#: 0.2 ms, so that a controller period is never lost in rounding.
+MAX_TIME_S = 1e12
+#: Any finite yaw is plausible (a yaw angle integrated over many turns is still a heading); one beyond this
+#: magnitude (rad; about 1600 turns) is wrapped to [-pi, pi) before the controller sees it, so that its rounding
+#: does not swallow the small angles added to it. Below it the yaw is passed unchanged, as it always was.
+MAX_UNWRAPPED_YAW_RAD = 1e4
+#: The flags `diagnostics` adds to the controller's own signals.
+MEASUREMENT_REJECTED = "measurement_rejected"
+COMMAND_REJECTED = "command_rejected"
+_FIELDS = ("t_s", "x_m", "y_m", "vx_mps", "vy_mps", "yaw_rad", "yaw_rate_rad_s", "steer_wheel_rad")
 
 
 @dataclass(frozen=True, slots=True)
@@ -47,7 +95,8 @@ class Measurement:
 
 
 class Controller(ABC):
-    """Base class: subclasses set `name`, `config_type` and implement `reset` and `step`."""
+    """Base class: subclasses set `name`, `config_type` and implement `_reset`, `_command` and, if they log
+    anything, `_diagnostics` (the module docstring's contract is kept here, in `step`)."""
 
     name: ClassVar[str]
     config_type: ClassVar[type]
@@ -60,6 +109,8 @@ class Controller(ABC):
         self.config = config if config is not None else self.config_type()
         if not isinstance(self.config, self.config_type):
             raise TypeError(f"{self.name} takes a {self.config_type.__name__}; got {type(self.config).__name__}")
+        self._clear_hold()
+        self._report: dict[str, float] = {MEASUREMENT_REJECTED: 0.0, COMMAND_REJECTED: 0.0}
 
     @classmethod
     def summary(cls) -> str:
@@ -67,20 +118,122 @@ class Controller(ABC):
         doc = sys.modules[cls.__module__].__doc__ or cls.__name__
         return doc.strip().splitlines()[0]
 
-    @abstractmethod
+    # ------------------------------------------------------------------ the interface (not overridden)
     def reset(self, path: ReferencePath, sample_time_s: float) -> None:
         """Forget all state; the next step is the first on `path`; steps come every `sample_time_s` seconds."""
+        require_positive("sample_time_s", sample_time_s)
+        self._clear_hold()
+        self._reset(path, sample_time_s)
+        self._report = self._merged(self._diagnostics(), 0.0, 0.0)
 
-    @abstractmethod
     def step(self, measurement: Measurement, path: ReferencePath) -> float:
-        """Steering-wheel angle command (rad) for this step; always finite and within the vehicle's limit."""
+        """Steering-wheel angle command (rad) for this step: always finite and within the vehicle's limit (the
+        module docstring's contract: an implausible measurement or a non-finite result holds the last command)."""
+        screened = self._screen(measurement)
+        if screened is None:
+            self._report = self._merged(self._report, 1.0, 0.0)  # a new mapping: one handed out earlier stays as it was
+            return self._held_command
+        command = float(self._command(screened, path))
+        own = self._diagnostics()
+        if not (math.isfinite(command) and all(map(math.isfinite, own.values()))):
+            self.rejection = "the controller's command or diagnostics were not finite"
+            self._report = self._merged(self._report, 0.0, 1.0)
+            return self._held_command
+        limit = self.geometry.max_steer_wheel_angle_rad
+        command = min(max(command, -limit), limit)
+        self._held_command, self._last_t_s = command, screened.t_s
+        self._report = self._merged(own, 0.0, 0.0)
+        return command
 
     @property
     def diagnostics(self) -> Mapping[str, float]:
-        """Internal signals of the last step, to be logged (empty by default)."""
-        return _NO_DIAGNOSTICS
+        """Internal signals of the last step, to be logged: the controller's own (those of the last accepted step
+        when this one was rejected) and the flags `measurement_rejected` and `command_rejected` (1.0 / 0.0)."""
+        return self._report
+
+    @property
+    def held_command(self) -> float:
+        """The command a rejected step returns: the last one returned since `reset` (0.0 before any)."""
+        return self._held_command
 
     def saturate(self, steer_wheel_rad: float) -> float:
         """Clip a steering-wheel angle to the vehicle's limit."""
         limit = self.geometry.max_steer_wheel_angle_rad
         return min(max(steer_wheel_rad, -limit), limit)
+
+    # ------------------------------------------------------------------ what subclasses implement
+    def _reset(self, path: ReferencePath, sample_time_s: float) -> None:
+        """Forget all state for a new run on `path` (sample_time_s > 0 already checked); set up the controller's
+        own diagnostics with every key it will ever report. Every controller implements it."""
+        raise NotImplementedError(f"{type(self).__name__} must implement _reset")
+
+    def _command(self, measurement: Measurement, path: ReferencePath) -> float:
+        """The steering-wheel command (rad) for a measurement that passed the screen. Every controller implements
+        it; the base class saturates the result and holds the last command when it is not finite."""
+        raise NotImplementedError(f"{type(self).__name__} must implement _command")
+
+    def _diagnostics(self) -> Mapping[str, float]:
+        """The controller's own signals of its last `_command` (the same keys every step; none by default)."""
+        return _NO_DIAGNOSTICS
+
+    # ------------------------------------------------------------------ the screen
+    def _clear_hold(self) -> None:
+        self._held_command = 0.0
+        self._last_t_s = -math.inf
+        #: Why the last rejected step was rejected ("" until one is), for a person reading a failure.
+        self.rejection = ""
+
+    @staticmethod
+    def _merged(own: Mapping[str, float], measurement_rejected: float, command_rejected: float) -> dict[str, float]:
+        report = dict(own)
+        report[MEASUREMENT_REJECTED] = measurement_rejected
+        report[COMMAND_REJECTED] = command_rejected
+        return report
+
+    def _screen(self, m: Measurement) -> Measurement | None:
+        """The measurement the controller may see (with its yaw wrapped when beyond MAX_UNWRAPPED_YAW_RAD), or
+        None when it lies outside the plausible envelope (then `self.rejection` says why)."""
+        try:  # one expression on the path every plausible step takes (a comparison with NaN is False)
+            plausible = (
+                abs(m.steer_wheel_rad) <= STEER_SENSOR_MARGIN * self.geometry.max_steer_wheel_angle_rad
+                and math.hypot(m.vx_mps, m.vy_mps) <= MAX_SPEED_MPS
+                and abs(m.yaw_rate_rad_s) <= MAX_YAW_RATE_RAD_S
+                and abs(m.x_m) <= MAX_POSITION_M
+                and abs(m.y_m) <= MAX_POSITION_M
+                and abs(m.t_s) <= MAX_TIME_S
+                and m.t_s >= self._last_t_s
+                and math.isfinite(m.yaw_rad)
+            )
+        except (TypeError, ValueError, OverflowError, AttributeError):  # not numbers at all
+            plausible = False
+        if not plausible:
+            self.rejection = self._why_implausible(m)
+            return None
+        if abs(m.yaw_rad) > MAX_UNWRAPPED_YAW_RAD:
+            m = Measurement(
+                m.t_s, m.x_m, m.y_m, m.vx_mps, m.vy_mps, float(wrap_angle(float(m.yaw_rad))), m.yaw_rate_rad_s,
+                m.steer_wheel_rad,
+            )  # fmt: skip
+        return m
+
+    def _why_implausible(self, m: Measurement) -> str:
+        """What puts the measurement outside the envelope, in words."""
+        try:
+            values = (m.t_s, m.x_m, m.y_m, m.vx_mps, m.vy_mps, m.yaw_rad, m.yaw_rate_rad_s, m.steer_wheel_rad)
+            bad = [name for name, v in zip(_FIELDS, values, strict=True) if not math.isfinite(v)]
+        except (TypeError, ValueError, OverflowError, AttributeError):
+            return "a field is not a number"
+        if bad:
+            return f"{', '.join(bad)} not finite"
+        lock = STEER_SENSOR_MARGIN * self.geometry.max_steer_wheel_angle_rad
+        if abs(m.steer_wheel_rad) > lock:
+            return f"|steer_wheel_rad| = {abs(float(m.steer_wheel_rad)):g} is beyond the sensor's range {lock:g} rad"
+        if math.hypot(m.vx_mps, m.vy_mps) > MAX_SPEED_MPS:
+            return f"speed {math.hypot(m.vx_mps, m.vy_mps):g} m/s is above {MAX_SPEED_MPS:g} m/s"
+        if abs(m.yaw_rate_rad_s) > MAX_YAW_RATE_RAD_S:
+            return f"|yaw_rate_rad_s| = {abs(float(m.yaw_rate_rad_s)):g} is above {MAX_YAW_RATE_RAD_S:g} rad/s"
+        if abs(m.x_m) > MAX_POSITION_M or abs(m.y_m) > MAX_POSITION_M:
+            return f"position ({float(m.x_m):g}, {float(m.y_m):g}) m is beyond +-{MAX_POSITION_M:g} m"
+        if abs(m.t_s) > MAX_TIME_S:
+            return f"t_s = {float(m.t_s):g} s is beyond +-{MAX_TIME_S:g} s"
+        return f"t_s = {float(m.t_s):g} s is earlier than the last accepted {self._last_t_s:g} s"

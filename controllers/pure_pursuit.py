@@ -14,8 +14,12 @@ from dataclasses import dataclass
 from typing import ClassVar
 
 from controllers.base import Controller, Measurement
-from workbench.errors import WorkbenchInputError, require_positive
+from controllers.config_checks import check_number, shown
+from workbench.errors import WorkbenchInputError
 from workbench.path import PathTracker, ReferencePath
+
+#: The longest lookahead (m) the options allow.
+MAX_LOOKAHEAD_M = 1000.0
 
 
 @dataclass(frozen=True)
@@ -27,12 +31,13 @@ class PurePursuitConfig:
     max_lookahead_m: float = 30.0
 
     def __post_init__(self) -> None:
-        require_positive("lookahead_gain_s", self.lookahead_gain_s)
-        require_positive("min_lookahead_m", self.min_lookahead_m)
-        require_positive("max_lookahead_m", self.max_lookahead_m)
+        check_number("lookahead_gain_s", self.lookahead_gain_s, 0.0, 100.0, "s", low_open=True)
+        check_number("min_lookahead_m", self.min_lookahead_m, 0.0, MAX_LOOKAHEAD_M, "m", low_open=True)
+        check_number("max_lookahead_m", self.max_lookahead_m, 0.0, MAX_LOOKAHEAD_M, "m", low_open=True)
         if self.max_lookahead_m < self.min_lookahead_m:
             raise WorkbenchInputError(
-                f"max_lookahead_m ({self.max_lookahead_m}) must be >= min_lookahead_m ({self.min_lookahead_m})"
+                f"max_lookahead_m must be >= min_lookahead_m = {shown(self.min_lookahead_m)} m; "
+                f"got {shown(self.max_lookahead_m)}"
             )
 
 
@@ -40,11 +45,11 @@ class PurePursuit(Controller):
     name: ClassVar[str] = "pure-pursuit"
     config_type: ClassVar[type] = PurePursuitConfig
 
-    def reset(self, path: ReferencePath, sample_time_s: float) -> None:
+    def _reset(self, path: ReferencePath, sample_time_s: float) -> None:
         self._tracker: PathTracker = path.tracker(0.0)
         self._diag = {"lookahead_m": 0.0, "target_s_m": 0.0, "curvature_cmd_1pm": 0.0}
 
-    def step(self, measurement: Measurement, path: ReferencePath) -> float:
+    def _command(self, measurement: Measurement, path: ReferencePath) -> float:
         cfg = self.config
         m = measurement
         foot = self._tracker.update(m.x_m, m.y_m)
@@ -62,6 +67,5 @@ class PurePursuit(Controller):
         self._diag = {"lookahead_m": lookahead, "target_s_m": target_s, "curvature_cmd_1pm": curvature}
         return self.saturate(self.geometry.steer_wheel_for_curvature(curvature))
 
-    @property
-    def diagnostics(self) -> Mapping[str, float]:
+    def _diagnostics(self) -> Mapping[str, float]:
         return self._diag

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 from typing import ClassVar
 
 from controllers.base import Controller, Measurement
-from workbench.errors import require_positive
+from controllers.config_checks import check_bool, check_number
 from workbench.path import PathTracker, ReferencePath, wrap_angle
 
 
@@ -27,19 +27,20 @@ class StanleyConfig:
     curvature_feedforward: bool = False
 
     def __post_init__(self) -> None:
-        require_positive("gain_per_s", self.gain_per_s)
-        require_positive("softening_mps", self.softening_mps)
+        check_number("gain_per_s", self.gain_per_s, 0.0, 100.0, "1/s", low_open=True)
+        check_number("softening_mps", self.softening_mps, 0.0, 100.0, "m/s", low_open=True)
+        check_bool("curvature_feedforward", self.curvature_feedforward)
 
 
 class Stanley(Controller):
     name: ClassVar[str] = "stanley"
     config_type: ClassVar[type] = StanleyConfig
 
-    def reset(self, path: ReferencePath, sample_time_s: float) -> None:
+    def _reset(self, path: ReferencePath, sample_time_s: float) -> None:
         self._tracker: PathTracker = path.tracker(0.0)
         self._diag = {"front_cte_m": 0.0, "heading_term_rad": 0.0, "cross_track_term_rad": 0.0}
 
-    def step(self, measurement: Measurement, path: ReferencePath) -> float:
+    def _command(self, measurement: Measurement, path: ReferencePath) -> float:
         cfg, m, wheelbase = self.config, measurement, self.geometry.wheelbase_m
         front_x = m.x_m + wheelbase * math.cos(m.yaw_rad)
         front_y = m.y_m + wheelbase * math.sin(m.yaw_rad)
@@ -57,6 +58,5 @@ class Stanley(Controller):
         limit = self.geometry.max_road_wheel_angle_rad
         return self.saturate(min(max(road_wheel, -limit), limit) * self.geometry.steering_ratio)
 
-    @property
-    def diagnostics(self) -> Mapping[str, float]:
+    def _diagnostics(self) -> Mapping[str, float]:
         return self._diag

@@ -65,7 +65,15 @@ from controllers.clothoid.loop_analysis import LoopSettings, PlantLags, lookahea
 from controllers.clothoid.path_feedforward import FeedforwardTiming, two_degree_of_freedom_rate
 from controllers.clothoid.pose_prediction import along_arc
 from controllers.clothoid.vehicle_tuning import VehicleTuning, tuning_for
-from workbench.errors import WorkbenchInputError, require_in_range, require_positive
+from controllers.config_checks import (
+    check_bool,
+    check_choice,
+    check_number,
+    check_optional_number,
+    check_optional_path,
+    shown,
+)
+from workbench.errors import WorkbenchInputError
 from workbench.path import PathTracker, ReferencePath
 from workbench.vehicles.base import VehicleGeometry, VehicleModel
 
@@ -83,6 +91,26 @@ MAX_FLOOR_LOOKAHEAD_M = 40.0
 #: 0.3 g bound, with margin), capped by the curvature limit.
 FLOOR_ARC_LATERAL_ACCEL_G = 0.4
 G_MPS2 = 9.80665
+#: The longest lookahead (m) the options allow.
+MAX_LOOKAHEAD_M = 200.0
+#: The controller's own diagnostics (`ctrl_*` columns), the same every step: zero until the first step.
+DIAGNOSTIC_KEYS = (
+    "lookahead_m",
+    "searched_lookahead_m",
+    "lookahead_floor_m",
+    "frechet_m",
+    "curvature_rate_1pm2",
+    "clothoid_curvature_rate_1pm2",
+    "reference_curvature_rate_1pm2",
+    "feedforward_curvature_rate_1pm2",
+    "clothoid_length_m",
+    "end_error_m",
+    "fit_status",
+    "evaluations",
+    "initial_curvature_1pm",
+    "curvature_cmd_1pm",
+    "steer_unfiltered_rad",
+)
 
 
 @dataclass(frozen=True)
@@ -138,50 +166,50 @@ class ClothoidConfig:
     limits_file: Path | None = None
 
     def __post_init__(self) -> None:
-        if self.lookahead_mode not in LOOKAHEAD_MODES:
-            raise WorkbenchInputError(
-                f"lookahead_mode must be one of {', '.join(LOOKAHEAD_MODES)}; got {self.lookahead_mode!r}"
-            )
-        if self.initial_curvature not in INITIAL_CURVATURE:
-            raise WorkbenchInputError(
-                f"initial_curvature must be one of {', '.join(INITIAL_CURVATURE)}; got {self.initial_curvature!r}"
-            )
-        for name, allowed in (("heading", HEADINGS), ("threshold_mode", THRESHOLD_MODES)):
-            if getattr(self, name) not in allowed:
-                raise WorkbenchInputError(f"{name} must be one of {', '.join(allowed)}; got {getattr(self, name)!r}")
-        require_in_range("prediction_time_s", self.prediction_time_s, 0.0, 2.0, "s")
-        require_in_range("min_preview_time_s", self.min_preview_time_s, 0.0, 10.0, "s")
-        require_in_range("lookahead_hysteresis_m", self.lookahead_hysteresis_m, 0.0, 50.0, "m")
+        # Every field on its own first (`config_checks.py`), then what relates them.
+        check_choice("lookahead_mode", self.lookahead_mode, LOOKAHEAD_MODES)
+        check_choice("initial_curvature", self.initial_curvature, INITIAL_CURVATURE)
+        check_choice("heading", self.heading, HEADINGS)
+        check_choice("threshold_mode", self.threshold_mode, THRESHOLD_MODES)
+        check_number("prediction_time_s", self.prediction_time_s, 0.0, 2.0, "s")
+        check_number("min_preview_time_s", self.min_preview_time_s, 0.0, 10.0, "s")
+        check_number("lookahead_hysteresis_m", self.lookahead_hysteresis_m, 0.0, 50.0, "m")
         require_rate("max_lookahead_growth_m_per_m", self.max_lookahead_growth_m_per_m)
         require_rate("max_lookahead_shrink_m_per_m", self.max_lookahead_shrink_m_per_m)
-        require_in_range("min_phase_margin_deg", self.min_phase_margin_deg, 0.0, 89.0, "deg")
-        require_in_range("min_gain_margin_db", self.min_gain_margin_db, 0.0, 40.0, "dB")
-        require_in_range("min_lookahead_m", self.min_lookahead_m, 0.5, 200.0, "m")
-        require_in_range("max_lookahead_m", self.max_lookahead_m, self.min_lookahead_m, 200.0, "m")
-        require_in_range("fixed_lookahead_m", self.fixed_lookahead_m, 0.5, 200.0, "m")
-        require_positive("lookahead_gain_s", self.lookahead_gain_s)
-        require_positive("frechet_threshold_m", self.frechet_threshold_m)
-        require_positive("tolerance_x_m", self.tolerance_x_m)
-        require_positive("tolerance_y_m", self.tolerance_y_m)
-        require_positive("max_curvature_rate_1pm2", self.max_curvature_rate_1pm2)
-        require_in_range("lookahead_step_m", self.lookahead_step_m, 0.05, 50.0, "m")
-        require_in_range("feedforward_window_m", self.feedforward_window_m, 0.1, 100.0, "m")
+        check_number("min_phase_margin_deg", self.min_phase_margin_deg, 0.0, 89.0, "deg")
+        check_number("min_gain_margin_db", self.min_gain_margin_db, 0.0, 40.0, "dB")
+        check_number("min_lookahead_m", self.min_lookahead_m, 0.5, MAX_LOOKAHEAD_M, "m")
+        check_number("max_lookahead_m", self.max_lookahead_m, 0.5, MAX_LOOKAHEAD_M, "m")
+        check_number("fixed_lookahead_m", self.fixed_lookahead_m, 0.5, MAX_LOOKAHEAD_M, "m")
+        check_number("lookahead_gain_s", self.lookahead_gain_s, 0.0, 100.0, "s", low_open=True)
+        check_number("frechet_threshold_m", self.frechet_threshold_m, 0.0, 100.0, "m", low_open=True)
+        check_number("frechet_point_spacing_m", self.frechet_point_spacing_m, 0.0, 50.0, "m", low_open=True)
+        check_number("tolerance_x_m", self.tolerance_x_m, 0.0, 100.0, "m", low_open=True)
+        check_number("tolerance_y_m", self.tolerance_y_m, 0.0, 100.0, "m", low_open=True)
+        check_number("max_curvature_rate_1pm2", self.max_curvature_rate_1pm2, 0.0, 10.0, "1/m^2", low_open=True)
+        check_number("lookahead_step_m", self.lookahead_step_m, 0.05, 50.0, "m")
+        check_bool("path_feedforward", self.path_feedforward)
+        check_number("feedforward_window_m", self.feedforward_window_m, 0.1, 100.0, "m")
         for name in ("feedforward_time_s", "reference_lead_s"):
-            if getattr(self, name) is not None:
-                require_in_range(name, getattr(self, name), 0.0, 5.0, "s (or None: from the vehicle's lags)")
-        if not isinstance(self.path_feedforward, bool):
-            raise WorkbenchInputError(f"path_feedforward must be true or false; got {self.path_feedforward!r}")
+            check_optional_number(name, getattr(self, name), 0.0, 5.0, "s", none_means="from the vehicle's lags")
+        check_optional_path("filter_file", self.filter_file)
+        check_bool("use_lead_filter", self.use_lead_filter)
+        check_optional_path("limits_file", self.limits_file)
+        if self.max_lookahead_m < self.min_lookahead_m:
+            raise WorkbenchInputError(
+                f"max_lookahead_m must be >= min_lookahead_m = {shown(self.min_lookahead_m)} m; "
+                f"got {shown(self.max_lookahead_m)}"
+            )
         steps = (self.max_lookahead_m - self.min_lookahead_m) / self.lookahead_step_m
         if steps > 1000:
             raise WorkbenchInputError(
                 f"lookahead range / lookahead_step_m gives {steps:.0f} candidates; at most 1000 are allowed"
             )
-        spacing_ok = self.max_lookahead_m / self.frechet_point_spacing_m < MAX_CURVE_POINTS
-        require_positive("frechet_point_spacing_m", self.frechet_point_spacing_m)
-        if not spacing_ok:
+        # the curves compared hold int(lookahead / spacing) + 1 points, at most MAX_CURVE_POINTS
+        if self.max_lookahead_m / self.frechet_point_spacing_m >= MAX_CURVE_POINTS:
             raise WorkbenchInputError(
-                f"frechet_point_spacing_m must be >= max_lookahead_m / {MAX_CURVE_POINTS - 1} = "
-                f"{self.max_lookahead_m / (MAX_CURVE_POINTS - 1):.3g} m; got {self.frechet_point_spacing_m!r}"
+                f"frechet_point_spacing_m must be > max_lookahead_m / {MAX_CURVE_POINTS} = "
+                f"{self.max_lookahead_m / MAX_CURVE_POINTS:g} m; got {shown(self.frechet_point_spacing_m)}"
             )
 
 
@@ -217,25 +245,26 @@ class ClothoidController(Controller):
         top = max(cfg.max_lookahead_m, MAX_FLOOR_LOOKAHEAD_M)
         self._scores = np.empty(candidate_count(cfg.min_lookahead_m, top, cfg.lookahead_step_m))
         self._filters: dict[int, DiscreteLeadFilter] = {}
-        self._floors: dict[int, float] = {}
+        self._floors: dict[int, float] = {}  # per speed band, for the sample time _floors_dt
+        self._floors_dt: float | None = None
         self._choice = LookaheadFilter(
             LookaheadFilterSettings(
                 cfg.lookahead_hysteresis_m, cfg.max_lookahead_growth_m_per_m, cfg.max_lookahead_shrink_m_per_m
             )
         )
 
-    def reset(self, path: ReferencePath, sample_time_s: float) -> None:
-        require_positive("sample_time_s", sample_time_s)
+    def _reset(self, path: ReferencePath, sample_time_s: float) -> None:
+        if float(sample_time_s) != self._floors_dt:  # the floors depend on the sample time, not on the path
+            self._floors, self._floors_dt = {}, float(sample_time_s)
         self._dt = float(sample_time_s)
         self._tracker: PathTracker = path.tracker(0.0)
         self._here: PathTracker = path.tracker(0.0)
         self._kappa_cmd: float | None = None
         self._filters = {}
-        self._floors = {}
         self._filter: SteeringFilter = PassThroughFilter()
         self._filter_speed_kmh = -1
         self._choice.reset()
-        self._diag: dict[str, float] = {}
+        self._diag: dict[str, float] = dict.fromkeys(DIAGNOSTIC_KEYS, 0.0)
         if path.speed_mps is not None:  # the floors of the planned speeds now, not inside a step (~0.1 s per band)
             for speed_mps in np.unique(np.round(path.speed_mps * 3.6 / FLOOR_SPEED_BAND_KMH)) * FLOOR_SPEED_BAND_KMH:
                 self.lookahead_floor_m(float(speed_mps) / 3.6)
@@ -347,7 +376,7 @@ class ClothoidController(Controller):
         lookahead = self._choice.step(chosen, floor, top, speed_mps * self._dt)
         return lookahead, chosen, floor, evaluations
 
-    def step(self, measurement: Measurement, path: ReferencePath) -> float:
+    def _command(self, measurement: Measurement, path: ReferencePath) -> float:
         cfg, g, m = self.config, self.geometry, measurement
         steering_kappa = math.tan(m.steer_wheel_rad / g.steering_ratio) / g.wheelbase_m
         if self._kappa_cmd is None:  # first step: continue from the vehicle's current steering
@@ -399,6 +428,5 @@ class ClothoidController(Controller):
         }
         return command
 
-    @property
-    def diagnostics(self) -> Mapping[str, float]:
+    def _diagnostics(self) -> Mapping[str, float]:
         return self._diag

@@ -24,6 +24,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from controllers.config_checks import shown
 from workbench.errors import WorkbenchInputError, require_positive
 from workbench.vehicles.base import VehicleGeometry
 
@@ -58,9 +59,12 @@ class CurvatureLimits:
         ):
             for i, value in enumerate(values):
                 if not (math.isfinite(value) and (value > 0 or (name == "speed_kmh" and value == 0))):
-                    raise WorkbenchInputError(f"{self.source}: {name} must be finite and > 0; row {i} has {value!r}")
+                    raise WorkbenchInputError(
+                        f"{self.source}: {name} must be finite and > 0; row {i} has {shown(value)}"
+                    )
         if any(b <= a for a, b in itertools.pairwise(self.speeds_kmh)):
-            raise WorkbenchInputError(f"{self.source}: speed_kmh must increase strictly; got {list(self.speeds_kmh)}")
+            speeds = ", ".join(shown(v) for v in self.speeds_kmh)
+            raise WorkbenchInputError(f"{self.source}: speed_kmh must increase strictly; got [{speeds}]")
 
     def at_speed(self, speed_mps: float) -> tuple[float, float]:
         """(max curvature 1/m, max curvature rate 1/(m s)) at this speed, interpolated."""
@@ -112,7 +116,7 @@ class CurvatureLimits:
         if numeric.isna().to_numpy().any():
             row, col = np.argwhere(numeric.isna().to_numpy())[0]
             raise WorkbenchInputError(
-                f"{path.name}: row {row + 1} column {table.columns[col]} is {table.iat[row, col]!r}, not a number"
+                f"{path.name}: row {row + 1} column {table.columns[col]} is {shown(table.iat[row, col])}, not a number"
             )
         if RATE_COLUMN in numeric.columns:
             rates = numeric[RATE_COLUMN].tolist()

@@ -17,13 +17,12 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from workbench.errors import WorkbenchInputError, require_in_range
+from controllers.config_checks import check_number, check_optional_number
 
 
 def require_rate(name: str, value: float | None) -> None:
     """A rate limit in metres of lookahead per metre travelled: None (unlimited) or a number in (0, 100]."""
-    if value is not None and (isinstance(value, bool) or not isinstance(value, int | float) or not 0 < value <= 100):
-        raise WorkbenchInputError(f"{name} must be None (unlimited) or a number in (0, 100] m per m; got {value!r}")
+    check_optional_number(name, value, 0.0, 100.0, "m per m", low_open=True, none_means="unlimited")
 
 
 @dataclass(frozen=True)
@@ -36,7 +35,7 @@ class LookaheadFilterSettings:
     max_shrink_m_per_m: float | None = 0.5
 
     def __post_init__(self) -> None:
-        require_in_range("hysteresis_m", self.hysteresis_m, 0.0, 50.0, "m")
+        check_number("hysteresis_m", self.hysteresis_m, 0.0, 50.0, "m")
         require_rate("max_growth_m_per_m", self.max_growth_m_per_m)
         require_rate("max_shrink_m_per_m", self.max_shrink_m_per_m)
 

@@ -38,6 +38,7 @@ from scipy import signal
 
 from controllers.clothoid.clothoid_fit import fit_kernel
 from controllers.clothoid.lead_filter import DiscreteLeadFilter, LeadFilterParams
+from controllers.config_checks import shown
 from workbench.errors import WorkbenchInputError, require_in_range, require_positive
 from workbench.vehicles.steering_lag import SteeringLag
 
@@ -128,8 +129,8 @@ def clothoid_law_gains(lookahead_m: float, path_curvature_1pm: float = 0.0) -> t
     kr = float(path_curvature_1pm)
     if abs(kr) * lookahead_m >= 1.9:
         raise WorkbenchInputError(
-            f"lookahead_m x |path_curvature_1pm| must be < 1.9 (a target on the arc ahead); got {lookahead_m!r} x "
-            f"{kr!r}"
+            f"lookahead_m x |path_curvature_1pm| must be < 1.9 (a target on the arc ahead); got {shown(lookahead_m)} x "
+            f"{shown(kr)}"
         )
 
     def kdot(y: float, psi: float, kappa: float) -> float:

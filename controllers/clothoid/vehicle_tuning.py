@@ -61,6 +61,7 @@ from typing import TYPE_CHECKING, Any
 
 from controllers.clothoid.curvature_limits import CurvatureLimits
 from controllers.clothoid.filter_file import FilterSchedule, read_filter_file
+from controllers.config_checks import shown, shown_all
 from workbench.errors import WorkbenchInputError
 from workbench.user_cache import user_cache_dir
 from workbench.vehicles.base import VehicleModel
@@ -123,7 +124,8 @@ class VehicleTuning:
         measured = _checked_lags("measured_lags", self.measured_lags)
         if measured and tuple(s for s, _ in measured) != self.lag_speeds_kmh:
             raise WorkbenchInputError(
-                f"measured_lags' speeds {[s for s, _ in measured]} must be the lags' {list(self.lag_speeds_kmh)}"
+                f"measured_lags' speeds {shown_all(s for s, _ in measured)} must be the lags' "
+                f"{shown_all(self.lag_speeds_kmh)}"
             )
         object.__setattr__(self, "measured_lags", measured)
 
@@ -148,7 +150,7 @@ class VehicleTuning:
 
 def _check_speed(speed_kmh: float) -> None:
     if isinstance(speed_kmh, bool) or not isinstance(speed_kmh, int | float) or not math.isfinite(speed_kmh):
-        raise WorkbenchInputError(f"speed_kmh must be a finite number; got {speed_kmh!r}")
+        raise WorkbenchInputError(f"speed_kmh must be a finite number; got {shown(speed_kmh)}")
 
 
 def _checked_lags(name: str, value: object) -> tuple[tuple[float, SteeringLag], ...]:
@@ -157,11 +159,11 @@ def _checked_lags(name: str, value: object) -> tuple[tuple[float, SteeringLag], 
     for i, (speed, lag) in enumerate(lags):
         if not (math.isfinite(speed) and speed >= 0.0) or not isinstance(lag, SteeringLag):
             raise WorkbenchInputError(
-                f"{name}[{i}] must be (speed_kmh >= 0, SteeringLag); got ({speed!r}, {type(lag).__name__})"
+                f"{name}[{i}] must be (speed_kmh >= 0, SteeringLag); got ({shown(speed)}, {type(lag).__name__})"
             )
     speeds = [speed for speed, _ in lags]
     if any(b <= a for a, b in itertools.pairwise(speeds)):
-        raise WorkbenchInputError(f"{name}' speeds must increase strictly; got {speeds}")
+        raise WorkbenchInputError(f"{name}' speeds must increase strictly; got {shown_all(speeds)}")
     return lags
 
 
@@ -337,7 +339,7 @@ def _lags(
             raise WorkbenchInputError(f"{path}: design.per_speed[{i}] must hold {list(LAG_KEYS)}; got {row!r}")
         speed = row["speed_kmh"]
         if isinstance(speed, bool) or not isinstance(speed, int | float):
-            raise WorkbenchInputError(f"{path}: design.per_speed[{i}].speed_kmh must be a number; got {speed!r}")
+            raise WorkbenchInputError(f"{path}: design.per_speed[{i}].speed_kmh must be a number; got {shown(speed)}")
         lags.append((float(speed), _row_lag(path, i, row, "", speed)))
         if any(k in row for k in MEASURED_LAG_KEYS):
             if any(k not in row for k in MEASURED_LAG_KEYS):
@@ -353,7 +355,7 @@ def _lags(
     speeds = tuple(speed for speed, _ in lags)
     if speeds != schedule.speeds_kmh:
         raise WorkbenchInputError(
-            f"{path}: the lags' speeds {list(speeds)} differ from the schedule's {list(schedule.speeds_kmh)}"
+            f"{path}: the lags' speeds {shown_all(speeds)} differ from the schedule's {shown_all(schedule.speeds_kmh)}"
         )
     return tuple(lags), tuple(measured)
 

@@ -29,6 +29,7 @@ from typing import Any
 import numpy as np
 
 from controllers.base import Controller, Measurement
+from controllers.config_checks import check_bool, check_choice, check_number, check_optional_path, check_whole
 from controllers.mpc.ocp import TrackingOCP, TrackingWeights
 from controllers.mpc.plan import Plan
 from controllers.mpc.prediction_model import (
@@ -41,7 +42,7 @@ from controllers.mpc.prediction_model import (
 )
 from controllers.mpc.preview import PathPreview
 from controllers.mpc.status import SolveResult, SolveStatus
-from workbench.errors import WorkbenchInputError, require_in_range, require_positive
+from workbench.errors import WorkbenchInputError
 from workbench.path import PathTracker, Projection, ReferencePath, wrap_angle
 from workbench.vehicles.base import VehicleGeometry
 from workbench.vehicles.steering_lag import read_lag_file
@@ -53,6 +54,8 @@ MIN_MEASURED_SPEED_MPS = 0.5
 GEOMETRY_TOLERANCE = 0.02
 #: The objective logged when a solve returned none.
 NO_OBJECTIVE = -1.0
+#: The largest cost weight the options allow (larger ones only make the QPs ill-conditioned).
+MAX_WEIGHT = 1e9
 
 
 @dataclass(frozen=True)
@@ -95,29 +98,20 @@ class MPCConfig:
     def __post_init__(self) -> None:
         from workbench.vehicles import VEHICLES
 
-        if self.vehicle not in ("auto", "geometry", *VEHICLES):
-            raise WorkbenchInputError(
-                f"vehicle must be 'auto', 'geometry' or a preset name ({', '.join(VEHICLES)}); got {self.vehicle!r}"
-            )
-        allowed = ("auto", *MODEL_KINDS)
-        if self.model not in allowed:
-            raise WorkbenchInputError(f"model must be one of {', '.join(allowed)}; got {self.model!r}")
-        if (
-            isinstance(self.horizon_steps, bool)
-            or not isinstance(self.horizon_steps, int)
-            or not 2 <= self.horizon_steps <= 500
-        ):
-            raise WorkbenchInputError(f"horizon_steps must be a whole number in [2, 500]; got {self.horizon_steps!r}")
-        require_in_range("step_s", self.step_s, 1e-3, 1.0, "s")
+        check_choice("vehicle", self.vehicle, ("auto", "geometry", *VEHICLES))
+        check_optional_path("vehicle_file", self.vehicle_file)
+        check_optional_path("lag_file", self.lag_file)
+        check_choice("model", self.model, ("auto", *MODEL_KINDS))
+        check_whole("horizon_steps", self.horizon_steps, 2, 500)
+        check_number("step_s", self.step_s, 1e-3, 1.0, "s")
         for name in ("weight_cte", "weight_heading", "terminal_weight_cte", "terminal_weight_heading"):
-            require_in_range(name, getattr(self, name), 0.0, 1e9)
-        require_positive("weight_steer_rate", self.weight_steer_rate)
-        require_in_range("max_lat_accel_mps2", self.max_lat_accel_mps2, 0.0, 50.0, "m/s^2 (0: no limit)")
-        require_in_range("weight_lat_accel_slack", self.weight_lat_accel_slack, 0.0, 1e9)
-        require_in_range("min_model_speed_mps", self.min_model_speed_mps, 0.5, 50.0, "m/s")
-        require_in_range("max_solve_time_s", self.max_solve_time_s, 0.0, 10.0, "s (0: the sample time)")
-        if not isinstance(self.codegen, bool):
-            raise WorkbenchInputError(f"codegen must be true or false; got {self.codegen!r}")
+            check_number(name, getattr(self, name), 0.0, MAX_WEIGHT)
+        check_number("weight_steer_rate", self.weight_steer_rate, 0.0, MAX_WEIGHT, low_open=True)
+        check_number("max_lat_accel_mps2", self.max_lat_accel_mps2, 0.0, 50.0, "m/s^2", note="0: no limit")
+        check_number("weight_lat_accel_slack", self.weight_lat_accel_slack, 0.0, MAX_WEIGHT)
+        check_number("min_model_speed_mps", self.min_model_speed_mps, 0.5, 50.0, "m/s")
+        check_number("max_solve_time_s", self.max_solve_time_s, 0.0, 10.0, "s", note="0: the sample time")
+        check_bool("codegen", self.codegen)
 
     @property
     def weights(self) -> TrackingWeights:
@@ -225,8 +219,7 @@ class MPCController(Controller):
         return ()
 
     # ------------------------------------------------------------------ Controller interface
-    def reset(self, path: ReferencePath, sample_time_s: float) -> None:
-        require_positive("sample_time_s", sample_time_s)
+    def _reset(self, path: ReferencePath, sample_time_s: float) -> None:
         self._sample_time_s = float(sample_time_s)
         self._set_time_budget(self.config.max_solve_time_s or self._sample_time_s)
         self._reset_state()
@@ -250,7 +243,7 @@ class MPCController(Controller):
             "model_speed_mps": 0.0,
         }
 
-    def step(self, measurement: Measurement, path: ReferencePath) -> float:
+    def _command(self, measurement: Measurement, path: ReferencePath) -> float:
         m, ocp, model = measurement, self.ocp, self.model
         foot = self._tracker.update(m.x_m, m.y_m)
         plan = self._plan
@@ -287,7 +280,8 @@ class MPCController(Controller):
             command, rate = float(x0[model.i_cmd]), 0.0
         limit = self.prediction.max_road_wheel_angle_rad
         command = min(max(command, -limit), limit)
-        self._last_command = command
+        if math.isfinite(command):  # else the base class holds the last command and says so
+            self._last_command = command
         self._diag = {
             "solver_status": float(result.status),
             "solve_time_s": float(result.solve_time_s),
@@ -302,8 +296,7 @@ class MPCController(Controller):
         }
         return self.saturate(command * self.prediction.steering_ratio)
 
-    @property
-    def diagnostics(self) -> Mapping[str, float]:
+    def _diagnostics(self) -> Mapping[str, float]:
         return self._diag
 
     @property
@@ -325,7 +318,11 @@ class MPCController(Controller):
             heading += math.atan2(m.vy_mps, m.vx_mps)
         x[model.i_cte] = foot.cte_m
         x[model.i_heading] = float(wrap_angle(heading - foot.heading_rad))
-        command = road_wheel if self._last_command is None else self._last_command
+        if self._last_command is None:  # the first step: the commanded angle is the measured one, within its bounds
+            limit = prm.max_road_wheel_angle_rad
+            command = min(max(road_wheel, -limit), limit)
+        else:
+            command = self._last_command
         x[model.i_cmd] = command
         if model.kind == "dynamic":
             st = prm.single_track

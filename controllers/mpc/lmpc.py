@@ -26,12 +26,13 @@ from typing import Any, ClassVar
 import casadi as ca
 import numpy as np
 
+from controllers.config_checks import check_number, check_whole, shown
 from controllers.mpc.codegen import FastFunction, compile_function
 from controllers.mpc.common import MPCConfig, MPCController
 from controllers.mpc.ocp import TrackingOCP
 from controllers.mpc.sparse_qp import OsqpSettings
 from controllers.mpc.status import SolveResult
-from workbench.errors import WorkbenchInputError, require_in_range
+from workbench.errors import WorkbenchInputError
 from workbench.vehicles.base import VehicleGeometry
 
 
@@ -110,12 +111,10 @@ class LMPCConfig(MPCConfig):
         if self.max_lat_accel_mps2 != 0.0:
             raise WorkbenchInputError(
                 f"max_lat_accel_mps2 must be 0 for the LTV-MPC (it has no lateral-acceleration limit; the NMPC has); "
-                f"got {self.max_lat_accel_mps2!r}"
+                f"got {shown(self.max_lat_accel_mps2)}"
             )
-        require_in_range("qp_tolerance", self.qp_tolerance, 1e-10, 1e-1)
-        value = self.qp_max_iterations
-        if isinstance(value, bool) or not isinstance(value, int) or not 1 <= value <= 10**6:
-            raise WorkbenchInputError(f"qp_max_iterations must be a whole number in [1, 1000000]; got {value!r}")
+        check_number("qp_tolerance", self.qp_tolerance, 1e-10, 1e-1)
+        check_whole("qp_max_iterations", self.qp_max_iterations, 1, 10**6)
 
 
 class LMPCController(MPCController):

@@ -23,13 +23,13 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from controllers.config_checks import check_bool, check_choice, check_number, check_whole
 from controllers.mpc.common import MPCConfig, MPCController
 from controllers.mpc.nlp_solver import IpoptSolver
 from controllers.mpc.plan import Plan
 from controllers.mpc.rti import RtiSolver
 from controllers.mpc.sparse_qp import OsqpSettings
 from controllers.mpc.status import SolveResult
-from workbench.errors import WorkbenchInputError, require_in_range
 from workbench.vehicles.base import VehicleGeometry
 
 SOLVERS = ("rti", "ipopt")
@@ -53,18 +53,13 @@ class NMPCConfig(MPCConfig):
 
     def __post_init__(self) -> None:
         super().__post_init__()
-        if self.solver not in SOLVERS:
-            raise WorkbenchInputError(f"solver must be one of {', '.join(SOLVERS)}; got {self.solver!r}")
-        for name, low, high in (
-            ("first_iterations", 1, 100),
-            ("max_iterations", 1, 10000),
-            ("qp_max_iterations", 1, 10**6),
-        ):
-            value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, int) or not low <= value <= high:
-                raise WorkbenchInputError(f"{name} must be a whole number in [{low}, {high}]; got {value!r}")
-        require_in_range("tolerance", self.tolerance, 1e-12, 1e-1)
-        require_in_range("qp_tolerance", self.qp_tolerance, 1e-10, 1e-1)
+        check_choice("solver", self.solver, SOLVERS)
+        check_whole("first_iterations", self.first_iterations, 1, 100)
+        check_whole("max_iterations", self.max_iterations, 1, 10000)
+        check_number("tolerance", self.tolerance, 1e-12, 1e-1)
+        check_bool("exact_hessian", self.exact_hessian)
+        check_number("qp_tolerance", self.qp_tolerance, 1e-10, 1e-1)
+        check_whole("qp_max_iterations", self.qp_max_iterations, 1, 10**6)
 
 
 class NMPCController(MPCController):

@@ -20,6 +20,7 @@ from dataclasses import dataclass
 import casadi as ca
 import numpy as np
 
+from controllers.config_checks import check_whole
 from controllers.mpc.codegen import CompiledFunction, FastFunction, compile_function
 from controllers.mpc.prediction_model import PredictionModel
 from controllers.mpc.sparse_qp import OsqpSettings, SparseMPCQP
@@ -57,8 +58,8 @@ class TrackingOCP:
         min_speed_mps: float = 3.0,
         terminal_weight: np.ndarray | None = None,
     ) -> None:
-        if isinstance(horizon_steps, bool) or not isinstance(horizon_steps, int) or not 2 <= horizon_steps <= 500:
-            raise WorkbenchInputError(f"horizon_steps must be a whole number in [2, 500]; got {horizon_steps!r}")
+        check_whole("horizon_steps", horizon_steps, 2, 500)
+        horizon_steps = int(horizon_steps)
         require_in_range("step_s", step_s, 1e-3, 1.0, "s")
         require_in_range("max_lat_accel_mps2", max_lat_accel_mps2, 0.0, 50.0, "m/s^2 (0: no limit)")
         require_in_range("min_speed_mps", min_speed_mps, 0.5, 50.0, "m/s")

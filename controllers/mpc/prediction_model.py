@@ -157,8 +157,8 @@ class PredictionParams:
         require_in_range("steering_time_constant_s", self.steering_time_constant_s, 1e-3, 2.0, "s")
         if self.single_track is not None and abs(self.single_track.wheelbase_m - self.wheelbase_m) > 1e-6:
             raise WorkbenchInputError(
-                f"single_track axle positions add up to {self.single_track.wheelbase_m} m; they must equal "
-                f"wheelbase_m = {self.wheelbase_m} m"
+                f"single_track axle positions add up to {float(self.single_track.wheelbase_m):g} m; they must "
+                f"equal wheelbase_m = {float(self.wheelbase_m):g} m"
             )
 
     def with_lag(self, lag: SteeringLag | None) -> PredictionParams:

@@ -21,6 +21,7 @@ namespace built on every solve), a tenth of the LTV-MPC's whole step. Setup and 
 
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import dataclass
 
@@ -33,6 +34,14 @@ from controllers.mpc.status import SolveStatus, osqp_status
 
 #: OSQP's infinity: bounds beyond it are treated as absent.
 OSQP_INFINITY = float(osqp.constant("OSQP_INFTY"))
+#: Largest |entry| of the constraint matrix handed to OSQP. Its LDL' factorisation of the KKT matrix loses the
+#: quasi-definiteness it relies on in rounding when the dynamics blocks hold entries far beyond the O(1) weights and
+#: penalty (measured: from about 1e15, when OSQP prints "ERROR in osqp_update_data_mat: new KKT matrix is not
+#: quasidefinite" and its next solve fails); the plausible problems stay below 1e3 (speeds up to 150 m/s).
+MAX_MATRIX_ENTRY = 1e9
+#: Largest |value| of the vectors handed to OSQP (the dynamics rows' right sides, the linear cost, the soft bounds):
+#: well inside OSQP_INFINITY, beyond which a bound silently counts as absent.
+MAX_VECTOR_ENTRY = 1e20
 
 
 @dataclass(frozen=True)
@@ -210,6 +219,8 @@ class SparseMPCQP:
             P=P, q=self.q.copy(), A=A, l=self.lower.copy(), u=self.upper.copy(), **self.settings.as_kwargs()
         )
         self._native = getattr(self.solver, "_solver", None)
+        #: Whether the last `update` held data OSQP cannot use (then `solve` reports NUMERICAL_ERROR).
+        self.refused = False
         if not all(hasattr(self._native, name) for name in ("update_data_vec", "update_data_mat", "solve", "info")):
             raise RuntimeError(
                 f"osqp {osqp.__version__} is not supported: the MPC needs osqp >= 1.0, < 2 (pip install 'osqp>=1,<2')"
@@ -248,7 +259,12 @@ class SparseMPCQP:
         x_ref: np.ndarray | None = None,
     ) -> None:
         """Dynamics blocks A (N, nx, nx), B (N, nx, nu), c (N, nx); initial state; soft-constraint rows G (N, nx)
-        with bounds soft_lo, soft_hi (N,); state references x_ref (N+1, nx) for the linear cost term."""
+        with bounds soft_lo, soft_hi (N,); state references x_ref (N+1, nx) for the linear cost term.
+
+        Data OSQP cannot use (non-finite, or beyond MAX_MATRIX_ENTRY / MAX_VECTOR_ENTRY) is not handed to it: the
+        next `solve` then reports NUMERICAL_ERROR without calling OSQP, whose C code would print its failure to
+        the console instead. OSQP keeps the last data it accepted, and the next good update overwrites every
+        block this one wrote."""
         vals = self._csc_values
         self.x0 = np.array(x0, dtype=float)
         self._x0_cost = _quadratic_form(self.Q, self.x0)  # x_0' Q x_0: the cost's constant term
@@ -262,6 +278,16 @@ class SparseMPCQP:
             q = self.q.copy()
             q[self.ix[:-1]] = -2.0 * x_ref[1:-1] @ self.Q
             q[self.ix[-1]] = -2.0 * x_ref[-1] @ self.QN
+        self.refused = not (
+            _bounded(vals, MAX_MATRIX_ENTRY)
+            and _bounded(self.lower[: self.n_eq], MAX_VECTOR_ENTRY)  # the dynamics rows: l = u = their right side
+            and _bounded(self.lower, OSQP_INFINITY)
+            and _bounded(self.upper, OSQP_INFINITY)
+            and (q is None or _bounded(q, MAX_VECTOR_ENTRY))
+            and np.isfinite(self._x0_cost)
+        )
+        if self.refused:
+            return
         self._native.update_data_vec(q=q, l=self.lower, u=self.upper)
         self._native.update_data_mat(P_x=None, P_i=None, A_x=vals, A_i=None)
 
@@ -277,7 +303,13 @@ class SparseMPCQP:
     def solve(self, warm_start: np.ndarray | None = None) -> QPSolution:
         """Solve; warm_start (z) replaces the primal part of OSQP's own warm start (its previous solution)."""
         native = self._native
-        if warm_start is not None:
+        if self.refused:  # `update` kept data OSQP cannot use from it
+            z = np.zeros(self.n)
+            states, inputs, _ = _unpack(z, self.x0, self.N, self.u_lower, self.u_upper)
+            return QPSolution(
+                SolveStatus.NUMERICAL_ERROR, states, inputs, z[self.ie], 0, 0.0, math.nan, z, np.zeros(self.m)
+            )
+        if warm_start is not None and _bounded(warm_start, MAX_VECTOR_ENTRY):
             native.warm_start(warm_start, None)
         start = time.perf_counter()
         native.solve()
@@ -348,6 +380,15 @@ def _unpack(
         for i in range(nx):
             states[k + 1, i] = z[base + nu + i]
     return states, inputs, finite
+
+
+@njit(cache=True)
+def _bounded(values: np.ndarray, limit: float) -> bool:  # pragma: no cover - compiled
+    """Whether every entry of the 1-D array is finite and within +-limit."""
+    for v in values:
+        if not abs(v) <= limit:  # NaN fails too
+            return False
+    return True
 
 
 @njit(cache=True)

@@ -21,7 +21,8 @@ class SolveStatus(IntEnum):
     MAX_ITERATIONS = 2  # iteration limit reached before convergence
     LATE = 3  # the solver's wall-time limit (max_solve_time_s) cut it short
     INFEASIBLE = 4  # the constraints cannot be met (e.g. inconsistent bounds)
-    NUMERICAL_ERROR = 5  # NaN/Inf in the functions, failed step computation, restoration failure
+    NUMERICAL_ERROR = 5  # NaN/Inf in the functions, failed step computation, restoration failure, QP data OSQP
+    #                      cannot factorise (non-finite or huge: refused before the call, `sparse_qp.py`)
     NOT_FINITE = 6  # the solver claimed success but returned non-finite numbers
     ERROR = 7  # any other failure (the solver raised, unknown status)
 

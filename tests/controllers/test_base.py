@@ -1,0 +1,158 @@
+"""The base class's contract (`controllers/base.py`): the plausible envelope, the held command, the flags."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from typing import ClassVar
+
+import pytest
+
+from controllers import base
+from controllers.base import Controller, Measurement
+from workbench.clothoid_chain import ClothoidChain
+from workbench.path import ReferencePath
+from workbench.vehicles import KinematicBicycle
+
+PATH = ClothoidChain().straight(50.0).to_path("straight")
+GEOMETRY = KinematicBicycle().geometry
+LOCK = GEOMETRY.max_steer_wheel_angle_rad
+GOOD = Measurement(1.0, 5.0, 0.5, 8.0, 0.0, 0.0, 0.0, 0.0)
+
+
+class _Scripted(Controller):
+    """Returns what it is told to, records what it saw, and reports one signal."""
+
+    name: ClassVar[str] = "scripted"
+    config_type: ClassVar[type] = dict
+
+    def _reset(self, path: ReferencePath, sample_time_s: float) -> None:
+        self.seen: list[Measurement] = []
+        self.next_command, self.signal = 0.1, 0.0
+
+    def _command(self, measurement: Measurement, path: ReferencePath) -> float:
+        self.seen.append(measurement)
+        return self.next_command
+
+    def _diagnostics(self):
+        return {"signal": self.signal}
+
+
+def _controller() -> _Scripted:
+    controller = _Scripted(GEOMETRY)
+    controller.reset(PATH, 0.02)
+    return controller
+
+
+def test_a_plausible_measurement_reaches_the_controller_unchanged() -> None:
+    controller = _controller()
+    assert controller.step(GOOD, PATH) == 0.1
+    assert controller.seen == [GOOD] and controller.seen[0] is GOOD
+    assert controller.diagnostics == {"signal": 0.0, "measurement_rejected": 0.0, "command_rejected": 0.0}
+
+
+@pytest.mark.parametrize(
+    ("field", "value"),
+    [
+        ("steer_wheel_rad", base.STEER_SENSOR_MARGIN * LOCK),
+        ("steer_wheel_rad", -base.STEER_SENSOR_MARGIN * LOCK),
+        ("vx_mps", base.MAX_SPEED_MPS),
+        ("vx_mps", -base.MAX_SPEED_MPS),
+        ("yaw_rate_rad_s", -base.MAX_YAW_RATE_RAD_S),
+        ("x_m", base.MAX_POSITION_M),
+        ("y_m", -base.MAX_POSITION_M),
+        ("t_s", 1.0),  # the same time again (zero dt)
+        ("yaw_rad", 1e300),
+        ("yaw_rad", -base.MAX_UNWRAPPED_YAW_RAD),
+    ],
+)
+def test_the_envelope_edges_are_plausible(field: str, value: float) -> None:
+    controller = _controller()
+    controller.step(GOOD, PATH)
+    controller.next_command = 0.2
+    assert controller.step(dataclasses.replace(GOOD, **{field: value}), PATH) == 0.2
+    assert controller.diagnostics["measurement_rejected"] == 0.0
+
+
+@pytest.mark.parametrize(
+    ("field", "value"),
+    [
+        ("steer_wheel_rad", base.STEER_SENSOR_MARGIN * LOCK * (1 + 1e-9)),
+        ("vx_mps", math.nextafter(base.MAX_SPEED_MPS, math.inf)),
+        ("vy_mps", -base.MAX_SPEED_MPS - 1e-6),
+        ("yaw_rate_rad_s", base.MAX_YAW_RATE_RAD_S + 1e-9),
+        ("x_m", -base.MAX_POSITION_M * 1.000001),
+        ("t_s", math.nextafter(1.0, 0.0)),
+        ("t_s", 2 * base.MAX_TIME_S),
+        ("t_s", math.nan),
+        ("yaw_rad", math.inf),
+        ("steer_wheel_rad", None),
+        ("x_m", "5"),
+    ],
+)
+def test_beyond_the_envelope_the_last_command_is_held(field: str, value: object) -> None:
+    controller = _controller()
+    controller.step(GOOD, PATH)
+    controller.next_command, controller.signal = 0.2, 7.0
+    assert controller.step(dataclasses.replace(GOOD, **{field: value}), PATH) == 0.1
+    assert controller.seen == [GOOD]  # the controller never saw it
+    assert controller.diagnostics == {"signal": 0.0, "measurement_rejected": 1.0, "command_rejected": 0.0}
+    assert controller.rejection
+    assert controller.held_command == 0.1
+
+
+def test_a_huge_yaw_is_wrapped_before_the_controller_sees_it() -> None:
+    controller = _controller()
+    yaw = 2 * math.pi * 1e6 + 0.25
+    controller.step(dataclasses.replace(GOOD, yaw_rad=yaw), PATH)
+    seen = controller.seen[-1].yaw_rad
+    assert -math.pi <= seen < math.pi and math.isclose(math.sin(seen), math.sin(yaw), abs_tol=1e-6)
+    controller.step(dataclasses.replace(GOOD, yaw_rad=1e300), PATH)
+    assert -math.pi <= controller.seen[-1].yaw_rad < math.pi
+    controller.step(dataclasses.replace(GOOD, yaw_rad=50.0), PATH)
+    assert controller.seen[-1].yaw_rad == 50.0  # below MAX_UNWRAPPED_YAW_RAD: as measured
+
+
+@pytest.mark.parametrize("bad", [math.nan, math.inf, -math.inf])
+def test_a_non_finite_command_is_not_sent(bad: float) -> None:
+    controller = _controller()
+    controller.step(GOOD, PATH)
+    controller.next_command, controller.signal = bad, 3.0
+    assert controller.step(dataclasses.replace(GOOD, t_s=1.02), PATH) == 0.1
+    assert controller.diagnostics == {"signal": 0.0, "measurement_rejected": 0.0, "command_rejected": 1.0}
+    controller.next_command = 0.3
+    assert controller.step(dataclasses.replace(GOOD, t_s=1.04), PATH) == 0.3
+    assert controller.diagnostics == {"signal": 3.0, "measurement_rejected": 0.0, "command_rejected": 0.0}
+
+
+def test_non_finite_diagnostics_reject_the_command_too() -> None:
+    controller = _controller()
+    controller.step(GOOD, PATH)
+    controller.next_command, controller.signal = 0.3, math.nan
+    assert controller.step(dataclasses.replace(GOOD, t_s=1.02), PATH) == 0.1
+    assert controller.diagnostics == {"signal": 0.0, "measurement_rejected": 0.0, "command_rejected": 1.0}
+
+
+def test_the_command_is_saturated_and_a_reset_forgets_the_hold() -> None:
+    controller = _controller()
+    controller.next_command = 1e6
+    assert controller.step(GOOD, PATH) == LOCK
+    controller.next_command = -math.inf
+    assert controller.step(dataclasses.replace(GOOD, t_s=1.02), PATH) == LOCK
+    controller.reset(PATH, 0.02)
+    assert controller.held_command == 0.0
+    assert controller.step(dataclasses.replace(GOOD, t_s=math.nan), PATH) == 0.0
+    controller.next_command = 0.5
+    assert controller.step(dataclasses.replace(GOOD, t_s=0.0), PATH) == 0.5  # time starts afresh
+
+
+def test_the_flags_are_there_before_the_first_step() -> None:
+    controller = _controller()
+    assert controller.diagnostics == {"signal": 0.0, "measurement_rejected": 0.0, "command_rejected": 0.0}
+
+
+def test_a_bad_sample_time_is_refused_for_every_controller() -> None:
+    from workbench.errors import WorkbenchInputError
+
+    with pytest.raises(WorkbenchInputError, match="sample_time_s"):
+        _Scripted(GEOMETRY).reset(PATH, 0.0)
