@@ -22,18 +22,19 @@ bad sensor frame, and so does every controller. `Controller.step` is a template 
 So `step` always returns a finite command within the limit, and an implausible measurement changes nothing in
 the controller. On a rejected step the controller's own diagnostics are those of the last accepted one;
 `diagnostics` always holds the controller's own keys plus `measurement_rejected` and `command_rejected` (1.0 or
-0.0), all finite, the same keys every step. `reset` clears the held command and the last accepted time (time
-never runs backwards within a run: once a frame stamped far in the future is accepted, every frame stamped
-before it is refused until the next reset). Subclasses implement `_reset` and `_command` (the base
-raises NotImplementedError for them) and optionally `_diagnostics`; they do not override `step`, `reset` or
-`diagnostics`. `rejection` says in words why the last rejected step was rejected.
+0.0), all finite, the same keys every step. `reset` clears the held command and the last accepted time. A frame
+stamped earlier than the last accepted one is rejected, unless CLOCK_RESET_FRAMES come so in a row: then the
+clock was reset, and the controller restarts (as `reset`) and takes the frame, so that one frame stamped far
+ahead cannot lock it out. Subclasses implement the abstract `_reset` and `_command` and optionally
+`_diagnostics`; they do not override `step`, `reset` or `diagnostics`. `rejection` says in words why the last
+rejected step was rejected.
 """
 
 from __future__ import annotations
 
 import math
 import sys
-from abc import ABC
+from abc import ABC, abstractmethod
 from collections.abc import Mapping
 from dataclasses import dataclass
 from types import MappingProxyType
@@ -65,6 +66,10 @@ MAX_TIME_S = 1e12
 #: magnitude (rad; about 1600 turns) is wrapped to [-pi, pi) before the controller sees it, so that its rounding
 #: does not swallow the small angles added to it. Below it the yaw is passed unchanged, as it always was.
 MAX_UNWRAPPED_YAW_RAD = 1e4
+#: A clock that runs backwards for this many frames in a row has been reset (a new time base), not glitched: the
+#: controller restarts (as `reset`, on the same path) and takes the frame. Fewer are single bad frames, rejected;
+#: without the restart one frame stamped far ahead would lock the controller out until the next `reset`.
+CLOCK_RESET_FRAMES = 5
 #: The flags `diagnostics` adds to the controller's own signals.
 MEASUREMENT_REJECTED = "measurement_rejected"
 COMMAND_REJECTED = "command_rejected"
@@ -123,6 +128,7 @@ class Controller(ABC):
         """Forget all state; the next step is the first on `path`; steps come every `sample_time_s` seconds."""
         require_positive("sample_time_s", sample_time_s)
         self._clear_hold()
+        self._sample_time_s = float(sample_time_s)
         self._reset(path, sample_time_s)
         self._report = self._merged(self._diagnostics(), 0.0, 0.0)
 
@@ -130,6 +136,13 @@ class Controller(ABC):
         """Steering-wheel angle command (rad) for this step: always finite and within the vehicle's limit (the
         module docstring's contract: an implausible measurement or a non-finite result holds the last command)."""
         screened = self._screen(measurement)
+        if screened is not None and screened.t_s < self._last_t_s:
+            self._rewound_frames += 1
+            if self._rewound_frames < CLOCK_RESET_FRAMES:
+                self.rejection = f"t_s = {screened.t_s:g} s is earlier than the last accepted {self._last_t_s:g} s"
+                screened = None
+            else:  # the clock has been reset, not glitched: so is the controller, and it takes the frame
+                self._reset(path, self._sample_time_s)
         if screened is None:
             self._report = self._merged(self._report, 1.0, 0.0)  # a new mapping: one handed out earlier stays as it was
             return self._held_command
@@ -141,7 +154,7 @@ class Controller(ABC):
             return self._held_command
         limit = self.geometry.max_steer_wheel_angle_rad
         command = min(max(command, -limit), limit)
-        self._held_command, self._last_t_s = command, screened.t_s
+        self._held_command, self._last_t_s, self._rewound_frames = command, screened.t_s, 0
         self._report = self._merged(own, 0.0, 0.0)
         return command
 
@@ -162,15 +175,15 @@ class Controller(ABC):
         return min(max(steer_wheel_rad, -limit), limit)
 
     # ------------------------------------------------------------------ what subclasses implement
+    @abstractmethod
     def _reset(self, path: ReferencePath, sample_time_s: float) -> None:
         """Forget all state for a new run on `path` (sample_time_s > 0 already checked); set up the controller's
-        own diagnostics with every key it will ever report. Every controller implements it."""
-        raise NotImplementedError(f"{type(self).__name__} must implement _reset")
+        own diagnostics with every key it will ever report."""
 
+    @abstractmethod
     def _command(self, measurement: Measurement, path: ReferencePath) -> float:
-        """The steering-wheel command (rad) for a measurement that passed the screen. Every controller implements
-        it; the base class saturates the result and holds the last command when it is not finite."""
-        raise NotImplementedError(f"{type(self).__name__} must implement _command")
+        """The steering-wheel command (rad) for a measurement that passed the screen; the base class saturates the
+        result and holds the last command when it is not finite."""
 
     def _diagnostics(self) -> Mapping[str, float]:
         """The controller's own signals of its last `_command` (the same keys every step; none by default)."""
@@ -180,6 +193,7 @@ class Controller(ABC):
     def _clear_hold(self) -> None:
         self._held_command = 0.0
         self._last_t_s = -math.inf
+        self._rewound_frames = 0  # frames in a row stamped earlier than the last accepted one
         #: Why the last rejected step was rejected ("" until one is), for a person reading a failure.
         self.rejection = ""
 
@@ -201,7 +215,6 @@ class Controller(ABC):
                 and abs(m.x_m) <= MAX_POSITION_M
                 and abs(m.y_m) <= MAX_POSITION_M
                 and abs(m.t_s) <= MAX_TIME_S
-                and m.t_s >= self._last_t_s
                 and math.isfinite(m.yaw_rad)
             )
         except (TypeError, ValueError, OverflowError, AttributeError):  # not numbers at all
@@ -234,6 +247,4 @@ class Controller(ABC):
             return f"|yaw_rate_rad_s| = {abs(float(m.yaw_rate_rad_s)):g} is above {MAX_YAW_RATE_RAD_S:g} rad/s"
         if abs(m.x_m) > MAX_POSITION_M or abs(m.y_m) > MAX_POSITION_M:
             return f"position ({float(m.x_m):g}, {float(m.y_m):g}) m is beyond +-{MAX_POSITION_M:g} m"
-        if abs(m.t_s) > MAX_TIME_S:
-            return f"t_s = {float(m.t_s):g} s is beyond +-{MAX_TIME_S:g} s"
-        return f"t_s = {float(m.t_s):g} s is earlier than the last accepted {self._last_t_s:g} s"
+        return f"t_s = {float(m.t_s):g} s is beyond +-{MAX_TIME_S:g} s"

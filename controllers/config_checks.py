@@ -15,29 +15,12 @@ from collections.abc import Iterable
 
 import numpy as np
 
-from workbench.errors import WorkbenchInputError
-
-
-def shown(value: object) -> str:
-    """`value` as a message shows it: a number (numpy's included) as Python writes the plain int or float (`nan`,
-    `inf`, `1e+308`, `3`), a boolean as True/False, anything else by its repr."""
-    if isinstance(value, bool | np.bool_):
-        return repr(bool(value))
-    if isinstance(value, numbers.Integral):
-        return repr(int(value))
-    if isinstance(value, numbers.Real):
-        return repr(float(value))
-    return repr(value)
+from workbench.errors import WorkbenchInputError, is_number, value_text
 
 
 def shown_all(values: object) -> str:
-    """A sequence as a message shows it: `[5.0, 10.0]`, each entry by `shown`."""
-    return "[" + ", ".join(shown(v) for v in values) + "]"  # type: ignore[union-attr]
-
-
-def is_number(value: object) -> bool:
-    """A real number, Python's or numpy's, not a boolean."""
-    return isinstance(value, numbers.Real) and not isinstance(value, bool | np.bool_)
+    """A sequence as a message shows it: `[5.0, 10.0]`, each entry by `value_text`."""
+    return "[" + ", ".join(value_text(v) for v in values) + "]"  # type: ignore[union-attr]
 
 
 def check_number(
@@ -47,9 +30,9 @@ def check_number(
     interval = f"{'(' if low_open else '['}{low:g}, {high:g}]" + (f" {unit}" if unit else "")
     allowed = f"a finite number in {interval}" + (f" ({note})" if note else "")
     if not is_number(value) or not math.isfinite(value):
-        raise WorkbenchInputError(f"{name} must be {allowed}; got {shown(value)}")
+        raise WorkbenchInputError(f"{name} must be {allowed}; got {value_text(value)}")
     if value < low or (low_open and value == low) or value > high:
-        raise WorkbenchInputError(f"{name} must be {allowed}; got {shown(value)}")
+        raise WorkbenchInputError(f"{name} must be {allowed}; got {value_text(value)}")
 
 
 def check_optional_number(
@@ -70,20 +53,20 @@ def check_optional_number(
 def check_whole(name: str, value: object, low: int, high: int) -> None:
     """A whole number (not a boolean, not a float) in [low, high]."""
     if not isinstance(value, numbers.Integral) or isinstance(value, bool | np.bool_) or not low <= value <= high:
-        raise WorkbenchInputError(f"{name} must be a whole number in [{low}, {high}]; got {shown(value)}")
+        raise WorkbenchInputError(f"{name} must be a whole number in [{low}, {high}]; got {value_text(value)}")
 
 
 def check_bool(name: str, value: object) -> None:
     """True or False."""
     if not isinstance(value, bool | np.bool_):
-        raise WorkbenchInputError(f"{name} must be true or false; got {shown(value)}")
+        raise WorkbenchInputError(f"{name} must be true or false; got {value_text(value)}")
 
 
 def check_choice(name: str, value: object, allowed: Iterable[str]) -> None:
     """One of the names in `allowed`."""
     allowed = tuple(allowed)
     if not isinstance(value, str) or value not in allowed:
-        raise WorkbenchInputError(f"{name} must be one of {', '.join(allowed)}; got {shown(value)}")
+        raise WorkbenchInputError(f"{name} must be one of {', '.join(allowed)}; got {value_text(value)}")
 
 
 def check_optional_path(name: str, value: object) -> None:
@@ -93,4 +76,4 @@ def check_optional_path(name: str, value: object) -> None:
     if isinstance(value, os.PathLike):
         value = os.fspath(value)
     if not isinstance(value, str) or not value:
-        raise WorkbenchInputError(f"{name} must be a file path or None; got {shown(value)}")
+        raise WorkbenchInputError(f"{name} must be a file path or None; got {value_text(value)}")

@@ -14,8 +14,8 @@ from dataclasses import dataclass
 from typing import ClassVar
 
 from controllers.base import Controller, Measurement
-from controllers.config_checks import check_number, shown
-from workbench.errors import WorkbenchInputError
+from controllers.config_checks import check_number
+from workbench.errors import WorkbenchInputError, value_text
 from workbench.path import PathTracker, ReferencePath
 
 #: The longest lookahead (m) the options allow.
@@ -36,8 +36,8 @@ class PurePursuitConfig:
         check_number("max_lookahead_m", self.max_lookahead_m, 0.0, MAX_LOOKAHEAD_M, "m", low_open=True)
         if self.max_lookahead_m < self.min_lookahead_m:
             raise WorkbenchInputError(
-                f"max_lookahead_m must be >= min_lookahead_m = {shown(self.min_lookahead_m)} m; "
-                f"got {shown(self.max_lookahead_m)}"
+                f"max_lookahead_m must be >= min_lookahead_m = {value_text(self.min_lookahead_m)} m; "
+                f"got {value_text(self.max_lookahead_m)}"
             )
 
 

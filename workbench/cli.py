@@ -26,7 +26,7 @@ from typing import TYPE_CHECKING
 
 from controllers import CONTROLLERS, make_controller
 from controllers.config_file import config_template, read_controller_config
-from workbench.comparison import Comparison, RunSpec, compare, long_run_warning, warn_on_stderr
+from workbench.comparison import Comparison, RunSpec, compare, warn_on_stderr
 from workbench.errors import WorkbenchInputError
 from workbench.fig17 import run_fig17
 from workbench.input_files import check_input_file
@@ -394,8 +394,7 @@ def _run(args: argparse.Namespace) -> int:
         max_lateral_accel_g=args.lat_accel_g,
     )
     simulation = Simulation(scenario, vehicle, controller, config)
-    long_run = long_run_warning(simulation, f"{scenario.name}: {controller.name} on {vehicle.name}")
-    for warning in [*simulation.path_warnings(), *([long_run] if long_run is not None else [])]:
+    for warning in simulation.warnings(f"{scenario.name}: {controller.name} on {vehicle.name}"):
         warn_on_stderr(warning)
     result = simulation.run(progress=sys.stderr.isatty())
     with _writing(out):

@@ -10,9 +10,8 @@ keeps its row with its status and message: nothing is dropped. `workbench compar
 the result with `save` (traces, metrics, summary.csv, figures) and `workbench.report.write_report` (report.html).
 
 Every run is built (vehicle, scenario, controller options and files) before the first one is simulated, so a bad
-input is refused before any work; stretches of the path a vehicle cannot turn (`Simulation.path_warnings`) and a
-run that may take more than LONG_RUN_STEPS controller steps before its time-out (`long_run_warning`: its simulated
-time, steps and trace size) are announced first.
+input is refused before any work, and what each run's `Simulation.warnings` says (stretches of the path the
+vehicle cannot turn, a run that may be very long) is announced first.
 """
 
 from __future__ import annotations
@@ -43,12 +42,6 @@ if TYPE_CHECKING:
 
 #: |CTE| (m) within which a run counts as converged onto the path (the fig17 scenario starts 1 m off it).
 CONVERGED_CTE_M = 0.1
-#: A run that may take more controller steps than this before its time-out is announced with a warning (at 50 Hz
-#: about 83 simulated minutes; a dlc at 30 km/h may take 5 700, a Zandvoort lap 79 000).
-LONG_RUN_STEPS = 250_000
-#: Trace columns besides the vehicle's outputs, estimated generously for the trace-size warning: the simulator's
-#: 11 signals and up to 29 controller diagnostics (`ctrl_*`).
-EXTRA_TRACE_COLUMNS = 40
 #: The comparison figures: file name, Comparison method (Figures 17a, 17b, 18a, 18b).
 FIGURES: tuple[tuple[str, str], ...] = (
     ("trajectories.png", "plot_trajectories"),
@@ -215,34 +208,6 @@ class Comparison:
         return written + self.save_figures(out)
 
 
-def _duration_text(seconds: float) -> str:
-    if seconds < 120:
-        return f"{seconds:.0f} s"
-    if seconds < 2 * 3600:
-        return f"{seconds / 60:.0f} min"
-    if seconds < 2 * 86400:
-        return f"{seconds / 3600:.0f} h"
-    return f"{seconds / 86400:,.0f} days"
-
-
-def long_run_warning(simulation: Simulation, label: str = "the run") -> str | None:
-    """A warning for a run that may take more than LONG_RUN_STEPS controller steps before its time-out (a very
-    low speed, many laps): the simulated time, the steps and the trace's size (rows x columns x 8 bytes, the
-    columns estimated generously), and what shortens it; None for a run of ordinary length."""
-    steps = simulation.max_steps
-    if steps <= LONG_RUN_STEPS:
-        return None
-    columns = len(simulation.vehicle.output_names) + EXTRA_TRACE_COLUMNS
-    size = steps * columns * 8
-    size_text = f"{size / 1e9:,.1f} GB" if size >= 1e9 else f"{size / 1e6:,.0f} MB"
-    return (
-        f"{label} may simulate up to {_duration_text(simulation.max_time_s)} "
-        f"({steps:,} controller steps at {simulation.config.controller_rate_hz:g} Hz) before it times out, with a "
-        f"trace of up to {steps:,} rows x about {columns} columns (about {size_text} at 8 bytes a value); it may "
-        f"take a long time. A higher --speed (now {simulation.config.speed_kmh:g} km/h) or fewer --laps shortens it"
-    )
-
-
 def warn_on_stderr(message: str) -> None:
     """Print a warning as the CLI does: `workbench: warning: ...` on stderr."""
     print(f"workbench: warning: {message}", file=sys.stderr, flush=True)
@@ -258,7 +223,7 @@ def compare(
 ) -> Comparison:
     """Simulate each run on `scenario` (a name, a waypoint file or a Scenario) with the same config. Every run is
     built first (a bad input is refused before any simulation); what a vehicle cannot follow
-    (`Simulation.path_warnings`) and each run that may be long (`long_run_warning`) are announced through `warn`
+    and each run that may be long (`Simulation.warnings`) are announced through `warn`
     before the first run (None: silent)."""
     if not runs:
         raise WorkbenchInputError("a comparison needs at least one (controller, vehicle) run; got none")
@@ -279,9 +244,7 @@ def compare(
         simulations.append(Simulation(scen, vehicle, controller, config))
     messages: list[str] = []
     for spec, simulation in zip(runs, simulations, strict=True):
-        messages += simulation.path_warnings()
-        long_run = long_run_warning(simulation, spec.label)
-        messages += [long_run] if long_run is not None else []
+        messages += simulation.warnings(spec.label)
     for message in dict.fromkeys(messages) if warn is not None else ():
         warn(message)
     results = [simulation.run() for simulation in simulations]
@@ -290,11 +253,9 @@ def compare(
 
 __all__ = [
     "CONVERGED_CTE_M",
-    "LONG_RUN_STEPS",
     "Comparison",
     "RunSpec",
     "compare",
     "converge_distance_m",
-    "long_run_warning",
     "warn_on_stderr",
 ]

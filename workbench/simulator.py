@@ -19,7 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 from tqdm import tqdm
 
-from controllers.base import Controller, Measurement
+from controllers.base import COMMAND_REJECTED, MEASUREMENT_REJECTED, Controller, Measurement
 from workbench.errors import WorkbenchInputError, require_in_range, require_positive
 from workbench.path import ReferencePath, wrap_angle
 from workbench.result import SimulationResult, Status
@@ -30,6 +30,12 @@ from workbench.vehicles.base import VehicleModel
 
 #: Spacing (m) of the points the speed profile is planned on (the paper plans on its waypoints).
 SPEED_PLAN_SPACING_M = 1.0
+#: A run that may take more controller steps than this before its time-out is announced with a warning (at 50 Hz
+#: about 83 simulated minutes; a dlc at 30 km/h may take 5 700, a Zandvoort lap 79 000).
+LONG_RUN_STEPS = 250_000
+#: Trace columns besides the vehicle's outputs, estimated generously for the trace-size warning: the simulator's
+#: 11 signals and up to 29 controller diagnostics (`ctrl_*`).
+EXTRA_TRACE_COLUMNS = 40
 
 
 @dataclass(frozen=True)
@@ -136,6 +142,28 @@ class Simulation:
         self.config = config or SimulationConfig()
         self.path = plan_path_speed(scenario.path, self.config)
 
+    def warnings(self, label: str = "the run") -> list[str]:
+        """What to tell a person before this run: `path_warnings` and `long_run_warning`."""
+        long_run = self.long_run_warning(label)
+        return self.path_warnings() + ([long_run] if long_run is not None else [])
+
+    def long_run_warning(self, label: str = "the run") -> str | None:
+        """A warning for a run that may take more than LONG_RUN_STEPS controller steps before its time-out (a very
+        low speed, many laps): the simulated time, the steps and the trace's size (rows x columns x 8 bytes, the
+        columns estimated generously), and what shortens it; None for a run of ordinary length."""
+        steps = self.max_steps
+        if steps <= LONG_RUN_STEPS:
+            return None
+        columns = len(self.vehicle.output_names) + EXTRA_TRACE_COLUMNS
+        size = steps * columns * 8
+        size_text = f"{size / 1e9:,.1f} GB" if size >= 1e9 else f"{size / 1e6:,.0f} MB"
+        return (
+            f"{label} may simulate up to {_duration_text(self.max_time_s)} "
+            f"({steps:,} controller steps at {self.config.controller_rate_hz:g} Hz) before it times out, with a "
+            f"trace of up to {steps:,} rows x about {columns} columns (about {size_text} at 8 bytes a value); it may "
+            f"take a long time. A higher --speed (now {self.config.speed_kmh:g} km/h) or fewer --laps shortens it"
+        )
+
     def path_warnings(self) -> list[str]:
         """What about the path this vehicle cannot do, to say before the run: stretches curving tighter than its
         steering lock turns it (Ackermann, tan(max road-wheel angle) / wheelbase)."""
@@ -188,6 +216,7 @@ class Simulation:
         log = _TraceLog(vehicle.output_names, max_steps)
         status, message = Status.TIMEOUT, f"did not finish within {max_time:.1f} s"
         steer_cmd = accel_cmd = 0.0
+        held, first_held = 0, ""  # steps whose measurement the controller's screen rejected (it held its command)
         bar = tqdm(total=round(total_length), unit="m", delay=2.0, disable=not progress, leave=False)
         t = 0.0
         for _ in range(max_steps):
@@ -219,10 +248,15 @@ class Simulation:
                 status, message = Status.CONTROLLER_FAILED, f"{controller.name} raised {type(exc).__name__}: {exc}"
                 break
             step_time = time.perf_counter() - start
-            if not math.isfinite(steer_cmd):
+            flags = controller.diagnostics
+            if flags.get(COMMAND_REJECTED) or not math.isfinite(steer_cmd):
                 status = Status.CONTROLLER_FAILED
-                message = f"{controller.name} returned a non-finite steering command ({steer_cmd}) at t = {t:.2f} s"
+                message = f"{controller.name} computed a non-finite steering command at t = {t:.2f} s"
                 break
+            if flags.get(MEASUREMENT_REJECTED):
+                if not held:
+                    first_held = f"first at t = {t:.2f} s: {controller.rejection}"
+                held += 1
             speed = math.hypot(vx, vy)
             speed_ref = float(path.speed(foot.s_m))
             # The reference changes at d(v_ref)/dt = dv_ref/ds * ds/dt, fed forward so braking for a corner is
@@ -250,6 +284,10 @@ class Simulation:
                 break
             bar.update(round(foot.progress_m) - bar.n)
         bar.close()
+        if held:
+            message += (
+                f"; the controller rejected {held} measurements as implausible and held its command ({first_held})"
+            )
         return SimulationResult(
             trace=log.to_dict(),
             status=status,
@@ -260,6 +298,16 @@ class Simulation:
             vehicle=vehicle.name,
             config=cfg,
         )
+
+
+def _duration_text(seconds: float) -> str:
+    if seconds < 120:
+        return f"{seconds:.0f} s"
+    if seconds < 2 * 3600:
+        return f"{seconds / 60:.0f} min"
+    if seconds < 2 * 86400:
+        return f"{seconds / 3600:.0f} h"
+    return f"{seconds / 86400:,.0f} days"
 
 
 class _TraceLog:

@@ -57,8 +57,7 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from controllers.config_checks import shown
-from workbench.errors import WorkbenchInputError
+from workbench.errors import WorkbenchInputError, value_text
 
 FIT_OK = 0
 FIT_SATURATED = 1
@@ -392,9 +391,9 @@ def _finite(name: str, value: object) -> float:
     try:
         number = float(value)  # type: ignore[arg-type]
     except (TypeError, ValueError):
-        raise WorkbenchInputError(f"{name} must be a finite number; got {shown(value)}") from None
+        raise WorkbenchInputError(f"{name} must be a finite number; got {value_text(value)}") from None
     if isinstance(value, bool) or not math.isfinite(number):
-        raise WorkbenchInputError(f"{name} must be a finite number; got {shown(value)}")
+        raise WorkbenchInputError(f"{name} must be a finite number; got {value_text(value)}")
     return number
 
 
@@ -408,7 +407,7 @@ def fit_hyper_clothoid(
     rate = _finite("max_curvature_rate_1pm2", max_curvature_rate_1pm2)
     if rate <= 0.0:
         raise WorkbenchInputError(
-            f"max_curvature_rate_1pm2 must be a finite number > 0; got {shown(max_curvature_rate_1pm2)}"
+            f"max_curvature_rate_1pm2 must be a finite number > 0; got {value_text(max_curvature_rate_1pm2)}"
         )
     kdot, length, ex, ey, status = fit_kernel(*values, rate)
     return ClothoidFit(float(kdot), float(length), float(ex), float(ey), int(status))
@@ -421,9 +420,9 @@ def clothoid_points(
     args = {"x0": x0, "y0": y0, "theta0": theta0, "kappa0": kappa0, "kdot": kdot, "length": length}
     values = [_finite(name, value) for name, value in args.items()]
     if values[-1] < 0.0:
-        raise WorkbenchInputError(f"length must be >= 0 m; got {shown(length)}")
+        raise WorkbenchInputError(f"length must be >= 0 m; got {value_text(length)}")
     if isinstance(n, bool) or not isinstance(n, int | np.integer) or n < 1:
-        raise WorkbenchInputError(f"n must be an integer >= 1; got {shown(n)}")
+        raise WorkbenchInputError(f"n must be an integer >= 1; got {value_text(n)}")
     x = np.empty(int(n))
     y = np.empty(int(n))
     sample_kernel(*values, int(n), x, y)

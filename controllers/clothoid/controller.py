@@ -65,15 +65,8 @@ from controllers.clothoid.loop_analysis import LoopSettings, PlantLags, lookahea
 from controllers.clothoid.path_feedforward import FeedforwardTiming, two_degree_of_freedom_rate
 from controllers.clothoid.pose_prediction import along_arc
 from controllers.clothoid.vehicle_tuning import VehicleTuning, tuning_for
-from controllers.config_checks import (
-    check_bool,
-    check_choice,
-    check_number,
-    check_optional_number,
-    check_optional_path,
-    shown,
-)
-from workbench.errors import WorkbenchInputError
+from controllers.config_checks import check_bool, check_choice, check_number, check_optional_number, check_optional_path
+from workbench.errors import WorkbenchInputError, value_text
 from workbench.path import PathTracker, ReferencePath
 from workbench.vehicles.base import VehicleGeometry, VehicleModel
 
@@ -197,8 +190,8 @@ class ClothoidConfig:
         check_optional_path("limits_file", self.limits_file)
         if self.max_lookahead_m < self.min_lookahead_m:
             raise WorkbenchInputError(
-                f"max_lookahead_m must be >= min_lookahead_m = {shown(self.min_lookahead_m)} m; "
-                f"got {shown(self.max_lookahead_m)}"
+                f"max_lookahead_m must be >= min_lookahead_m = {value_text(self.min_lookahead_m)} m; "
+                f"got {value_text(self.max_lookahead_m)}"
             )
         steps = (self.max_lookahead_m - self.min_lookahead_m) / self.lookahead_step_m
         if steps > 1000:
@@ -209,7 +202,7 @@ class ClothoidConfig:
         if self.max_lookahead_m / self.frechet_point_spacing_m >= MAX_CURVE_POINTS:
             raise WorkbenchInputError(
                 f"frechet_point_spacing_m must be > max_lookahead_m / {MAX_CURVE_POINTS} = "
-                f"{self.max_lookahead_m / MAX_CURVE_POINTS:g} m; got {shown(self.frechet_point_spacing_m)}"
+                f"{self.max_lookahead_m / MAX_CURVE_POINTS:g} m; got {value_text(self.frechet_point_spacing_m)}"
             )
 
 

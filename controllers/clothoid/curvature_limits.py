@@ -24,8 +24,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from controllers.config_checks import shown
-from workbench.errors import WorkbenchInputError, require_positive
+from workbench.errors import WorkbenchInputError, require_positive, value_text
+from workbench.input_files import check_input_file
 from workbench.vehicles.base import VehicleGeometry
 
 REQUIRED_COLUMNS = ("speed_kmh", "max_curvature_1pm")
@@ -60,10 +60,10 @@ class CurvatureLimits:
             for i, value in enumerate(values):
                 if not (math.isfinite(value) and (value > 0 or (name == "speed_kmh" and value == 0))):
                     raise WorkbenchInputError(
-                        f"{self.source}: {name} must be finite and > 0; row {i} has {shown(value)}"
+                        f"{self.source}: {name} must be finite and > 0; row {i} has {value_text(value)}"
                     )
         if any(b <= a for a, b in itertools.pairwise(self.speeds_kmh)):
-            speeds = ", ".join(shown(v) for v in self.speeds_kmh)
+            speeds = ", ".join(value_text(v) for v in self.speeds_kmh)
             raise WorkbenchInputError(f"{self.source}: speed_kmh must increase strictly; got [{speeds}]")
 
     def at_speed(self, speed_mps: float) -> tuple[float, float]:
@@ -98,12 +98,10 @@ class CurvatureLimits:
     @classmethod
     def read_csv(cls, path: str | Path, geometry: VehicleGeometry | None = None) -> CurvatureLimits:
         """Read a limits table; without a rate column, the rate comes from `default_for(geometry)`."""
-        path = Path(path)
-        if not path.is_file():
-            raise WorkbenchInputError(f"curvature limits file {str(path)!r} does not exist")
+        path = check_input_file(path, f"curvature limits file {str(path)!r}")
         try:
             table = pd.read_csv(path, comment="#")
-        except (ValueError, UnicodeDecodeError) as exc:
+        except (OSError, ValueError, UnicodeDecodeError) as exc:
             raise WorkbenchInputError(f"{path.name}: not a readable CSV file ({exc})") from None
         table.columns = [str(c).strip().lower() for c in table.columns]
         missing = [c for c in REQUIRED_COLUMNS if c not in table.columns]
@@ -116,7 +114,8 @@ class CurvatureLimits:
         if numeric.isna().to_numpy().any():
             row, col = np.argwhere(numeric.isna().to_numpy())[0]
             raise WorkbenchInputError(
-                f"{path.name}: row {row + 1} column {table.columns[col]} is {shown(table.iat[row, col])}, not a number"
+                f"{path.name}: row {row + 1} column {table.columns[col]} is {value_text(table.iat[row, col])}, "
+                "not a number"
             )
         if RATE_COLUMN in numeric.columns:
             rates = numeric[RATE_COLUMN].tolist()

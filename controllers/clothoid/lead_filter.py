@@ -26,8 +26,7 @@ import control
 import numpy as np
 from scipy import optimize, signal
 
-from controllers.config_checks import shown
-from workbench.errors import WorkbenchInputError, require_in_range, require_positive
+from workbench.errors import WorkbenchInputError, require_in_range, require_positive, value_text
 
 #: Sane ranges of the corner frequencies (rad/s) and of the zero damping psi (exclusive of 0).
 OMEGA_RANGE_RAD_S = (0.01, 1000.0)
@@ -40,7 +39,7 @@ POLE_RATIO_RANGE = (1.0, 100.0)
 def _require_psi(name: str, value: float) -> None:
     """Damping of a complex pair: a finite number in (0, PSI_MAX]."""
     if isinstance(value, bool) or not isinstance(value, int | float) or not 0 < value <= PSI_MAX:
-        raise WorkbenchInputError(f"{name} must be a finite number in (0, {PSI_MAX}]; got {shown(value)}")
+        raise WorkbenchInputError(f"{name} must be a finite number in (0, {PSI_MAX}]; got {value_text(value)}")
 
 
 @dataclass(frozen=True)
@@ -61,7 +60,7 @@ class LeadFilterParams:
         if not low * (1 - 1e-12) <= ratio <= high * (1 + 1e-12):  # slack for interpolated schedules
             raise WorkbenchInputError(
                 f"omega_p_rad_s / omega_z_rad_s must be in [{low}, {high}] (poles at or above the zeros, "
-                f"at most 72 dB of peak gain); got {shown(self.omega_p_rad_s)} / {shown(self.omega_z_rad_s)} "
+                f"at most 72 dB of peak gain); got {value_text(self.omega_p_rad_s)} / {value_text(self.omega_z_rad_s)} "
                 f"= {ratio:.6g}"
             )
         for name in ("omega_z_rad_s", "psi", "omega_p_rad_s"):  # JSON/TOML integers become floats
@@ -158,7 +157,7 @@ class DiscreteLeadFilter:
             ):
                 raise WorkbenchInputError(
                     f"prewarp_rad_s must be in [0, {nyquist:.6g}) rad/s (below the Nyquist frequency pi / dt_s); "
-                    f"got {shown(prewarp_rad_s)}"
+                    f"got {value_text(prewarp_rad_s)}"
                 )
             if prewarp_rad_s > 0:
                 step = 2.0 * math.tan(prewarp_rad_s * self.dt_s / 2.0) / prewarp_rad_s
@@ -174,7 +173,7 @@ class DiscreteLeadFilter:
         self.poles: np.ndarray = np.linalg.eigvals(a)
         if not (np.all(np.isfinite(a)) and np.all(np.abs(self.poles) < 1.0)):
             raise WorkbenchInputError(
-                f"the lead filter discretised at dt_s = {shown(dt_s)} s is unstable: pole magnitudes "
+                f"the lead filter discretised at dt_s = {value_text(dt_s)} s is unstable: pole magnitudes "
                 f"{np.abs(self.poles).round(9).tolist()} (all must be < 1)"
             )
         # Steady state x = (u, u, u) and DC gain 1 mean each row of [A B] and [C D] sums to 1, and A is lower
@@ -183,7 +182,7 @@ class DiscreteLeadFilter:
         sums = np.append(a.sum(axis=1) + b[:, 0], c.sum() + d.sum())
         if a[0, 1] != 0 or a[0, 2] != 0 or a[1, 2] != 0 or np.abs(sums - 1.0).max() > 1e-9:
             raise WorkbenchInputError(
-                f"the lead filter cannot be discretised accurately at dt_s = {shown(dt_s)} s: A = {a.tolist()}, "
+                f"the lead filter cannot be discretised accurately at dt_s = {value_text(dt_s)} s: A = {a.tolist()}, "
                 f"row sums of [A B] and [C D] {sums.tolist()} (must be 1)"
             )
         self._coeffs = tuple(float(v) for v in (*rows[0], *rows[1], *rows[2], c[0, 0], c[0, 1], d[0, 0]))

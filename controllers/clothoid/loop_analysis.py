@@ -38,8 +38,7 @@ from scipy import signal
 
 from controllers.clothoid.clothoid_fit import fit_kernel
 from controllers.clothoid.lead_filter import DiscreteLeadFilter, LeadFilterParams
-from controllers.config_checks import shown
-from workbench.errors import WorkbenchInputError, require_in_range, require_positive
+from workbench.errors import WorkbenchInputError, require_in_range, require_positive, value_text
 from workbench.vehicles.steering_lag import SteeringLag
 
 #: Design requirement the controller keeps at every lookahead it may pick (issue 15): phase margin (deg), and gain
@@ -129,8 +128,8 @@ def clothoid_law_gains(lookahead_m: float, path_curvature_1pm: float = 0.0) -> t
     kr = float(path_curvature_1pm)
     if abs(kr) * lookahead_m >= 1.9:
         raise WorkbenchInputError(
-            f"lookahead_m x |path_curvature_1pm| must be < 1.9 (a target on the arc ahead); got {shown(lookahead_m)} x "
-            f"{shown(kr)}"
+            "lookahead_m x |path_curvature_1pm| must be < 1.9 (a target on the arc ahead); got "
+            f"{value_text(lookahead_m)} x {value_text(kr)}"
         )
 
     def kdot(y: float, psi: float, kappa: float) -> float:

@@ -61,8 +61,9 @@ from typing import TYPE_CHECKING, Any
 
 from controllers.clothoid.curvature_limits import CurvatureLimits
 from controllers.clothoid.filter_file import FilterSchedule, read_filter_file
-from controllers.config_checks import shown, shown_all
-from workbench.errors import WorkbenchInputError
+from controllers.config_checks import shown_all
+from workbench.errors import WorkbenchInputError, value_text
+from workbench.input_files import read_json
 from workbench.user_cache import user_cache_dir
 from workbench.vehicles.base import VehicleModel
 from workbench.vehicles.presets import MODEL_TYPES, params_from_toml, preset_text
@@ -150,7 +151,7 @@ class VehicleTuning:
 
 def _check_speed(speed_kmh: float) -> None:
     if isinstance(speed_kmh, bool) or not isinstance(speed_kmh, int | float) or not math.isfinite(speed_kmh):
-        raise WorkbenchInputError(f"speed_kmh must be a finite number; got {shown(speed_kmh)}")
+        raise WorkbenchInputError(f"speed_kmh must be a finite number; got {value_text(speed_kmh)}")
 
 
 def _checked_lags(name: str, value: object) -> tuple[tuple[float, SteeringLag], ...]:
@@ -159,7 +160,7 @@ def _checked_lags(name: str, value: object) -> tuple[tuple[float, SteeringLag], 
     for i, (speed, lag) in enumerate(lags):
         if not (math.isfinite(speed) and speed >= 0.0) or not isinstance(lag, SteeringLag):
             raise WorkbenchInputError(
-                f"{name}[{i}] must be (speed_kmh >= 0, SteeringLag); got ({shown(speed)}, {type(lag).__name__})"
+                f"{name}[{i}] must be (speed_kmh >= 0, SteeringLag); got ({value_text(speed)}, {type(lag).__name__})"
             )
     speeds = [speed for speed, _ in lags]
     if any(b <= a for a, b in itertools.pairwise(speeds)):
@@ -306,12 +307,7 @@ def _default_options() -> PresetTuningOptions:
 def read_manifest(directory: str | Path) -> dict[str, Any]:
     """The manifest.json of a tuning directory, its keys checked."""
     path = Path(directory) / MANIFEST_FILE
-    try:
-        doc = json.loads(path.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise WorkbenchInputError(f"tuning manifest {str(path)!r} does not exist") from None
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
-        raise WorkbenchInputError(f"tuning manifest {str(path)!r} cannot be read: {exc}") from None
+    doc = read_json(path, f"tuning manifest {str(path)!r}")
     if not isinstance(doc, dict) or doc.get("format") != MANIFEST_FORMAT:
         raise WorkbenchInputError(f"tuning manifest {str(path)!r}: format must be {MANIFEST_FORMAT!r}")
     missing = [k for k in MANIFEST_KEYS if k not in doc]
@@ -339,7 +335,9 @@ def _lags(
             raise WorkbenchInputError(f"{path}: design.per_speed[{i}] must hold {list(LAG_KEYS)}; got {row!r}")
         speed = row["speed_kmh"]
         if isinstance(speed, bool) or not isinstance(speed, int | float):
-            raise WorkbenchInputError(f"{path}: design.per_speed[{i}].speed_kmh must be a number; got {shown(speed)}")
+            raise WorkbenchInputError(
+                f"{path}: design.per_speed[{i}].speed_kmh must be a number; got {value_text(speed)}"
+            )
         lags.append((float(speed), _row_lag(path, i, row, "", speed)))
         if any(k in row for k in MEASURED_LAG_KEYS):
             if any(k not in row for k in MEASURED_LAG_KEYS):

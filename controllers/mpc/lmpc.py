@@ -26,13 +26,13 @@ from typing import Any, ClassVar
 import casadi as ca
 import numpy as np
 
-from controllers.config_checks import check_number, check_whole, shown
+from controllers.config_checks import check_number, check_whole
 from controllers.mpc.codegen import FastFunction, compile_function
 from controllers.mpc.common import MPCConfig, MPCController
 from controllers.mpc.ocp import TrackingOCP
 from controllers.mpc.sparse_qp import OsqpSettings
 from controllers.mpc.status import SolveResult
-from workbench.errors import WorkbenchInputError
+from workbench.errors import WorkbenchInputError, value_text
 from workbench.vehicles.base import VehicleGeometry
 
 
@@ -111,7 +111,7 @@ class LMPCConfig(MPCConfig):
         if self.max_lat_accel_mps2 != 0.0:
             raise WorkbenchInputError(
                 f"max_lat_accel_mps2 must be 0 for the LTV-MPC (it has no lateral-acceleration limit; the NMPC has); "
-                f"got {shown(self.max_lat_accel_mps2)}"
+                f"got {value_text(self.max_lat_accel_mps2)}"
             )
         check_number("qp_tolerance", self.qp_tolerance, 1e-10, 1e-1)
         check_whole("qp_max_iterations", self.qp_max_iterations, 1, 10**6)

@@ -156,3 +156,21 @@ def test_a_bad_sample_time_is_refused_for_every_controller() -> None:
 
     with pytest.raises(WorkbenchInputError, match="sample_time_s"):
         _Scripted(GEOMETRY).reset(PATH, 0.0)
+
+
+def test_a_clock_that_stays_behind_restarts_the_controller_instead_of_locking_it_out() -> None:
+    """One frame stamped far ahead, then the clock as it was: the next CLOCK_RESET_FRAMES - 1 frames are rejected
+    as earlier than the last accepted one; the one after is a new time base, and the controller restarts on it."""
+    controller = _controller()
+    controller.step(GOOD, PATH)
+    controller.next_command = 0.2
+    assert controller.step(dataclasses.replace(GOOD, t_s=1e9), PATH) == 0.2  # a glitch, but plausible on its own
+    controller.next_command = 0.3
+    for k in range(1, base.CLOCK_RESET_FRAMES):
+        assert controller.step(dataclasses.replace(GOOD, t_s=1.0 + 0.02 * k), PATH) == 0.2
+        assert controller.diagnostics["measurement_rejected"] == 1.0 and "earlier than" in controller.rejection
+    restart = dataclasses.replace(GOOD, t_s=1.0 + 0.02 * base.CLOCK_RESET_FRAMES)
+    assert controller.step(restart, PATH) == 0.1  # the restarted controller's first command (its _reset's)
+    assert controller.seen == [restart] and controller.diagnostics["measurement_rejected"] == 0.0
+    later = dataclasses.replace(GOOD, t_s=restart.t_s + 0.02)
+    assert controller.step(later, PATH) == 0.1 and controller.seen == [restart, later]

@@ -12,10 +12,9 @@ import pytest
 
 from controllers import CONTROLLERS, make_controller
 from controllers.base import Measurement
-from controllers.config_checks import shown
 from controllers.mpc import MPCConfig
 from workbench.clothoid_chain import ClothoidChain
-from workbench.errors import WorkbenchInputError
+from workbench.errors import WorkbenchInputError, value_text
 from workbench.vehicles import KinematicBicycle
 
 CONFIGS = {cls.config_type.__name__: (name, cls.config_type) for name, cls in CONTROLLERS.items()}
@@ -40,7 +39,7 @@ def test_every_option_refuses_a_bad_value_by_name(config_name: str, field: str, 
     except WorkbenchInputError as exc:
         message = str(exc)
         assert field in message, message
-        assert shown(value) in message, message
+        assert value_text(value) in message, message
         assert "np.float64" not in message
         return
     if controller_name is None:  # the MPCs' shared base: its own fields are checked through NMPC/LMPC too
@@ -65,10 +64,10 @@ def test_every_config_is_covered() -> None:
 def test_numbers_are_shown_as_numbers() -> None:
     import numpy as np
 
-    assert shown(np.float64("nan")) == "nan"
-    assert shown(np.float64(1e308)) == "1e+308"
-    assert shown(np.int64(3)) == "3"
-    assert shown(True) == "True"
-    assert shown("x") == "'x'"
+    assert value_text(np.float64("nan")) == "nan"
+    assert value_text(np.float64(1e308)) == "1e+308"
+    assert value_text(np.int64(3)) == "3"
+    assert value_text(True) == "True"
+    assert value_text("x") == "'x'"
     with pytest.raises(WorkbenchInputError, match=r"frechet_threshold_m must be .*; got nan$"):
         CONTROLLERS["clothoid"].config_type(frechet_threshold_m=np.float64("nan"))

@@ -361,7 +361,7 @@ def test_a_very_long_run_is_announced_before_it_starts(tmp_path: Path, capsys, m
 
 
 def test_compare_announces_a_long_run(tmp_path: Path, capsys, monkeypatch) -> None:
-    monkeypatch.setattr("workbench.comparison.LONG_RUN_STEPS", 1000)  # a dlc at 30 km/h may take ~5 700 steps
+    monkeypatch.setattr("workbench.simulator.LONG_RUN_STEPS", 1000)  # a dlc at 30 km/h may take ~5 700 steps
     args = COMMANDS_WITH_OUT["compare"]
     assert main([*args, "--out", str(tmp_path / "cmp")]) == 0
     err = capsys.readouterr().err

@@ -149,20 +149,22 @@ class _Failing(Controller):
         super().__init__(geometry, {})
         self.mode, self.after = mode, after
 
-    def reset(self, path: ReferencePath, sample_time_s: float) -> None:
+    def _reset(self, path: ReferencePath, sample_time_s: float) -> None:
         self.n = 0
 
-    def step(self, measurement: Measurement, path: ReferencePath) -> float:
+    def _command(self, measurement: Measurement, path: ReferencePath) -> float:
         self.n += 1
         if self.n > self.after:
             if self.mode == "nan":
                 return float("nan")
+            if self.mode == "full-lock":
+                return self.geometry.max_steer_wheel_angle_rad
             raise RuntimeError("solver exploded")
         return 0.0
 
 
 @pytest.mark.parametrize(
-    ("mode", "needle"), [("nan", "non-finite steering"), ("raise", "RuntimeError: solver exploded")]
+    ("mode", "needle"), [("nan", "computed a non-finite steering command"), ("raise", "RuntimeError: solver exploded")]
 )
 def test_controller_failure_is_reported_and_the_partial_trace_kept(mode: str, needle: str) -> None:
     vehicle = KinematicBicycle()
@@ -190,6 +192,33 @@ def test_diverging_plant_stops_with_a_clear_message_and_keeps_the_trace() -> Non
     assert "yaw_rad" in result.message
     assert result.trace["x_m"][-1] == pytest.approx(30.0, abs=0.2)
     assert np.all(np.isfinite(result.to_pandas().drop(columns=["ctrl_lookahead_m"]).to_numpy()))
+
+
+def test_going_past_the_start_of_an_open_path_is_leaving_it() -> None:
+    """A vehicle circling at full lock from the start passes behind it: before, the CTE was measured sideways from
+    the start's tangent only and the run went on to its time-out, reported on the path."""
+    vehicle = KinematicBicycle()
+    scenario = _scenario(ClothoidChain().straight(100.0).to_path("straight"), heading_error=math.radians(80))
+    controller = _Failing(vehicle.geometry, "full-lock", after=0)
+    result = Simulation(scenario, vehicle, controller, SimulationConfig(max_past_end_m=1.0)).run()
+    assert result.status is Status.LEFT_PATH
+    assert re.search(r"went 1\.\d m past the start of the path \(max_past_end_m = 1 m\)", result.message)
+    assert result.metrics.max_abs_cte_m > 1.0  # the distance from the path counts beyond its start
+    assert result.metrics.to_dict()["completed"] is False
+
+
+def test_a_measurement_the_controller_rejects_is_counted_in_the_message() -> None:
+    class _Spinning(KinematicBicycle):
+        def outputs(self, state, steer, accel):
+            out = np.array(super().outputs(state, steer, accel))
+            out[5] = 50.0  # yaw rate, rad/s: far beyond the plausible envelope
+            return out
+
+    vehicle = _Spinning()
+    scenario = _scenario(ClothoidChain().straight(30.0).to_path("straight"))
+    result = Simulation(scenario, vehicle, PurePursuit(vehicle.geometry)).run()
+    assert "measurements as implausible and held its command" in result.message and "yaw_rate" in result.message
+    assert result.trace["ctrl_measurement_rejected"].min() == 1.0
 
 
 def test_leaving_the_path_stops_the_run() -> None:
@@ -229,3 +258,17 @@ def test_a_path_tighter_than_the_vehicle_turns_is_named_before_the_run() -> None
     assert "hairpin curves tighter than the kinematic-bicycle can turn" in warning
     assert re.search(r"at s = 21\.[34]-27\.[67] m \(peak 1\.05 1/m\)", warning), warning
     assert Simulation(_scenario(_circle()), vehicle, PurePursuit(vehicle.geometry)).path_warnings() == []
+
+
+@pytest.mark.parametrize("first_only", [True, False])
+def test_a_path_speed_of_zero_is_refused_before_the_run(first_only: bool) -> None:
+    """All speeds 0 divided by zero; a first speed of 0 left every controller standing until the time-out."""
+    path = ClothoidChain().straight(50.0).to_path("straight")
+    speed = np.full(path.s_m.size, 5.0)
+    if first_only:
+        speed[0] = 0.0
+    else:
+        speed[:] = 0.0
+    vehicle = KinematicBicycle()
+    with pytest.raises(WorkbenchInputError, match=r"straight: the path's speed must be > 0 m/s .* 0 m/s at s = 0\.0 m"):
+        Simulation(_scenario(path.with_speed(speed)), vehicle, PurePursuit(vehicle.geometry))
