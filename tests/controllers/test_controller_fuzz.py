@@ -20,10 +20,10 @@ import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from test_controller_contract import PATH as CONTRACT_PATH
 
 from controllers import CONTROLLERS, make_controller
 from controllers.base import MAX_SPEED_MPS, STEER_SENSOR_MARGIN, Measurement
-from workbench.clothoid_chain import ClothoidChain
 from workbench.errors import WorkbenchInputError
 from workbench.path import ReferencePath
 from workbench.scenarios import make_scenario
@@ -43,16 +43,7 @@ def _closed_path() -> ReferencePath:
 
 
 #: The contract test's path (open) and the figure8 loop (closed).
-OPEN_PATH = (
-    ClothoidChain()
-    .straight(30.0)
-    .clothoid_to(1 / 25, 15.0)
-    .arc(30.0)
-    .clothoid_to(0.0, 15.0)
-    .straight(30.0)
-    .to_path("p")
-)
-PATHS = {"open": OPEN_PATH, "closed": _closed_path()}
+PATHS = {"open": CONTRACT_PATH, "closed": _closed_path()}
 EXAMPLES = STEPS_PER_CONTROLLER // (SEQUENCE_LENGTH * len(PATHS))
 #: Segment kinds, repeated to weight them: plausible ("track", "extreme") about a quarter of the steps.
 KINDS = ("track", "track", "extreme", "corrupt", "corrupt", "corrupt", "backwards", "noise", "noise")
