@@ -19,6 +19,8 @@ class WorkbenchInputError(ValueError):
 
 def is_number(value: object) -> bool:
     """A real number, Python's or numpy's, but not a boolean."""
+    if type(value) is float or type(value) is int:  # the common case, without the ABC check (these run per step)
+        return True
     return isinstance(value, numbers.Real) and not isinstance(value, bool | np.bool_)
 
 
@@ -51,8 +53,9 @@ def require_positive(name: str, value: float) -> None:
 
 def require_in_range(name: str, value: float, low: float, high: float, unit: str = "") -> None:
     """Raise WorkbenchInputError unless low <= value <= high (and finite)."""
+    if is_number(value) and math.isfinite(value) and low <= value <= high:
+        return  # the message is built only for a value refused (parameters are checked on every controller step)
     bounds = f"[{value_text(low)}, {value_text(high)}] {unit}"
     if not is_number(value) or not math.isfinite(value):
         raise WorkbenchInputError(f"{name} must be a finite number in {bounds}; got {value_text(value)}")
-    if not low <= value <= high:
-        raise WorkbenchInputError(f"{name} must be in {bounds}; got {value_text(value)}".replace("  ", " "))
+    raise WorkbenchInputError(f"{name} must be in {bounds}; got {value_text(value)}".replace("  ", " "))
