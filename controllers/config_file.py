@@ -18,63 +18,13 @@ float, int, bool, str, Path or `Path | None` (written "none" to clear).
 from __future__ import annotations
 
 import dataclasses
-import types
-import typing
 from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import Any
 
 from workbench.errors import WorkbenchInputError, value_text
 from workbench.input_files import read_toml
-
-_TRUE = ("true", "yes", "on", "1")
-_FALSE = ("false", "no", "off", "0")
-
-
-def _field_types(config_type: type) -> dict[str, Any]:
-    hints = typing.get_type_hints(config_type)
-    return {f.name: hints[f.name] for f in dataclasses.fields(config_type) if f.init}
-
-
-def _coerce(name: str, value: Any, annotation: Any, base_dir: Path | None) -> Any:
-    """`value` (from TOML, or a string from the command line) as the type `annotation` of field `name`."""
-    optional = False
-    if isinstance(annotation, types.UnionType) or typing.get_origin(annotation) is typing.Union:
-        members = [a for a in typing.get_args(annotation) if a is not type(None)]
-        optional = len(members) < len(typing.get_args(annotation))
-        annotation = members[0] if len(members) == 1 else annotation
-    if optional and (value is None or (isinstance(value, str) and value.lower() in ("none", ""))):
-        return None
-    text = value if isinstance(value, str) else None
-    try:
-        if annotation is bool:
-            if isinstance(value, bool):
-                return value
-            if text is not None and text.lower() in _TRUE + _FALSE:
-                return text.lower() in _TRUE
-        elif annotation is int:
-            if isinstance(value, int) and not isinstance(value, bool):
-                return value
-            if text is not None:
-                return int(text)
-        elif annotation is float:
-            if isinstance(value, int | float) and not isinstance(value, bool):
-                return float(value)
-            if text is not None:
-                return float(text)
-        elif annotation is str:
-            if text is not None:
-                return text
-        elif annotation is Path:
-            if text is not None:
-                path = Path(text).expanduser()
-                return path if path.is_absolute() or base_dir is None else base_dir / path
-        else:
-            raise WorkbenchInputError(f"option {name!r} has type {annotation!r}, which cannot be set from a file")
-    except ValueError:
-        pass
-    kind = getattr(annotation, "__name__", str(annotation)) + (" or none" if optional else "")
-    raise WorkbenchInputError(f"option {name!r} must be a {kind}; got {value_text(value)}")
+from workbench.typed_tables import field_types, typed_value
 
 
 def build_config(
@@ -84,7 +34,7 @@ def build_config(
     base_dir: Path | None = None,
 ) -> Any:
     """An instance of `config_type` from `values` (a TOML table) and `key=value` overrides; its defaults otherwise."""
-    fields = _field_types(config_type)
+    fields = field_types(config_type)
     merged: dict[str, Any] = {}
     items = list((values or {}).items())
     for override in overrides:
@@ -97,7 +47,7 @@ def build_config(
             raise WorkbenchInputError(
                 f"unknown option {key!r} for {config_type.__name__}; allowed: {', '.join(fields)}"
             )
-        merged[key] = _coerce(key, value, fields[key], base_dir)
+        merged[key] = typed_value(f"option {key!r}", value, fields[key], base_dir, from_text=True)
     return config_type(**merged)
 
 

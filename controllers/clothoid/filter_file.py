@@ -29,6 +29,7 @@ from typing import Any
 from controllers.clothoid.lead_filter import LeadFilterParams
 from workbench.errors import WorkbenchInputError, require_in_range
 from workbench.input_files import read_json, read_toml
+from workbench.typed_tables import check_keys
 
 FORMAT_TAG = "lead-filter/1"
 PARAM_KEYS = ("omega_z_rad_s", "psi", "omega_p_rad_s")
@@ -107,15 +108,7 @@ def _suffix(path: Path) -> str:
 
 
 def _check_keys(path: Path, where: str, table: object, required: tuple[str, ...], optional: tuple[str, ...]) -> dict:
-    if not isinstance(table, Mapping):
-        raise _fail(path, f"{where} must be a table/object; got {type(table).__name__}")
-    allowed = (*required, *optional)
-    missing = [k for k in required if k not in table]
-    unknown = [k for k in table if k not in allowed]
-    if missing or unknown:
-        problems = ([f"missing keys {missing}"] if missing else []) + ([f"unknown keys {unknown}"] if unknown else [])
-        raise _fail(path, f"{where}: {'; '.join(problems)}; allowed keys: {list(allowed)}")
-    return dict(table)
+    return check_keys(f"lead filter file {path}: {where}", table, (*required, *optional), required)
 
 
 def _number(path: Path, name: str, value: object) -> float:

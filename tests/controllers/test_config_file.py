@@ -34,8 +34,8 @@ def test_file_then_overrides_with_types_and_relative_paths(tmp_path: Path) -> No
     [
         (["frechet_threshold=0.3"], "unknown option 'frechet_threshold' for ClothoidConfig; allowed: lookahead_mode"),
         (["frechet_threshold_m"], "must look like key=value"),
-        (["frechet_threshold_m=abc"], "option 'frechet_threshold_m' must be a float; got 'abc'"),
-        (["use_lead_filter=maybe"], "option 'use_lead_filter' must be a bool"),
+        (["frechet_threshold_m=abc"], "option 'frechet_threshold_m' must be a number; got 'abc'"),
+        (["use_lead_filter=maybe"], "option 'use_lead_filter' must be a boolean"),
         (["frechet_threshold_m=-1"], "frechet_threshold_m must be"),
     ],
 )

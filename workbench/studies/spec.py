@@ -54,7 +54,6 @@ import itertools
 import json
 import math
 import os
-import types
 import typing
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
@@ -69,6 +68,7 @@ from workbench.metrics import METRIC_KEYS
 from workbench.scenarios import SCENARIOS, ZANDVOORT_ENV, ZANDVOORT_SOURCE, ScenarioOptions
 from workbench.simulator import SimulationConfig
 from workbench.studies.distributions import SEARCHABLE, Distribution, key_rng
+from workbench.typed_tables import type_name, typed_value, unwrap
 from workbench.vehicles import VEHICLES
 
 #: The run parameters besides SimulationConfig's fields, with their types.
@@ -124,45 +124,8 @@ def controller_parameters(controller: str) -> dict[str, Any]:
     return params
 
 
-def _type_name(annotation: Any) -> str:
-    base, optional = _unwrap(annotation)
-    name = {float: "number", int: "whole number", bool: "boolean", str: "text", Path: "file path"}.get(base, str(base))
-    return name + (' or "none"' if optional else "")
-
-
-def _unwrap(annotation: Any) -> tuple[Any, bool]:
-    """(the type, whether None is allowed) of `T` or `T | None`."""
-    if isinstance(annotation, types.UnionType) or typing.get_origin(annotation) is typing.Union:
-        members = [a for a in typing.get_args(annotation) if a is not type(None)]
-        return members[0], len(members) < len(typing.get_args(annotation))
-    return annotation, False
-
-
-def typed_value(where: str, value: Any, annotation: Any, base_dir: Path) -> Any:
-    """A spec value as the parameter's type, strictly: a number for a float (an integer is taken as a float), a
-    whole number for an int, a boolean for a bool, text for a str, a path (relative to base_dir) for a Path, and
-    "none" for an optional parameter's None. WorkbenchInputError naming `where` otherwise."""
-    base, optional = _unwrap(annotation)
-    if optional and (value is None or (isinstance(value, str) and value.lower() == "none")):
-        return None
-    if base is float and isinstance(value, int | float) and not isinstance(value, bool):
-        if not math.isfinite(value):
-            raise WorkbenchInputError(f"{where} must be a finite number; got {value_text(value)}")
-        return float(value)
-    if base is int and isinstance(value, int) and not isinstance(value, bool):
-        return value
-    if base is bool and isinstance(value, bool):
-        return value
-    if base is str and isinstance(value, str):
-        return value
-    if base is Path and isinstance(value, str | Path) and str(value):
-        path = Path(value).expanduser()
-        return path if path.is_absolute() else base_dir / path
-    raise WorkbenchInputError(f"{where} must be a {_type_name(annotation)}; got {value_text(value)}")
-
-
 def _check_distribution(where: str, dist: Distribution, annotation: Any, base_dir: Path) -> Distribution:
-    base, _ = _unwrap(annotation)
+    base, _ = unwrap(annotation)
     if dist.produces == "choice":
         return Distribution(
             "choice", tuple(typed_value(f"{where} choice", v, annotation, base_dir) for v in dist.values)
@@ -171,7 +134,7 @@ def _check_distribution(where: str, dist: Distribution, annotation: Any, base_di
         return dist
     raise WorkbenchInputError(
         f"{where}: {dist.kind} draws {'whole numbers' if dist.produces == 'int' else 'numbers'}, but the parameter "
-        f"is a {_type_name(annotation)}"
+        f"is a {type_name(annotation)}"
         + ("; use integers = [low, high]" if base is int else "; use choice = [...]" if base is not float else "")
     )
 
@@ -550,7 +513,7 @@ class StudySpec:
         checked: set[Path] = set()
         for controller in self.controllers:
             params = controller_parameters(controller)
-            file_options = [k for k, t in params.items() if _unwrap(t)[0] is Path]
+            file_options = [k for k, t in params.items() if unwrap(t)[0] is Path]
             config = read_controller_config(self.controller_config, controller, CONTROLLERS[controller].config_type)
             named = [(f"{controller}.{k} in study.controller_config", k, getattr(config, k)) for k in file_options]
             for where, table in (("grid", self.controller_grid), ("random", self.controller_random)):
@@ -794,5 +757,4 @@ __all__ = [
     "StudySpec",
     "controller_parameters",
     "load_spec",
-    "typed_value",
 ]

@@ -22,6 +22,7 @@ from typing import Any
 
 from workbench.errors import WorkbenchInputError, value_text
 from workbench.input_files import parse_toml, read_text
+from workbench.typed_tables import check_keys, dataclass_from_table
 from workbench.vehicles.base import VehicleModel
 from workbench.vehicles.commonroad_mb import CommonRoadMB, CommonRoadMBParams
 from workbench.vehicles.dynamic_bicycle import DynamicBicycle, DynamicBicycleParams
@@ -60,45 +61,15 @@ def preset_text(name: str) -> str:
     return _preset_dir().joinpath(f"{name}.toml").read_text(encoding="utf-8")
 
 
-def _check_keys(kind: str, got: dict[str, Any], allowed: tuple[str, ...], source: str, required: bool) -> None:
-    for key in got:
-        if key not in allowed:
-            raise WorkbenchInputError(f"{source}: unknown {kind} key {key!r}; allowed keys: {', '.join(allowed)}")
-    if required:
-        for key in allowed:
-            if key not in got:
-                raise WorkbenchInputError(
-                    f"{source}: missing {kind} key {key!r}; every one of these must be given: {', '.join(allowed)}"
-                )
-
-
-def _coerce(name: str, value: Any, annotation: Any, source: str) -> Any:
-    """TOML integers are accepted for float fields; anything else must already have the field's type."""
-    want = annotation if isinstance(annotation, str) else getattr(annotation, "__name__", str(annotation))
-    if want == "float" and isinstance(value, int | float) and not isinstance(value, bool):
-        return float(value)
-    if want == "int" and isinstance(value, int) and not isinstance(value, bool):
-        return value
-    raise WorkbenchInputError(f"{source}: parameter {name!r} must be a number ({want}); got {value_text(value)}")
-
-
 def params_from_toml(text: str, source: str) -> tuple[str, Any]:
     """Parse preset TOML text into (model type, params instance). `source` names the file in messages."""
-    doc = parse_toml(text, source)
-    _check_keys("top-level", doc, _TOP_KEYS, source, required=True)
-    model, given = doc["model"], doc["parameters"]
-    if not isinstance(model, dict) or not isinstance(given, dict):
-        raise WorkbenchInputError(f"{source}: [model] and [parameters] must be tables")
-    _check_keys("[model]", model, _MODEL_KEYS, source, required=False)
+    doc = check_keys(f"{source}: top level", parse_toml(text, source), _TOP_KEYS, _TOP_KEYS)
+    model = check_keys(f"{source}: [model]", doc["model"], _MODEL_KEYS)
     kind = model.get("type")
     if kind not in MODEL_TYPES:
         raise WorkbenchInputError(f"{source}: [model] type must be one of {', '.join(MODEL_TYPES)}; got {kind!r}")
-    params_cls = MODEL_TYPES[kind][1]
-    fields = {f.name: f for f in dataclasses.fields(params_cls)}
-    _check_keys("[parameters]", given, tuple(fields), source, required=True)
-    values = {name: _coerce(name, value, fields[name].type, source) for name, value in given.items()}
     try:
-        return kind, params_cls(**values)
+        return kind, dataclass_from_table(MODEL_TYPES[kind][1], doc["parameters"], "[parameters]", required=True)
     except WorkbenchInputError as exc:
         raise WorkbenchInputError(f"{source}: {exc}") from None
 

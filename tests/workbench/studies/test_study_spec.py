@@ -222,7 +222,7 @@ ONE = '[study]\nscenarios = ["dlc"]\ncontrollers = ["clothoid"]\nvehicles = ["ki
     ("options", "messages"),
     [
         ("[clothoid]\nfrechet_treshold_m = 0.1\n", ["unknown option 'frechet_treshold_m' for ClothoidConfig"]),
-        ("[clothoid]\nfrechet_threshold_m = nan\n", ["frechet_threshold_m must be", "got nan"]),
+        ("[clothoid]\nfrechet_threshold_m = nan\n", ["'frechet_threshold_m' must be a finite number", "got nan"]),
         (
             "[clothoid]\nfilter_file = 'none.json'\n",
             ["clothoid.filter_file in study.controller_config", "no such file"],
@@ -255,7 +255,7 @@ def test_the_files_the_spec_names_are_read_when_it_loads(tmp_path: Path) -> None
         (ONE + '[grid.clothoid]\nfilter_file = ["deep.json"]\n', "nested deeper than 64 levels", "deep.json"),
         (
             ONE + '[grid.clothoid]\nfilter_file = ["lead.json"]\n',
-            "missing keys ['omega_z_rad_s', 'omega_p",
+            "missing key 'omega_z_rad_s', missing key 'omega_p",
             "lead.json",
         ),
         (ONE.replace('"dlc"', '"zandvoort"') + 'track_file = "path.csv"\n', "study.track_file: ", "path.csv"),
