@@ -12,23 +12,17 @@ WorkbenchInputError, which makes that run an error.
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 
 from controllers.clothoid.filter_file import DEFAULT_FILTER, FilterSchedule, read_filter_file, write_filter_file
 from controllers.clothoid.lead_filter import LeadFilterParams
-from workbench.errors import WorkbenchInputError, value_text
-
-
-def _require_scale(name: str, value: float) -> None:
-    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value) or value <= 0:
-        raise WorkbenchInputError(f"{name} must be a finite number > 0; got {value_text(value)}")
+from workbench.errors import WorkbenchInputError, require_positive, value_text
 
 
 def scale_schedule(schedule: FilterSchedule, zero_scale: float = 1.0, pole_scale: float = 1.0) -> FilterSchedule:
     """The schedule with every filter's omega_z times zero_scale and omega_p times pole_scale."""
-    _require_scale("lead_filter_zero_scale", zero_scale)
-    _require_scale("lead_filter_pole_scale", pole_scale)
+    require_positive("lead_filter_zero_scale", zero_scale)
+    require_positive("lead_filter_pole_scale", pole_scale)
     try:
         params = tuple(
             LeadFilterParams(p.omega_z_rad_s * zero_scale, p.psi, p.omega_p_rad_s * pole_scale) for p in schedule.params

@@ -645,10 +645,9 @@ class StudySpec:
 
 def _has_payload(vehicle: Any) -> bool:
     """Whether a vehicle (a model, or a preset name) carries a payload."""
-    from workbench.vehicles.presets import MODEL_TYPES
+    from workbench.vehicles.presets import carries_payload
 
-    name = vehicle if isinstance(vehicle, str) else vehicle.name
-    return "payload_kg" in MODEL_TYPES[name][1].__dataclass_fields__
+    return carries_payload(vehicle if isinstance(vehicle, str) else vehicle.name)
 
 
 def _vehicle_models(vehicles: Sequence[str]) -> dict[str, Any]:

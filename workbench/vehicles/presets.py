@@ -61,6 +61,11 @@ def preset_text(name: str) -> str:
     return _preset_dir().joinpath(f"{name}.toml").read_text(encoding="utf-8")
 
 
+def carries_payload(model_type: str) -> bool:
+    """Whether vehicles of this model type (a key of MODEL_TYPES) carry a payload (`payload_kg`)."""
+    return "payload_kg" in MODEL_TYPES[model_type][1].__dataclass_fields__
+
+
 def params_from_toml(text: str, source: str) -> tuple[str, Any]:
     """Parse preset TOML text into (model type, params instance). `source` names the file in messages."""
     doc = check_keys(f"{source}: top level", parse_toml(text, source), _TOP_KEYS, _TOP_KEYS)
@@ -90,8 +95,8 @@ def load_vehicle(name_or_file: str, payload_kg: float | None = None) -> VehicleM
         text = read_text(path, f"vehicle file {source}")
     kind, params = params_from_toml(text, source)
     if payload_kg is not None:
-        if "payload_kg" not in {f.name for f in dataclasses.fields(params)}:
-            carriers = [k for k, (_, cls) in MODEL_TYPES.items() if "payload_kg" in cls.__dataclass_fields__]
+        if not carries_payload(kind):
+            carriers = [k for k in MODEL_TYPES if carries_payload(k)]
             raise WorkbenchInputError(f"vehicle {kind!r} has no payload; a payload applies to: {', '.join(carriers)}")
         if isinstance(payload_kg, bool) or not isinstance(payload_kg, int | float):
             raise WorkbenchInputError(f"payload_kg must be a number; got {value_text(payload_kg)}")
