@@ -18,7 +18,6 @@ import numpy as np
 from workbench.clothoid_chain import ClothoidChain
 from workbench.errors import WorkbenchInputError, require_in_range
 from workbench.path import ReferencePath
-from workbench.waypoint_files import read_waypoints
 from workbench.waypoints import Waypoints
 
 #: Environment variable naming the TUMFTM Zandvoort centre-line CSV when --track is not given.
@@ -123,7 +122,8 @@ def figure8(options: ScenarioOptions, radius_m: float = 22.0, transition_m: floa
 # ---------------------------------------------------------------------------------------------- ISO 3888-1
 @dataclass(frozen=True)
 class DoubleLaneChangeLayout:
-    """ISO 3888-1 double lane change for a vehicle of width b (m); see ../shared/reference for sources.
+    """ISO 3888-1 double lane change for a vehicle of width b (m), as Project Chrono's `ISO3888_Helper` and
+    MathWorks' `sm_car_trajectory_double_lane_change_iso3888.m` lay it out.
 
     Lane widths 1.1 b + 0.25, 1.2 b + 0.25 and 1.3 b + 0.25 m; sections 15, 30, 25, 25 and 15 m. The 3.5 m lateral
     offset is taken between the right-hand cone lines of sections 1 and 3 (the datum varies between sources);
@@ -236,6 +236,8 @@ def zandvoort(options: ScenarioOptions) -> Scenario:
 # ---------------------------------------------------------------------------------------------- files
 def from_file(path: Path, options: ScenarioOptions) -> Scenario:
     """A scenario from any waypoint file (CSV x,y[,v]; TUMFTM racetrack CSV; GPS CSV with lat/lon columns)."""
+    from workbench.waypoint_files import read_waypoints  # pandas and pyproj: only for a file (issue 17)
+
     waypoints = read_waypoints(path)
     ref = ReferencePath.from_waypoints(waypoints, name=path.stem)
     kind = "closed loop" if waypoints.closed else "open path"
