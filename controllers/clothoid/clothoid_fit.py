@@ -1,52 +1,31 @@
 """The per-step hyper-clothoid of the clothoid controller (paper, section 2, Eq. 3): one clothoid segment from the
-vehicle's rear-axle pose to a target point, solved exactly by a compiled Newton iteration.
+vehicle's rear-axle pose to a target point, solved by a compiled, damped Newton iteration.
 
-The curve. A clothoid's curvature is linear in arc length, kappa(s) = kappa0 + kdot s, so its heading is
-theta(s) = theta0 + kappa0 s + kdot s^2 / 2 and its points are (x0, y0) + int_0^s (cos theta, sin theta). The
-hyper-clothoid starts at the rear axle (x0, y0) with the vehicle's heading theta0 and current curvature kappa0
-(Eq. 3's x(0), y(0), psi(0), kappa(0)); its two unknowns, the curvature rate kdot (1/m^2) and the length L (m), are
-chosen so that its end point reaches the target (x1, y1). kdot is saturated at +-kdot_max; a saturated clothoid
-cannot reach the target, so its length is the one that brings the end point closest to it, and the residual is
-left for the controller to check against Eq. 3's tolerances delta_x, delta_y (`ClothoidFit.end_error_m`).
+The curve: kappa(s) = kappa0 + kdot s, theta(s) = theta0 + kappa0 s + kdot s^2 / 2, points (x0, y0) + int_0^s
+(cos theta, sin theta). It starts at the rear axle with the vehicle's heading and current curvature (Eq. 3's x(0),
+y(0), psi(0), kappa(0)); its unknowns, the curvature rate kdot (1/m^2) and the length L (m), put its end on the
+target (x1, y1). kdot is saturated at +-kdot_max; a saturated clothoid cannot reach the target, so its length is
+the one that brings its end closest, and the residual is left to the controller to check against Eq. 3's
+tolerances (`ClothoidFit.end_error_m`).
 
-The method. Everything runs in the start frame (the target rotated by -theta0: the start is the origin, heading 0).
-The end point F(kdot, L) is integrated by Gauss-Legendre quadrature. The heading turns by at most max(|kappa0|,
-|kappa0 + kdot L|)·L across [0, L] (|theta'| is linear in s), and that bound picks the rule: 4 to 12 nodes on one
-panel, each rule used only up to the turn at which its measured error stays below 1e-14 of the panel length (the
-integrand is entire, so the error falls super-exponentially with the turn), and 4-rad panels of the 12-node rule
-beyond. End points are therefore exact to rounding (~1e-13 m over 60 m; exact up to 256 rad of turning, finite
-beyond). The Jacobian comes from the same nodes: dF/dL = (cos theta(L), sin theta(L)) and dF/dkdot = int_0^L (s^2/2)
-(-sin theta, cos theta) ds. Newton starts from a small-angle solution (the end point of a gently turning curve lies
-at the bearing of its mean heading, kappa0 L / 2 + kdot L^2 / 6, and at distance L (1 - var theta / 2)) and is
-damped: a step changes the end heading by at most 1.5 rad, keeps L > 0, rejects clothoids turning more than 64 rad,
-and backtracks until |F - target| falls (Armijo). Targets ahead take 2-4 evaluations (1-3 for a vehicle near its
-path; at most 13 seen for bearings up to 100 deg). It has converged below 1e-12 max(1 m, distance) of residual, and
-fails (unless already below 1e-10 max(1 m, distance)) after 30 iterations, a line search that cannot descend, or 3
-steps in a row that each cut the residual by less than 10%: the sign of sliding into a local minimum of |F - target|
-that is not zero, i.e. no clothoid through the target exists (typically kappa0 turning away from a target at a wide
-bearing; pyclothoids finds none either, and no solution that pyclothoids finds is lost to this rule). When the
-solution needs |kdot| > kdot_max, kdot is clipped to +-kdot_max (the solution's sign) and L found by a 1-D Newton
-descent from the distance to a local minimum of the distance: h(L) = (F - T)·t(L) = 0 (half the derivative of |F -
-T|^2), h' = 1 + kappa(L) (F - T)·n(L), downhill steps where that is not positive, with the same turn cap and
-backtracking.
+The method, in the start frame: the end point F(kdot, L) and its Jacobian by Gauss-Legendre quadrature, the rule
+chosen by a bound on the heading turned so that end points are exact to rounding; Newton from a small-angle guess,
+damped (bounded heading change, L > 0, a cap on the turn, Armijo backtracking). It stops as failed after 30
+iterations, a line search that cannot descend, or 3 steps in a row that barely reduce the residual: a local minimum
+of |F - target| that is not zero, i.e. no clothoid through the target. A saturated kdot leaves a 1-D search for L.
 
 Status codes (the fifth value `fit_kernel` returns, and `ClothoidFit.status`):
     FIT_OK = 0          converged: the end point is on the target and |kdot| <= kdot_max.
     FIT_SATURATED = 1   kdot = +-kdot_max exactly; L > 0 a local minimiser of the end point's distance to the target.
     FIT_UNREACHABLE = 2 the target is behind or beside the start (bearing |phi| > 100 deg in the start frame), at
-                        the start (closer than 1 um), or no clothoid reaches it (see above), or the saturated
-                        search failed. The fallback is finite and bounded: kdot = sign(phi) kdot_max (turn towards
-                        the target as hard as allowed), L = distance, and that clothoid's end point (the start
-                        point when it would turn more than 256 rad). Non-finite inputs, or coordinates whose
-                        difference overflows, give kdot = L = 0 and the start point.
+                        the start, or no clothoid reaches it, or the saturated search failed. The fallback is finite
+                        and bounded: kdot = sign(phi) kdot_max, L = distance, and that clothoid's end point.
+                        Non-finite inputs give kdot = L = 0 and the start point.
 
-Why not pyclothoids at run time. `pyclothoids.Clothoid.Forward(x0, y0, th0, k0, x1, y1)` (Bertolazzi & Frego's
-Clothoids library) solves the same boundary problem exactly (no rate limit), and the tests use it as the reference:
-the two agree to ~1e-10 relative in kdot and ~1e-11 in L. But it cannot be called from a compiled search (the
-adaptive lookahead fits up to ~6 clothoids per controller step inside numba code), costs ~6-7 us per call from
-Python (measured on this workbench) against ~1-1.5 us here, and for targets behind or beside the start (and for the
-targets ahead that no clothoid reaches: ~17% of random ones within 60 deg, 3-30 m, |kappa0| <= 0.1) returns
-degenerate answers: length 0 m with a meaningless dk, or long loops (a 120 m clothoid for a target 10 m behind).
+Why not pyclothoids at run time: `pyclothoids.Clothoid.Forward` (Bertolazzi & Frego) solves the same boundary
+problem (without the rate limit) and is the tests' reference, but it cannot be called from the compiled lookahead
+search, costs several times more per call from Python, and returns degenerate answers for targets behind or beside
+the start and for targets no clothoid reaches (the README's clothoid section has the measured figures).
 """
 
 from __future__ import annotations

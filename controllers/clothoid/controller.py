@@ -17,20 +17,20 @@ in README.md):
   - kappa(0) is the curvature the vehicle actually drives, yaw rate / speed ("yaw-rate"). The integrator's own
     command ("command") or the kinematic curvature of the measured steering ("steering") differ from it by the
     vehicle's understeer and lag, and the fit then settles on a circle through the target with the wrong
-    curvature: a steady offset in every bend (about 1 m on the figure8 at 30 km/h with the truck).
+    curvature: a steady offset in every bend.
   - the clothoid starts along the rear axle's course (yaw plus its sideslip), the direction the vehicle moves in,
-    not its body yaw ("course"; the truck's tandem slips up to 3 degrees at 30 km/h).
+    not its body yaw ("course"; a tandem axle slips sideways).
   - the Fréchet threshold is the paper's, absolute ("absolute", 0.02 m): off the path no lookahead qualifies and
     the search takes the candidate of least Fréchet distance, the shortest, which brings the vehicle back fastest.
     Before the lookahead floor (below) that choice could drive a lagging plant into a limit cycle, so the
     threshold applied to the distance in excess of |CTE| ("excess", still an option), which keeps long lookaheads
-    off the path and converges slowly (35 m instead of 12 m from fig17's 1 m offset on the cars).
+    off the path and converges slowly.
 
 What this controller adds to the paper, so that its loop keeps its margins on the vehicle it steers (issue 15):
   - lookahead floor: `loop_analysis.py` linearises the loop (Eq. 3 on the predicted pose, the integrator of
     Figure 2, the lead filter, the vehicle's identified lags of Eq. 5, sampling) and finds, per speed, the
-    shortest lookahead from which every lookahead keeps min_phase_margin_deg (45) and min_gain_margin_db (6, both
-    ways) about a straight and about an arc at the lateral-acceleration limit. The adaptive search never goes
+    shortest lookahead from which every lookahead keeps min_phase_margin_deg and min_gain_margin_db (both ways)
+    about a straight and about an arc at the lateral-acceleration limit. The adaptive search never goes
     below it. The loop's gain goes as L^-3 (about a straight kappa' = -(6 / L^3) (y + psi D + kappa D^2 / 2), D the
     lookahead from the predicted pose), so each jump of the search's choice is a step change of the loop: the
     choice is followed with hysteresis and at a limited rate both ways (`lookahead_filter.py`), slowly against
@@ -41,8 +41,7 @@ What this controller adds to the paper, so that its loop keeps its margins on th
   - the lead filter, curvature limits and lags are the steered vehicle's own (`vehicle_tuning.py`), made by the
     project's tuning chain (the lead chosen for the shortest floor, `tuning schedule --design margins`); without
     a vehicle (geometry only) and without files, no lead filter and no floor.
-  - min_preview_time_s (default 0) can still raise the lower end of the lookahead range to a preview time, as
-    before the analysis floor did that job with the vehicle's own numbers.
+  - min_preview_time_s can still raise the lower end of the lookahead range to a preview time.
 """
 
 from __future__ import annotations

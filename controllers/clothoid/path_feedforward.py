@@ -5,9 +5,8 @@ Why. Eq. 3 fits one clothoid from the vehicle's (predicted) pose to a target poi
 Even with the vehicle exactly on the path its curvature rate is not the path's: for a path whose curvature varies
 within L the fit through one point gives kappa' = kappa_p' + kappa_p'' L / 4 + ..., so the vehicle turns in ahead
 of the path by about L / 4 and cuts every transition; the feedback then fights that error with a gain that falls
-as L^-3. Measured on the kinematic bicycle's dlc at 30 km/h, fixed lookahead: max |CTE| 0.006 m at 3 m, 0.073 m at
-6 m, 0.227 m at 9 m. Tracking therefore asked for short lookaheads, and short lookaheads are where the loop loses
-its margins (`loop_analysis.py`): the limit cycles of issue 15.
+as L^-3 (README: the dlc's max |CTE| against a fixed lookahead). Tracking therefore asked for short lookaheads,
+and short lookaheads are where the loop loses its margins (`loop_analysis.py`): the limit cycles of issue 15.
 
 What. The same hyper-clothoid is fitted twice to the same target: from the vehicle's predicted pose (as Eq. 3)
 and from the reference pose, where a vehicle exactly on the path would be predicted to (the path's pose ahead by
@@ -22,7 +21,7 @@ Linearised, the reference term depends on the path only, so the loop and its mar
 the vehicle's steady-state gain (understeer) from its identified lag. The timings come from the identified lags:
 tau_ff is the low-frequency delay of lead filter and path lag (Eq. 6 and Eq. 5), and the reference lead is how much
 the path curvature lags the yaw-rate curvature that the controller measures as kappa(0) (a truck's tandem and
-trailer make this about 0.12 s at 30 km/h; a car's is a few hundredths).
+trailer make it much longer than a car's).
 """
 
 from __future__ import annotations

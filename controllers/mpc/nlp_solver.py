@@ -7,15 +7,13 @@ current time, primal and dual (x0, lam_x0, lam_g0, with IPOPT's warm_start_init_
 per stage, [x_0, u_0, x_1, u_1, ..., x_N, eps_1..eps_N], which keeps the KKT matrix banded.
 
 The Hessian is by default the Gauss-Newton one (the cost's, constant: the cost is a sum of squares), which spares
-the exact Hessian of the Lagrangian through N RK4 steps (about 290k SX instructions at N = 30, 1.9 ms an
-evaluation); IPOPT then converges to the same KKT point in a few more iterations. `exact_hessian=True` restores it.
+the costly exact Hessian of the Lagrangian through N RK4 steps; IPOPT then converges to the same KKT point in a few
+more iterations. `exact_hessian=True` restores it.
 
 The constraint Jacobian, evaluated at every IPOPT iteration, comes from the OCP's compiled linearisation (the
-same C code the RTI uses, `TrackingOCP.linearisation`): 0.1 ms a call instead of 0.75 ms in CasADi's SX
-virtual machine at N = 30, which halved the IPOPT step (dlc at 30 km/h: median 5.2 -> 3.1 ms). Compiling the whole
-NLP with CasADi's JIT instead took 33 s to build and saved less, so it is not offered. What remains is IPOPT's own
-work: about 2 ms per solve of set-up (options, MUMPS analysis) and 0.6 ms per iteration. The real-time variant is
-`rti.py`.
+same C code the RTI uses, `TrackingOCP.linearisation`) rather than CasADi's SX virtual machine. Compiling the whole
+NLP with CasADi's JIT instead took far longer to build and saved less, so it is not offered. The real-time variant
+is `rti.py`; the README's MPC section has the measured step times.
 
 IPOPT's own wall-time limit (max_wall_time) enforces the real-time budget: a solve it cuts short returns status
 LATE and is not used.
