@@ -41,7 +41,8 @@ from controllers.mpc.prediction_model import (
     prediction_params_for,
 )
 from controllers.mpc.preview import PathPreview
-from controllers.mpc.status import SolveResult, SolveStatus
+from controllers.mpc.solver import MPCSolver
+from controllers.mpc.status import SolveStatus
 from workbench.errors import WorkbenchInputError
 from workbench.path import PathTracker, Projection, ReferencePath, wrap_angle
 from workbench.vehicles.base import VehicleGeometry
@@ -172,7 +173,7 @@ def resolve_prediction_params(geometry: VehicleGeometry, config: MPCConfig, vehi
 
 
 class MPCController(Controller):
-    """Base of the two MPCs: subclasses build `self.solver` in `_build_solver` and implement `_solve`."""
+    """Base of the two MPCs: subclasses build `self.solver` (an `MPCSolver`) in `_build_solver`."""
 
     def __init__(self, geometry: VehicleGeometry, config: Any | None = None, vehicle: object | None = None) -> None:
         super().__init__(geometry, config)
@@ -197,31 +198,16 @@ class MPCController(Controller):
         """The model kind for model = "auto"."""
         return self.prediction.default_kind()
 
+    solver: MPCSolver
+
     def _build_solver(self) -> None:  # pragma: no cover - abstract
+        """Set `self.solver` from `self.ocp` and the config."""
         raise NotImplementedError
-
-    def _set_time_budget(self, seconds: float) -> None:
-        """Give the solver its wall-time limit (s)."""
-
-    def _solve(
-        self,
-        x0: np.ndarray,
-        kappa: np.ndarray,
-        speed: np.ndarray,
-        guess_states: np.ndarray,
-        guess_inputs: np.ndarray,
-        guess_dual: tuple[np.ndarray, ...],
-        first: bool,
-    ) -> SolveResult:  # pragma: no cover - abstract
-        raise NotImplementedError
-
-    def _shift_dual(self, plan: Plan, t_s: float) -> tuple[np.ndarray, ...]:
-        return ()
 
     # ------------------------------------------------------------------ Controller interface
     def _reset(self, path: ReferencePath, sample_time_s: float) -> None:
         self._sample_time_s = float(sample_time_s)
-        self._set_time_budget(self.config.max_solve_time_s or self._sample_time_s)
+        self.solver.set_time_limit(self.config.max_solve_time_s or self._sample_time_s)
         self._reset_state()
         self._tracker: PathTracker = path.tracker(0.0)
         self._preview = PathPreview(path)
@@ -264,8 +250,8 @@ class MPCController(Controller):
             dual: tuple[np.ndarray, ...] = ()
         else:
             guess_states, guess_inputs = shifted[0], shifted[1]
-            dual = self._shift_dual(plan, m.t_s)
-        result = self._solve(x0, kappa, speed, guess_states, guess_inputs, dual, first)
+            dual = self.solver.shift_dual(plan.dual, plan.positions(m.t_s))
+        result = self.solver.solve(x0, kappa, speed, guess_states, guess_inputs, dual, first)
 
         t_next = m.t_s + self._sample_time_s
         if result.accepted:

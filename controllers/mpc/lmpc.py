@@ -80,6 +80,8 @@ class LtvSolver:
         speed: np.ndarray,
         guess_states: np.ndarray,
         guess_inputs: np.ndarray,
+        guess_dual: tuple[np.ndarray, ...] = (),
+        first: bool = False,
     ) -> SolveResult:
         """Solve from x0 along the path (kappa, speed per interval), warm-started from the guess (OSQP keeps the
         multipliers of its previous solve: shifting them to now measured no fewer iterations)."""
@@ -95,6 +97,12 @@ class LtvSolver:
         elapsed = time.perf_counter() - start
         objective = solution.objective if solution.status.accepted else float("nan")  # OSQP's 1/2 z'Pz = the cost
         return SolveResult(solution.status, solution.states, solution.inputs, solution.iterations, elapsed, objective)
+
+    def set_time_limit(self, seconds: float) -> None:
+        self.qp.set_time_limit(seconds)
+
+    def shift_dual(self, dual: tuple[np.ndarray, ...], positions: np.ndarray) -> tuple[np.ndarray, ...]:
+        return ()
 
 
 @dataclass(frozen=True)
@@ -135,18 +143,3 @@ class LMPCController(MPCController):
             time_limit_s=cfg.max_solve_time_s or 0.02,
         )
         self.solver = LtvSolver(self.ocp, settings, codegen=cfg.codegen)
-
-    def _set_time_budget(self, seconds: float) -> None:
-        self.solver.qp.set_time_limit(seconds)
-
-    def _solve(
-        self,
-        x0: np.ndarray,
-        kappa: np.ndarray,
-        speed: np.ndarray,
-        guess_states: np.ndarray,
-        guess_inputs: np.ndarray,
-        guess_dual: tuple[np.ndarray, ...],
-        first: bool,
-    ) -> SolveResult:
-        return self.solver.solve(x0, kappa, speed, guess_states, guess_inputs)

@@ -187,9 +187,10 @@ class IpoptSolver:
         guess_states: np.ndarray,
         guess_inputs: np.ndarray,
         guess_dual: tuple[np.ndarray, ...] = (),
+        first: bool = False,
     ) -> SolveResult:
         """Solve from x0 with the per-interval curvature and speed, warm-started from the guess (primal and, when
-        given, the multipliers (lam_x, lam_g) of a previous solve)."""
+        given, the multipliers (lam_x, lam_g) of a previous solve); IPOPT iterates to convergence, first or not."""
         lbx, ubx = self._bounds()
         w0 = self.pack(guess_states, guess_inputs)
         w0[self.ix[0]] = x0

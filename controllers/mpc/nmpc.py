@@ -21,15 +21,11 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
-import numpy as np
-
 from controllers.config_checks import check_bool, check_choice, check_number, check_whole
 from controllers.mpc.common import MPCConfig, MPCController
 from controllers.mpc.nlp_solver import IpoptSolver
-from controllers.mpc.plan import Plan
 from controllers.mpc.rti import RtiSolver
 from controllers.mpc.sparse_qp import OsqpSettings
-from controllers.mpc.status import SolveResult
 from workbench.vehicles.base import VehicleGeometry
 
 SOLVERS = ("rti", "ipopt")
@@ -76,41 +72,15 @@ class NMPCController(MPCController):
         cfg: NMPCConfig = self.config
         budget = cfg.max_solve_time_s or self._default_budget()
         if cfg.solver == "ipopt":
-            self.solver: IpoptSolver | RtiSolver = IpoptSolver(
+            self.solver = IpoptSolver(
                 self.ocp, cfg.max_iterations, cfg.tolerance, budget, cfg.exact_hessian, cfg.codegen
             )
         else:
             settings = OsqpSettings(
                 eps_abs=cfg.qp_tolerance, eps_rel=cfg.qp_tolerance, max_iter=cfg.qp_max_iterations, time_limit_s=budget
             )
-            self.solver = RtiSolver(self.ocp, settings, codegen=cfg.codegen)
+            self.solver = RtiSolver(self.ocp, settings, codegen=cfg.codegen, first_iterations=cfg.first_iterations)
 
     @staticmethod
     def _default_budget() -> float:
         return 0.02  # the default controller period (50 Hz); reset() sets the actual sample time
-
-    def _set_time_budget(self, seconds: float) -> None:
-        if isinstance(self.solver, IpoptSolver):
-            self.solver.set_time_limit(seconds)
-        else:
-            self.solver.qp.set_time_limit(seconds)
-
-    def _solve(
-        self,
-        x0: np.ndarray,
-        kappa: np.ndarray,
-        speed: np.ndarray,
-        guess_states: np.ndarray,
-        guess_inputs: np.ndarray,
-        guess_dual: tuple[np.ndarray, ...],
-        first: bool,
-    ) -> SolveResult:
-        if isinstance(self.solver, IpoptSolver):
-            return self.solver.solve(x0, kappa, speed, guess_states, guess_inputs, guess_dual)
-        iterations = self.config.first_iterations if first else 1
-        return self.solver.solve(x0, kappa, speed, guess_states, guess_inputs, iterations=iterations)
-
-    def _shift_dual(self, plan: Plan, t_s: float) -> tuple[np.ndarray, ...]:
-        if isinstance(self.solver, IpoptSolver):
-            return self.solver.shift_dual(plan.dual, plan.positions(t_s))
-        return ()

@@ -29,10 +29,15 @@ STEP_TOLERANCE = 1e-7
 
 
 class RtiSolver:
-    """Gauss-Newton SQP on a TrackingOCP with an OSQP sparse QP; `codegen` compiles the linearisation."""
+    """Gauss-Newton SQP on a TrackingOCP with an OSQP sparse QP (an `MPCSolver`); `codegen` compiles the
+    linearisation; `first_iterations`: SQP iterations of a run's first solve (one after it: the real-time
+    iteration)."""
 
-    def __init__(self, ocp: TrackingOCP, settings: OsqpSettings | None = None, codegen: bool = True) -> None:
+    def __init__(
+        self, ocp: TrackingOCP, settings: OsqpSettings | None = None, codegen: bool = True, first_iterations: int = 1
+    ) -> None:
         self.ocp = ocp
+        self.first_iterations = first_iterations
         N, nx = ocp.N, ocp.nx
         compiled = ocp.linearisation(codegen)
         self.linearise = FastFunction(compiled.function)
@@ -54,9 +59,13 @@ class RtiSolver:
         guess_states: np.ndarray,
         guess_inputs: np.ndarray,
         guess_dual: tuple[np.ndarray, ...] = (),
-        iterations: int = 1,
+        first: bool = False,
+        iterations: int | None = None,
     ) -> SolveResult:
-        """`iterations` Gauss-Newton SQP steps from the guess (one: the real-time iteration)."""
+        """`iterations` Gauss-Newton SQP steps from the guess (None: `first_iterations` on a run's first solve, one
+        after it, the real-time iteration). The multipliers are not used: OSQP keeps its own."""
+        if iterations is None:
+            iterations = self.first_iterations if first else 1
         ocp, qp = self.ocp, self.qp
         N, nx = ocp.N, ocp.nx
         if ocp.bounds_version != self._bounds_version:
@@ -97,3 +106,9 @@ class RtiSolver:
         elapsed = time.perf_counter() - start
         objective = solution.objective if (status.accepted and solution is not None) else float("nan")
         return SolveResult(status, states, inputs, qp_iterations, elapsed, objective)
+
+    def set_time_limit(self, seconds: float) -> None:
+        self.qp.set_time_limit(seconds)
+
+    def shift_dual(self, dual: tuple[np.ndarray, ...], positions: np.ndarray) -> tuple[np.ndarray, ...]:
+        return ()

@@ -22,7 +22,7 @@ def _solve(controller, speed_mps: float):
     ocp = controller.ocp
     kappa, speed = np.full(ocp.N, 0.04), np.full(ocp.N, speed_mps)
     guess_states, guess_inputs = np.zeros((ocp.N + 1, ocp.nx)), np.zeros((ocp.N, ocp.nu))
-    return controller._solve(np.zeros(ocp.nx), kappa, speed, guess_states, guess_inputs, (), True)
+    return controller.solver.solve(np.zeros(ocp.nx), kappa, speed, guess_states, guess_inputs, (), True)
 
 
 @pytest.mark.parametrize("vehicle_name", ["kinematic-bicycle", "dynamic-bicycle"])
@@ -51,3 +51,15 @@ def test_the_guard_leaves_plausible_problems_alone() -> None:
         assert not controller.solver.qp.refused
         assert result.status is not SolveStatus.NUMERICAL_ERROR
         assert np.abs(controller.solver.qp._csc_values).max() < MAX_MATRIX_ENTRY * 1e-5
+
+
+@pytest.mark.parametrize("variant", [*sorted(VARIANTS), "nmpc-ipopt"])
+def test_every_mpc_solver_offers_the_one_solver_interface(variant: str) -> None:
+    """MPCController steps its solver through `MPCSolver` only (no isinstance branches on the solver kind)."""
+    from controllers.mpc.solver import MPCSolver
+
+    cls, config = VARIANTS.get(variant, (NMPCController, NMPCConfig(solver="ipopt", max_solve_time_s=0.5)))
+    solver = cls(make_vehicle("kinematic-bicycle").geometry, config).solver
+    for name in ("solve", "set_time_limit", "shift_dual"):
+        assert callable(getattr(solver, name, None)), name
+    assert all(hasattr(solver, name) for name in MPCSolver.__dict__ if not name.startswith("_"))
