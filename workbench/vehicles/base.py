@@ -2,7 +2,8 @@
 
 A model is a set of ODEs x' = f(x, u) with named states, driven by two inputs: the steering-wheel angle command
 (rad) and the longitudinal acceleration command (m/s^2). The simulator calls `advance` once per controller step;
-a model integrates its own fine steps inside (RK4 at the plant rate, compiled with numba where it matters), so no
+a model integrates its own fine steps inside (RK4 at the plant rate, `workbench.vehicles.integration`, compiled
+with numba where it matters), so no
 Python-level ODE solver runs per step.
 
 Conventions: SI units; x east, y north, yaw counter-clockwise from x; the reference point the controllers see is
@@ -13,8 +14,9 @@ from __future__ import annotations
 
 import math
 from abc import ABC, abstractmethod
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import ClassVar
+from typing import Any, ClassVar
 
 import numpy as np
 
@@ -60,13 +62,29 @@ class VehicleGeometry:
     def max_steer_wheel_angle_rad(self) -> float:
         return self.max_road_wheel_angle_rad * self.steering_ratio
 
+    @classmethod
+    def from_params(cls, params: Any, wheelbase_m: float) -> VehicleGeometry:
+        """From a model's parameters with the usual fields (steering_ratio, max_road_wheel_angle_rad,
+        max_road_wheel_rate_rad_s, width_m); the steering-wheel rate limit is the road-wheel one x the ratio."""
+        return cls(
+            wheelbase_m=wheelbase_m,
+            steering_ratio=params.steering_ratio,
+            max_road_wheel_angle_rad=params.max_road_wheel_angle_rad,
+            max_steer_wheel_rate_rad_s=params.max_road_wheel_rate_rad_s * params.steering_ratio,
+            width_m=params.width_m,
+        )
+
     def steer_wheel_for_curvature(self, curvature_1pm: float) -> float:
         """Steering-wheel angle (rad) that gives this path curvature kinematically: tan(phi) = L kappa."""
         return math.atan(self.wheelbase_m * curvature_1pm) * self.steering_ratio
 
 
 class VehicleModel(ABC):
-    """A plant. Subclasses set `name`, `state_names`, `extra_output_names` and implement the abstract methods.
+    """A plant. Subclasses set `name`, `state_names`, `extra_output_names`, and in `__init__` `params` (a frozen
+    dataclass with max_accel_mps2 and max_decel_mps2) and `_geometry`; they implement `advance` and `outputs`.
+
+    The default `initial_state` suits models whose first four states are x_m, y_m, yaw_rad and the longitudinal
+    speed, with every other state zero except those in `heading_states` (yaws of trailing units, in line).
 
     Extra outputs with these names are picked up by the metrics: `ltr` (load transfer ratio, max over axle
     groups, |LTR| = 1 is wheel lift-off), `trailer_x_m`/`trailer_y_m` (the trailer's rear-axle centre).
@@ -75,15 +93,30 @@ class VehicleModel(ABC):
     name: ClassVar[str]
     state_names: ClassVar[tuple[str, ...]]
     extra_output_names: ClassVar[tuple[str, ...]] = ()
+    #: States that start at the heading yaw_rad (the yaw of a trailing unit: the units start in line).
+    heading_states: ClassVar[tuple[str, ...]] = ()
+    params: Any
+    _geometry: VehicleGeometry
 
     @property
-    @abstractmethod
     def geometry(self) -> VehicleGeometry:
         """Controller-facing geometry and limits."""
+        return self._geometry
 
-    @abstractmethod
     def initial_state(self, x_m: float, y_m: float, yaw_rad: float, speed_mps: float) -> np.ndarray:
         """State at rest in steering (straight wheels), reference point at (x, y), heading yaw, moving at speed."""
+        state = np.zeros(len(self.state_names))
+        state[0], state[1], state[2], state[3] = x_m, y_m, yaw_rad, speed_mps
+        for name in self.heading_states:
+            state[self.state_names.index(name)] = yaw_rad
+        return state
+
+    def _inputs(self, steer_wheel_cmd_rad: float, accel_cmd_mps2: float) -> tuple[float, float]:
+        """(road-wheel angle command (rad), acceleration (m/s^2)), each clipped to the vehicle's limits."""
+        g, p = self._geometry, self.params
+        lim = g.max_road_wheel_angle_rad
+        delta_cmd = min(max(steer_wheel_cmd_rad / g.steering_ratio, -lim), lim)
+        return delta_cmd, min(max(accel_cmd_mps2, -p.max_decel_mps2), p.max_accel_mps2)
 
     @abstractmethod
     def advance(
@@ -105,4 +138,30 @@ class VehicleModel(ABC):
         return (
             f"wheelbase {g.wheelbase_m:g} m, steering ratio {g.steering_ratio:g}, "
             f"max road-wheel angle {math.degrees(g.max_road_wheel_angle_rad):.0f} deg, width {g.width_m:g} m"
+        )
+
+
+class CompiledVehicleModel(VehicleModel):
+    """A model whose numerics are compiled with numba, on a parameter array `_p` built in `__init__`.
+
+    Subclasses set `_advance_kernel = staticmethod(_advance)`, their module's cached
+    `_advance(state, p, delta_cmd, accel, h, n)` (`integration.rk4` over the model's derivative), and either
+    `_outputs_kernel = staticmethod(_outputs)`, a compiled `_outputs(state, p, delta_cmd, accel, steering_ratio)`,
+    or their own `outputs`.
+    """
+
+    _p: np.ndarray
+    _advance_kernel: ClassVar[Callable[..., np.ndarray]]
+    _outputs_kernel: ClassVar[Callable[..., np.ndarray]]
+
+    def advance(
+        self, state: np.ndarray, steer_wheel_cmd_rad: float, accel_cmd_mps2: float, dt_s: float, substeps: int
+    ) -> np.ndarray:
+        delta_cmd, accel = self._inputs(steer_wheel_cmd_rad, accel_cmd_mps2)
+        return self._advance_kernel(state, self._p, delta_cmd, accel, dt_s / substeps, substeps)
+
+    def outputs(self, state: np.ndarray, steer_wheel_cmd_rad: float, accel_cmd_mps2: float) -> np.ndarray:
+        delta_cmd, accel = self._inputs(steer_wheel_cmd_rad, accel_cmd_mps2)
+        return self._outputs_kernel(
+            np.asarray(state, dtype=float), self._p, delta_cmd, accel, self.params.steering_ratio
         )

@@ -13,12 +13,15 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import partial
 from typing import Any, ClassVar
 
 import numpy as np
 
 from workbench.errors import WorkbenchInputError, require_in_range
 from workbench.vehicles.base import VehicleGeometry, VehicleModel
+from workbench.vehicles.integration import rk4_python
+from workbench.vehicles.reference_point import reference_point_python
 
 #: CommonRoad's names of the MB states, in order (x/y are the CG; vx/vy of the sprung mass, body frame).
 _MB_STATES: tuple[str, ...] = (
@@ -104,18 +107,9 @@ class CommonRoadMB(VehicleModel):
             width_m=float(cr.w),
         )
 
-    @property
-    def geometry(self) -> VehicleGeometry:
-        return self._geometry
-
     def initial_state(self, x_m: float, y_m: float, yaw_rad: float, speed_mps: float) -> np.ndarray:
         xc, yc = x_m + self._b * math.cos(yaw_rad), y_m + self._b * math.sin(yaw_rad)
         return np.array(self._init([xc, yc, 0.0, speed_mps, yaw_rad, 0.0, 0.0], self._cr), dtype=float)
-
-    def _inputs(self, steer_wheel_cmd_rad: float, accel_cmd_mps2: float) -> tuple[float, float]:
-        p, lim = self.params, self._geometry.max_road_wheel_angle_rad
-        delta_cmd = min(max(steer_wheel_cmd_rad / p.steering_ratio, -lim), lim)
-        return delta_cmd, min(max(accel_cmd_mps2, -p.max_decel_mps2), p.max_accel_mps2)
 
     def _rhs(self, x: np.ndarray, delta_cmd: float, accel: float) -> np.ndarray:
         """MB derivative; NaN where CommonRoad's code breaks down (e.g. a wheel stops rolling in a spin:
@@ -132,13 +126,10 @@ class CommonRoadMB(VehicleModel):
         delta_cmd, accel = self._inputs(steer_wheel_cmd_rad, accel_cmd_mps2)
         n = max(substeps, math.ceil(dt_s / self.params.max_step_s - 1e-9))
         h = dt_s / n
+        rhs = partial(self._rhs, delta_cmd=delta_cmd, accel=accel)
         s = np.array(state, dtype=float)
         for _ in range(n):
-            k1 = self._rhs(s, delta_cmd, accel)
-            k2 = self._rhs(s + 0.5 * h * k1, delta_cmd, accel)
-            k3 = self._rhs(s + 0.5 * h * k2, delta_cmd, accel)
-            k4 = self._rhs(s + h * k3, delta_cmd, accel)
-            s = s + h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+            s = rk4_python(rhs, s, h)
             s[23:27] = np.maximum(s[23:27], 0.0)  # CommonRoad forbids negative wheel spin
         return s
 
@@ -147,10 +138,9 @@ class CommonRoadMB(VehicleModel):
         x = np.asarray(state, dtype=float)
         d = self._rhs(x, delta_cmd, accel)
         b, yaw, u, r = self._b, x[4], x[3], x[5]
-        vref = x[10] - b * r
-        ax_ref, ay_ref = d[3] - vref * r, d[10] - b * d[5] + u * r
-        speed = math.hypot(u, vref)
-        kappa = (u * ay_ref - vref * ax_ref) / speed**3 if speed > 1e-3 else math.tan(x[2]) / self.geometry.wheelbase_m
+        vref, _, ay_ref, kappa = reference_point_python(
+            u, x[10], r, d[3], d[10], d[5], b, x[2], self._geometry.wheelbase_m
+        )
         return np.array(
             [
                 x[0] - b * math.cos(yaw),

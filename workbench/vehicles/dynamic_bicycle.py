@@ -20,12 +20,13 @@ from typing import ClassVar
 import numpy as np
 from numba import njit
 
-from workbench.errors import WorkbenchInputError, require_in_range
-from workbench.vehicles.base import VehicleGeometry, VehicleModel
-
-G_MPS2 = 9.81
-#: Time constant (s) with which the blended kinematic branch pulls the lateral states onto the no-slip values.
-KINEMATIC_PULL_S = 0.02
+from workbench.errors import require_in_range
+from workbench.vehicles.actuator import realised_accel, road_wheel_rate
+from workbench.vehicles.base import CompiledVehicleModel, VehicleGeometry
+from workbench.vehicles.blend import blend, blend_weight, check_blend_speeds, pull
+from workbench.vehicles.integration import rk4
+from workbench.vehicles.reference_point import reference_point, world_velocity
+from workbench.vehicles.tyres import G_MPS2, magic_formula, relaxation_rate, slip_angle, steered_slip_angle
 
 
 @dataclass(frozen=True)
@@ -58,11 +59,7 @@ class DynamicBicycleParams:
     def __post_init__(self) -> None:
         for name, low, high, unit in _RANGES:
             require_in_range(name, getattr(self, name), low, high, unit)
-        if self.kinematic_blend_low_mps >= self.kinematic_blend_high_mps:
-            raise WorkbenchInputError(
-                f"kinematic_blend_low_mps must be < kinematic_blend_high_mps = {self.kinematic_blend_high_mps}; "
-                f"got {self.kinematic_blend_low_mps!r}"
-            )
+        check_blend_speeds(self.kinematic_blend_low_mps, self.kinematic_blend_high_mps)
 
     @property
     def wheelbase_m(self) -> float:
@@ -101,72 +98,38 @@ _RANGES: tuple[tuple[str, float, float, str], ...] = (
 
 
 @njit(cache=True)
-def _slip(vy, vx):  # pragma: no cover - compiled
-    """Slip angle (rad) of a contact moving at (vx, vy) in the wheel frame; zero for a wheel standing still."""
-    return math.atan2(vy, vx) if abs(vx) + abs(vy) > 1e-9 else 0.0
-
-
-@njit(cache=True)
-def _magic(alpha, d, bb, c, e):  # pragma: no cover - compiled
-    x = bb * alpha
-    return -d * math.sin(c * math.atan(x - e * (x - math.atan(x))))
-
-
-@njit(cache=True)
 def _rhs(s, p, delta_cmd, accel, out):  # pragma: no cover - compiled
     yaw, u, v, r, delta, fyf, fyr = s[2], max(s[3], 0.0), s[4], s[5], s[6], s[7], s[8]  # RK4 stages may dip < 0
     a, b, m, iz = p[P_A], p[P_B], p[P_M], p[P_I]
     wb = a + b
-    ax = 0.0 if (u <= 0.0 and accel < 0.0) else accel
-    ddelta = min(max((delta_cmd - delta) / p[P_TAU], -p[P_RATE]), p[P_RATE])
+    ax = realised_accel(u, accel)
+    ddelta = road_wheel_rate(delta_cmd, delta, p[P_TAU], p[P_RATE])
     sd, cd = math.sin(delta), math.cos(delta)
     fzf = m * (G_MPS2 * b - ax * p[P_H]) / wb
     fzr = m * (G_MPS2 * a + ax * p[P_H]) / wb
-    vf = v + a * r
-    alpha_f = _slip(vf * cd - u * sd, u * cd + vf * sd)
-    alpha_r = _slip(v - b * r, u)
-    relax = max(u, p[P_VLO]) / p[P_SIGMA]
-    out[7] = relax * (_magic(alpha_f, p[P_MU] * max(fzf, 0.0), p[P_BF], p[P_C], p[P_E]) - fyf)
-    out[8] = relax * (_magic(alpha_r, p[P_MU] * max(fzr, 0.0), p[P_BR], p[P_C], p[P_E]) - fyr)
+    alpha_f = steered_slip_angle(v + a * r, u, sd, cd)
+    alpha_r = slip_angle(v - b * r, u)
+    relax = relaxation_rate(u, p[P_VLO], p[P_SIGMA])
+    out[7] = relax * (magic_formula(alpha_f, p[P_MU] * max(fzf, 0.0), p[P_BF], p[P_C], p[P_E]) - fyf)
+    out[8] = relax * (magic_formula(alpha_r, p[P_MU] * max(fzr, 0.0), p[P_BR], p[P_C], p[P_E]) - fyr)
     dv_d = (fyf * cd + fyr) / m - u * r
     dr_d = (a * fyf * cd - b * fyr) / iz
     r_k = u * sd / cd / wb
     dr_k = (ax * sd / cd + u * ddelta / (cd * cd)) / wb
-    dv_k = b * dr_k + (b * r_k - v) / KINEMATIC_PULL_S
-    dr_k += (r_k - r) / KINEMATIC_PULL_S
-    w = min(max((u - p[P_VLO]) / (p[P_VHI] - p[P_VLO]), 0.0), 1.0)
-    w = w * w * (3.0 - 2.0 * w)
-    vref = v - b * r
-    cy, sy = math.cos(yaw), math.sin(yaw)
-    out[0] = u * cy - vref * sy
-    out[1] = u * sy + vref * cy
+    dv_k = b * dr_k + pull(b * r_k, v)
+    dr_k += pull(r_k, r)
+    w = blend_weight(u, p[P_VLO], p[P_VHI])
+    out[0], out[1] = world_velocity(u, v - b * r, yaw)
     out[2] = r
     out[3] = ax
-    out[4] = w * dv_d + (1.0 - w) * dv_k
-    out[5] = w * dr_d + (1.0 - w) * dr_k
+    out[4] = blend(w, dv_d, dv_k)
+    out[5] = blend(w, dr_d, dr_k)
     out[6] = ddelta
 
 
 @njit(cache=True)
-def _rk4(state, p, delta_cmd, accel, h, n):  # pragma: no cover - compiled
-    s = state.copy()
-    k1, k2, k3, k4, t = np.empty(9), np.empty(9), np.empty(9), np.empty(9), np.empty(9)
-    for _ in range(n):
-        _rhs(s, p, delta_cmd, accel, k1)
-        for i in range(9):
-            t[i] = s[i] + 0.5 * h * k1[i]
-        _rhs(t, p, delta_cmd, accel, k2)
-        for i in range(9):
-            t[i] = s[i] + 0.5 * h * k2[i]
-        _rhs(t, p, delta_cmd, accel, k3)
-        for i in range(9):
-            t[i] = s[i] + h * k3[i]
-        _rhs(t, p, delta_cmd, accel, k4)
-        for i in range(9):
-            s[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
-        if s[3] < 0.0:
-            s[3] = 0.0
-    return s
+def _advance(state, p, delta_cmd, accel, h, n):  # pragma: no cover - compiled
+    return rk4(_rhs, state, p, delta_cmd, accel, h, n)
 
 
 @njit(cache=True)
@@ -174,10 +137,7 @@ def _outputs(s, p, delta_cmd, accel, ratio):  # pragma: no cover - compiled
     d = np.empty(9)
     _rhs(s, p, delta_cmd, accel, d)
     u, v, r, delta, b = max(s[3], 0.0), s[4], s[5], s[6], p[P_B]
-    vref = v - b * r
-    ax_ref, ay_ref = d[3] - vref * r, d[4] - b * d[5] + u * r
-    speed = math.hypot(u, vref)
-    kappa = (u * ay_ref - vref * ax_ref) / speed**3 if speed > 1e-3 else math.tan(delta) / (p[P_A] + b)
+    vref, _, ay_ref, kappa = reference_point(u, v, r, d[3], d[4], d[5], b, delta, p[P_A] + b)
     out = np.empty(12)
     out[0], out[1], out[2], out[3], out[4], out[5] = s[0], s[1], s[2], u, vref, r
     out[6], out[7], out[8] = delta * ratio, delta, ay_ref
@@ -185,7 +145,7 @@ def _outputs(s, p, delta_cmd, accel, ratio):  # pragma: no cover - compiled
     return out
 
 
-class DynamicBicycle(VehicleModel):
+class DynamicBicycle(CompiledVehicleModel):
     name: ClassVar[str] = "dynamic-bicycle"
     state_names: ClassVar[tuple[str, ...]] = (
         "x_m",
@@ -199,6 +159,9 @@ class DynamicBicycle(VehicleModel):
         "fy_rear_N",
     )
     extra_output_names: ClassVar[tuple[str, ...]] = ("fy_front_N", "fy_rear_N", "path_curvature_1pm")
+
+    _advance_kernel = staticmethod(_advance)
+    _outputs_kernel = staticmethod(_outputs)
 
     def __init__(self, params: DynamicBicycleParams | None = None) -> None:
         self.params = p = params or DynamicBicycleParams()
@@ -217,33 +180,4 @@ class DynamicBicycle(VehicleModel):
         arr[P_BF] = p.front_cornering_coeff_per_rad / (p.tyre_shape_factor * p.tyre_friction)
         arr[P_BR] = p.rear_cornering_coeff_per_rad / (p.tyre_shape_factor * p.tyre_friction)
         self._p = arr
-        self._geometry = VehicleGeometry(
-            wheelbase_m=p.wheelbase_m,
-            steering_ratio=p.steering_ratio,
-            max_road_wheel_angle_rad=p.max_road_wheel_angle_rad,
-            max_steer_wheel_rate_rad_s=p.max_road_wheel_rate_rad_s * p.steering_ratio,
-            width_m=p.width_m,
-        )
-
-    @property
-    def geometry(self) -> VehicleGeometry:
-        return self._geometry
-
-    def initial_state(self, x_m: float, y_m: float, yaw_rad: float, speed_mps: float) -> np.ndarray:
-        return np.array([x_m, y_m, yaw_rad, speed_mps, 0.0, 0.0, 0.0, 0.0, 0.0], dtype=float)
-
-    def _inputs(self, steer_wheel_cmd_rad: float, accel_cmd_mps2: float) -> tuple[float, float]:
-        p = self.params
-        lim = p.max_road_wheel_angle_rad
-        delta_cmd = min(max(steer_wheel_cmd_rad / p.steering_ratio, -lim), lim)
-        return delta_cmd, min(max(accel_cmd_mps2, -p.max_decel_mps2), p.max_accel_mps2)
-
-    def advance(
-        self, state: np.ndarray, steer_wheel_cmd_rad: float, accel_cmd_mps2: float, dt_s: float, substeps: int
-    ) -> np.ndarray:
-        delta_cmd, accel = self._inputs(steer_wheel_cmd_rad, accel_cmd_mps2)
-        return _rk4(state, self._p, delta_cmd, accel, dt_s / substeps, substeps)
-
-    def outputs(self, state: np.ndarray, steer_wheel_cmd_rad: float, accel_cmd_mps2: float) -> np.ndarray:
-        delta_cmd, accel = self._inputs(steer_wheel_cmd_rad, accel_cmd_mps2)
-        return _outputs(np.asarray(state, dtype=float), self._p, delta_cmd, accel, self.params.steering_ratio)
+        self._geometry = VehicleGeometry.from_params(p, p.wheelbase_m)

@@ -17,7 +17,9 @@ import numpy as np
 from numba import njit
 
 from workbench.errors import require_in_range, require_positive
-from workbench.vehicles.base import VehicleGeometry, VehicleModel
+from workbench.vehicles.actuator import realised_accel, road_wheel_rate
+from workbench.vehicles.base import CompiledVehicleModel, VehicleGeometry
+from workbench.vehicles.integration import rk4
 
 
 @dataclass(frozen=True)
@@ -48,35 +50,25 @@ class KinematicBicycleParams:
 
 
 @njit(cache=True)
-def _derivatives(state, p, delta_cmd, accel):  # pragma: no cover - compiled
+def _rhs(state, p, delta_cmd, accel, out):  # pragma: no cover - compiled
     yaw, v, delta = state[2], state[3], state[4]
-    out = np.empty(5)
     out[0] = v * math.cos(yaw)
     out[1] = v * math.sin(yaw)
     out[2] = v * math.tan(delta) / p[0]
-    out[3] = 0.0 if (v <= 0.0 and accel < 0.0) else accel
-    rate = (delta_cmd - delta) / p[3]
-    out[4] = min(max(rate, -p[2]), p[2])
-    return out
+    out[3] = realised_accel(v, accel)
+    out[4] = road_wheel_rate(delta_cmd, delta, p[3], p[2])
 
 
 @njit(cache=True)
-def _rk4(state, p, delta_cmd, accel, h, n):  # pragma: no cover - compiled
-    s = state.copy()
-    for _ in range(n):
-        k1 = _derivatives(s, p, delta_cmd, accel)
-        k2 = _derivatives(s + 0.5 * h * k1, p, delta_cmd, accel)
-        k3 = _derivatives(s + 0.5 * h * k2, p, delta_cmd, accel)
-        k4 = _derivatives(s + h * k3, p, delta_cmd, accel)
-        s = s + h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
-        if s[3] < 0.0:
-            s[3] = 0.0
-    return s
+def _advance(state, p, delta_cmd, accel, h, n):  # pragma: no cover - compiled
+    return rk4(_rhs, state, p, delta_cmd, accel, h, n)
 
 
-class KinematicBicycle(VehicleModel):
+class KinematicBicycle(CompiledVehicleModel):
     name: ClassVar[str] = "kinematic-bicycle"
     state_names: ClassVar[tuple[str, ...]] = ("x_m", "y_m", "yaw_rad", "speed_mps", "road_wheel_angle_rad")
+
+    _advance_kernel = staticmethod(_advance)
 
     def __init__(self, params: KinematicBicycleParams | None = None) -> None:
         self.params = params or KinematicBicycleParams()
@@ -84,34 +76,7 @@ class KinematicBicycle(VehicleModel):
         self._p = np.array(
             [p.wheelbase_m, p.max_road_wheel_angle_rad, p.max_road_wheel_rate_rad_s, p.steering_time_constant_s]
         )
-        self._geometry = VehicleGeometry(
-            wheelbase_m=p.wheelbase_m,
-            steering_ratio=p.steering_ratio,
-            max_road_wheel_angle_rad=p.max_road_wheel_angle_rad,
-            max_steer_wheel_rate_rad_s=p.max_road_wheel_rate_rad_s * p.steering_ratio,
-            width_m=p.width_m,
-        )
-
-    @property
-    def geometry(self) -> VehicleGeometry:
-        return self._geometry
-
-    def initial_state(self, x_m: float, y_m: float, yaw_rad: float, speed_mps: float) -> np.ndarray:
-        return np.array([x_m, y_m, yaw_rad, speed_mps, 0.0], dtype=float)
-
-    def _inputs(self, steer_wheel_cmd_rad: float, accel_cmd_mps2: float) -> tuple[float, float]:
-        p = self.params
-        delta_cmd = min(
-            max(steer_wheel_cmd_rad / p.steering_ratio, -p.max_road_wheel_angle_rad), p.max_road_wheel_angle_rad
-        )
-        accel = min(max(accel_cmd_mps2, -p.max_decel_mps2), p.max_accel_mps2)
-        return delta_cmd, accel
-
-    def advance(
-        self, state: np.ndarray, steer_wheel_cmd_rad: float, accel_cmd_mps2: float, dt_s: float, substeps: int
-    ) -> np.ndarray:
-        delta_cmd, accel = self._inputs(steer_wheel_cmd_rad, accel_cmd_mps2)
-        return _rk4(state, self._p, delta_cmd, accel, dt_s / substeps, substeps)
+        self._geometry = VehicleGeometry.from_params(p, p.wheelbase_m)
 
     def outputs(self, state: np.ndarray, steer_wheel_cmd_rad: float, accel_cmd_mps2: float) -> np.ndarray:
         x, y, yaw, v, delta = state

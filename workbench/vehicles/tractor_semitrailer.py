@@ -33,11 +33,12 @@ import numpy as np
 from numba import njit
 
 from workbench.errors import WorkbenchInputError, require_in_range
-from workbench.vehicles.base import VehicleGeometry, VehicleModel
-
-G_MPS2 = 9.81
-#: Time constant (s) with which the blended kinematic branch pulls the lateral states onto the no-slip values.
-KINEMATIC_PULL_S = 0.02
+from workbench.vehicles.actuator import realised_accel, road_wheel_rate
+from workbench.vehicles.base import CompiledVehicleModel, VehicleGeometry
+from workbench.vehicles.blend import blend, blend_weight, check_blend_speeds, pull
+from workbench.vehicles.integration import rk4
+from workbench.vehicles.reference_point import reference_point, world_velocity
+from workbench.vehicles.tyres import G_MPS2, magic_formula, relaxation_rate, slip_angle, steered_slip_angle
 
 
 @dataclass(frozen=True)
@@ -113,11 +114,7 @@ class TractorSemitrailerParams:
                 "hitch_ahead_of_drive_m must leave the fifth wheel at least 0.5 m behind the front axle, i.e. be "
                 f"< {self.cg_to_front_axle_m + self.cg_to_drive_axle_m - 0.5:g} m; got {self.hitch_ahead_of_drive_m!r}"
             )
-        if self.kinematic_blend_low_mps >= self.kinematic_blend_high_mps:
-            raise WorkbenchInputError(
-                f"kinematic_blend_low_mps must be < kinematic_blend_high_mps = {self.kinematic_blend_high_mps}; "
-                f"got {self.kinematic_blend_low_mps!r}"
-            )
+        check_blend_speeds(self.kinematic_blend_low_mps, self.kinematic_blend_high_mps)
 
 
 #: (field, low, high, unit): the physically sensible range of every parameter.
@@ -286,39 +283,27 @@ def derive(p: TractorSemitrailerParams) -> Derived:
 
 
 @njit(cache=True)
-def _slip(vy, vx):  # pragma: no cover - compiled
-    """Slip angle (rad) of a contact moving at (vx, vy) in the wheel frame; zero for a wheel standing still."""
-    return math.atan2(vy, vx) if abs(vx) + abs(vy) > 1e-9 else 0.0
-
-
-@njit(cache=True)
-def _magic(alpha, d, bb, shape):  # pragma: no cover - compiled
-    """Lateral force (N) at slip angle alpha (rad): -D sin(C atan(B alpha))."""
-    return -d * math.sin(shape * math.atan(bb * alpha))
-
-
-@njit(cache=True)
 def _rhs(s, p, delta_cmd, accel, out):  # pragma: no cover - compiled
     """State derivative into `out`."""
     yaw, u, v, r1, yaw2, r2, delta = s[2], max(s[3], 0.0), s[4], s[5], s[6], s[7], s[8]  # RK4 stages may dip < 0
     fyf, fyd, fyt = s[9], s[10], s[11]
     a, b, c, l1, lt, e = p[P_A], p[P_B], p[P_C], p[P_L1], p[P_LT], p[P_E]
     m1, m2, i1, i2 = p[P_M1], p[P_M2], p[P_I1], p[P_I2]
-    ax = 0.0 if (u <= 0.0 and accel < 0.0) else accel
-    ddelta = min(max((delta_cmd - delta) / p[P_TAU], -p[P_RATE]), p[P_RATE])
+    ax = realised_accel(u, accel)
+    ddelta = road_wheel_rate(delta_cmd, delta, p[P_TAU], p[P_RATE])
     th = yaw - yaw2
     sth, cth, sd, cd = math.sin(th), math.cos(th), math.sin(delta), math.cos(delta)
     vh = v - c * r1  # hitch lateral velocity, tractor frame
     # tyre slip and relaxation
     vy_t = u * sth + vh * cth - lt * r2
     vx_t = u * cth - vh * sth
-    alpha_f = _slip((v + a * r1) * cd - u * sd, u * cd + (v + a * r1) * sd)
-    alpha_d = _slip(v - b * r1, u)
-    alpha_t = _slip(vy_t, vx_t)
-    relax = max(u, p[P_VLO]) / p[P_SIGMA]
-    out[9] = relax * (_magic(alpha_f, p[P_DF], p[P_BF], p[P_SHAPE]) - fyf)
-    out[10] = relax * (_magic(alpha_d, p[P_DD], p[P_BD], p[P_SHAPE]) - fyd)
-    out[11] = relax * (_magic(alpha_t, p[P_DT], p[P_BT], p[P_SHAPE]) - fyt)
+    alpha_f = steered_slip_angle(v + a * r1, u, sd, cd)
+    alpha_d = slip_angle(v - b * r1, u)
+    alpha_t = slip_angle(vy_t, vx_t)
+    relax = relaxation_rate(u, p[P_VLO], p[P_SIGMA])
+    out[9] = relax * (magic_formula(alpha_f, p[P_DF], p[P_BF], p[P_SHAPE], 0.0) - fyf)
+    out[10] = relax * (magic_formula(alpha_d, p[P_DD], p[P_BD], p[P_SHAPE], 0.0) - fyd)
+    out[11] = relax * (magic_formula(alpha_t, p[P_DT], p[P_BT], p[P_SHAPE], 0.0) - fyt)
     # dynamic branch: 3x3 symmetric system in (dv, dr1, dr2), hitch force eliminated
     ff = fyf * cd
     x_acc = ax - v * r1 + c * r1 * r1
@@ -342,44 +327,23 @@ def _rhs(s, p, delta_cmd, accel, out):  # pragma: no cover - compiled
     r2_k = (u * sth + vh_k * cth) / lt
     dth = r1 - r2
     dr2_k = (ax * sth + u * cth * dth + (b - c) * dr1_k * cth - vh_k * sth * dth) / lt
-    dv_k += (b * r1_k - v) / KINEMATIC_PULL_S
-    dr1_k += (r1_k - r1) / KINEMATIC_PULL_S
-    dr2_k += (r2_k - r2) / KINEMATIC_PULL_S
-    w = min(max((u - p[P_VLO]) / (p[P_VHI] - p[P_VLO]), 0.0), 1.0)
-    w = w * w * (3.0 - 2.0 * w)
-    vref = v - b * r1
-    cy, sy = math.cos(yaw), math.sin(yaw)
-    out[0] = u * cy - vref * sy
-    out[1] = u * sy + vref * cy
+    dv_k += pull(b * r1_k, v)
+    dr1_k += pull(r1_k, r1)
+    dr2_k += pull(r2_k, r2)
+    w = blend_weight(u, p[P_VLO], p[P_VHI])
+    out[0], out[1] = world_velocity(u, v - b * r1, yaw)
     out[2] = r1
     out[3] = ax
-    out[4] = w * dv_d + (1.0 - w) * dv_k
-    out[5] = w * dr1_d + (1.0 - w) * dr1_k
+    out[4] = blend(w, dv_d, dv_k)
+    out[5] = blend(w, dr1_d, dr1_k)
     out[6] = r2
-    out[7] = w * dr2_d + (1.0 - w) * dr2_k
+    out[7] = blend(w, dr2_d, dr2_k)
     out[8] = ddelta
 
 
 @njit(cache=True)
-def _rk4(state, p, delta_cmd, accel, h, n):  # pragma: no cover - compiled
-    s = state.copy()
-    k1, k2, k3, k4, t = np.empty(12), np.empty(12), np.empty(12), np.empty(12), np.empty(12)
-    for _ in range(n):
-        _rhs(s, p, delta_cmd, accel, k1)
-        for i in range(12):
-            t[i] = s[i] + 0.5 * h * k1[i]
-        _rhs(t, p, delta_cmd, accel, k2)
-        for i in range(12):
-            t[i] = s[i] + 0.5 * h * k2[i]
-        _rhs(t, p, delta_cmd, accel, k3)
-        for i in range(12):
-            t[i] = s[i] + h * k3[i]
-        _rhs(t, p, delta_cmd, accel, k4)
-        for i in range(12):
-            s[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
-        if s[3] < 0.0:
-            s[3] = 0.0
-    return s
+def _advance(state, p, delta_cmd, accel, h, n):  # pragma: no cover - compiled
+    return rk4(_rhs, state, p, delta_cmd, accel, h, n)
 
 
 @njit(cache=True)
@@ -389,10 +353,7 @@ def _outputs(s, p, delta_cmd, accel, ratio):  # pragma: no cover - compiled
     x, y, yaw, u, v, r1, yaw2, delta = s[0], s[1], s[2], max(s[3], 0.0), s[4], s[5], s[6], s[8]
     b, c, e, lt = p[P_B], p[P_C], p[P_E], p[P_LT]
     th = yaw - yaw2
-    vref, dvref = v - b * r1, d[4] - b * d[5]
-    ax_ref, ay_ref = d[3] - vref * r1, dvref + u * r1
-    speed = math.hypot(u, vref)
-    kappa = (u * ay_ref - vref * ax_ref) / speed**3 if speed > 1e-3 else math.tan(delta) / p[P_L1]
+    vref, _, ay_ref, kappa = reference_point(u, v, r1, d[3], d[4], d[5], b, delta, p[P_L1])
     ay1 = d[4] + u * r1
     x_acc = d[3] - v * r1 + c * r1 * r1
     y_acc = d[4] + u * r1 - c * d[5]
@@ -412,7 +373,7 @@ def _outputs(s, p, delta_cmd, accel, ratio):  # pragma: no cover - compiled
     return out
 
 
-class TractorSemitrailer(VehicleModel):
+class TractorSemitrailer(CompiledVehicleModel):
     name: ClassVar[str] = "tractor-semitrailer"
     state_names: ClassVar[tuple[str, ...]] = (
         "x_m",
@@ -428,6 +389,7 @@ class TractorSemitrailer(VehicleModel):
         "fy_drive_N",
         "fy_trailer_N",
     )
+    heading_states: ClassVar[tuple[str, ...]] = ("trailer_yaw_rad",)
     extra_output_names: ClassVar[tuple[str, ...]] = (
         "ltr",
         "ltr_front",
@@ -439,6 +401,9 @@ class TractorSemitrailer(VehicleModel):
         "articulation_rad",
         "path_curvature_1pm",
     )
+
+    _advance_kernel = staticmethod(_advance)
+    _outputs_kernel = staticmethod(_outputs)
 
     def __init__(self, params: TractorSemitrailerParams | None = None) -> None:
         self.params = p = params or TractorSemitrailerParams()
@@ -457,36 +422,7 @@ class TractorSemitrailer(VehicleModel):
         arr[P_SHAPE], arr[P_HOFF] = p.tyre_shape_factor, p.hitch_ahead_of_drive_m
         arr[P_KF1:P_N] = np.ravel(dv.ltr_per_ay)
         self._p = arr
-        self._geometry = VehicleGeometry(
-            wheelbase_m=p.cg_to_front_axle_m + p.cg_to_drive_axle_m,
-            steering_ratio=p.steering_ratio,
-            max_road_wheel_angle_rad=p.max_road_wheel_angle_rad,
-            max_steer_wheel_rate_rad_s=p.max_road_wheel_rate_rad_s * p.steering_ratio,
-            width_m=p.width_m,
-        )
-
-    @property
-    def geometry(self) -> VehicleGeometry:
-        return self._geometry
-
-    def initial_state(self, x_m: float, y_m: float, yaw_rad: float, speed_mps: float) -> np.ndarray:
-        return np.array([x_m, y_m, yaw_rad, speed_mps, 0.0, 0.0, yaw_rad, 0.0, 0.0, 0.0, 0.0, 0.0], dtype=float)
-
-    def _inputs(self, steer_wheel_cmd_rad: float, accel_cmd_mps2: float) -> tuple[float, float]:
-        p = self.params
-        lim = p.max_road_wheel_angle_rad
-        delta_cmd = min(max(steer_wheel_cmd_rad / p.steering_ratio, -lim), lim)
-        return delta_cmd, min(max(accel_cmd_mps2, -p.max_decel_mps2), p.max_accel_mps2)
-
-    def advance(
-        self, state: np.ndarray, steer_wheel_cmd_rad: float, accel_cmd_mps2: float, dt_s: float, substeps: int
-    ) -> np.ndarray:
-        delta_cmd, accel = self._inputs(steer_wheel_cmd_rad, accel_cmd_mps2)
-        return _rk4(state, self._p, delta_cmd, accel, dt_s / substeps, substeps)
-
-    def outputs(self, state: np.ndarray, steer_wheel_cmd_rad: float, accel_cmd_mps2: float) -> np.ndarray:
-        delta_cmd, accel = self._inputs(steer_wheel_cmd_rad, accel_cmd_mps2)
-        return _outputs(np.asarray(state, dtype=float), self._p, delta_cmd, accel, self.params.steering_ratio)
+        self._geometry = VehicleGeometry.from_params(p, p.cg_to_front_axle_m + p.cg_to_drive_axle_m)
 
     def describe(self) -> str:
         dv = self.derived
