@@ -24,37 +24,17 @@ import math
 import sys
 from collections.abc import Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-from controllers.clothoid.curvature_limits import DEFAULT_LIMIT_LATERAL_ACCEL_G
-from controllers.clothoid.filter_file import write_filter_file
-from tuning.data_generation import generate_open_loop_log
-from tuning.lag_fit import CURVATURE_SOURCES, LagFitOptions, SteeringGeometry, fit_lag
-from tuning.lead_design import DEFAULT_MAX_CASCADE_PEAK_DB, DEFAULT_MAX_LEAD_GAIN, design_lead, validate
-from tuning.log_file import read_log
-from tuning.maneuvers import Maneuver
-from tuning.rollover import rollover_limits, table, to_curvature_limits
-from tuning.schedule import (
-    DEFAULT_CONTROLLER_RATE_HZ,
-    DEFAULT_LAT_ACCEL_G,
-    DEFAULT_PREDICTION_TIME_S,
-    DESIGNS,
-    PAPER_SPEED_KMH,
-    compare_closed_loop,
-    fixed_and_scheduled_filters,
-    identify_schedule,
-    scheduled_against_fixed,
-    steer_amplitude_deg,
-)
-from tuning.speeds import parse_speeds
-from tuning.steering_limits import steering_limits
-from tuning.steering_limits import table as steering_table
-from tuning.steering_limits import to_curvature_limits as steering_curvature_limits
 from workbench.errors import WorkbenchInputError
-from workbench.input_files import check_input_file, read_json
-from workbench.output_dir import check_output_file
-from workbench.vehicles import make_vehicle
-from workbench.vehicles.base import VehicleModel
-from workbench.vehicles.steering_lag import read_lag_file, write_lag_file
+
+if TYPE_CHECKING:
+    from tuning.lag_fit import SteeringGeometry
+    from workbench.vehicles.base import VehicleGeometry, VehicleModel
+
+# The tuning modules (python-control, SciPy, the controllers, the simulator) are imported inside the command that
+# needs them and the parser builds only the options of the command being run, so that `tuning --help` starts fast
+# (issue 17; benchmarks/startup.py measures it).
 
 EXIT_INPUT_ERROR = 2
 FORMATS = ("json", "toml")
@@ -89,6 +69,8 @@ def _format_option(parser: argparse.ArgumentParser) -> None:
 
 
 def _design_options(parser: argparse.ArgumentParser) -> None:
+    from tuning.lead_design import DEFAULT_MAX_CASCADE_PEAK_DB, DEFAULT_MAX_LEAD_GAIN
+
     parser.add_argument(
         "--max-lead-gain",
         type=float,
@@ -104,7 +86,19 @@ def _design_options(parser: argparse.ArgumentParser) -> None:
     )
 
 
-def _parser() -> argparse.ArgumentParser:
+def _command_word(argv: Sequence[str]) -> str:
+    """The command argv names (its first word that is not an option), or "" without one."""
+    return next((word for word in argv if not word.startswith("-")), "")
+
+
+def _builds(command: str | None, name: str) -> bool:
+    """Whether the parser adds the options of command `name`: the one being run, or every one (command None)."""
+    return command is None or command == name
+
+
+def _parser(command: str | None = None) -> argparse.ArgumentParser:
+    """The parser. `command` (the one being run, "" for none) limits the options built, and the modules their
+    defaults are read from, to that command's; None: every command's."""
     parser = argparse.ArgumentParser(prog="tuning", description="Identify vehicle lag and tune controller filters.")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
@@ -112,159 +106,177 @@ def _parser() -> argparse.ArgumentParser:
         "generate-data",
         help="drive a plant open loop with a steering profile and write a CSV log (the fit-lag input format)",
     )
-    _vehicle_options(gen)
-    gen.add_argument("--maneuver", required=True, choices=Maneuver.KINDS, help="steering-wheel profile")
-    gen.add_argument("--speed", type=float, required=True, metavar="KMH", help="held speed, km/h")
-    size = gen.add_mutually_exclusive_group()
-    size.add_argument("--amplitude-deg", type=float, help="steering-wheel amplitude (default 90 deg)")
-    size.add_argument(
-        "--lat-accel-g", type=float, help="size the amplitude for this kinematic lateral acceleration (g) instead"
-    )
-    gen.add_argument("--duration-s", type=float, default=20.0, help="log length (default 20 s)")
-    gen.add_argument(
-        "--chirp-hz",
-        default="0.1:2",
-        metavar="LOW:HIGH",
-        help="frequency band of --maneuver chirp, swept exponentially over the log (default 0.1:2 Hz)",
-    )
-    gen.add_argument(
-        "--max-rate-deg-s",
-        type=float,
-        help="limit the steering-wheel rate of the profile (deg/s; steps become ramps, the chirp's amplitude falls "
-        "at high frequency; default: no limit)",
-    )
-    gen.add_argument("--sample-rate-hz", type=float, default=100.0, help="log sample rate (default 100 Hz)")
-    gen.add_argument("--out", type=Path, required=True, metavar="FILE.csv", help="output CSV")
+    if _builds(command, "generate-data"):
+        from tuning.maneuvers import Maneuver
+
+        _vehicle_options(gen)
+        gen.add_argument("--maneuver", required=True, choices=Maneuver.KINDS, help="steering-wheel profile")
+        gen.add_argument("--speed", type=float, required=True, metavar="KMH", help="held speed, km/h")
+        size = gen.add_mutually_exclusive_group()
+        size.add_argument("--amplitude-deg", type=float, help="steering-wheel amplitude (default 90 deg)")
+        size.add_argument(
+            "--lat-accel-g", type=float, help="size the amplitude for this kinematic lateral acceleration (g) instead"
+        )
+        gen.add_argument("--duration-s", type=float, default=20.0, help="log length (default 20 s)")
+        gen.add_argument(
+            "--chirp-hz",
+            default="0.1:2",
+            metavar="LOW:HIGH",
+            help="frequency band of --maneuver chirp, swept exponentially over the log (default 0.1:2 Hz)",
+        )
+        gen.add_argument(
+            "--max-rate-deg-s",
+            type=float,
+            help="limit the steering-wheel rate of the profile (deg/s; steps become ramps, the chirp's amplitude falls "
+            "at high frequency; default: no limit)",
+        )
+        gen.add_argument("--sample-rate-hz", type=float, default=100.0, help="log sample rate (default 100 Hz)")
+        gen.add_argument("--out", type=Path, required=True, metavar="FILE.csv", help="output CSV")
 
     fit = sub.add_parser("fit-lag", help="fit the steering lag of Eq. 5 to vehicle logs; write lag.json")
-    fit.add_argument("logs", type=Path, nargs="+", metavar="FILE.csv", help="vehicle logs at one speed")
-    fit.add_argument("--out", type=Path, required=True, metavar="lag.json", help="output steering-lag file")
-    fit.add_argument("--plot", type=Path, metavar="FILE.png", help="Figure 8: kinematic, actual, with lag")
-    _geometry_options(fit)
-    fit.add_argument(
-        "--curvature-from",
-        choices=CURVATURE_SOURCES,
-        default="auto",
-        help="realised curvature: of the rear-axle path x, y (auto when present) or yaw rate / speed",
-    )
-    fit.add_argument("--smooth-s", type=float, default=0.3, help="window of the path derivatives (default 0.3 s)")
-    fit.add_argument("--delay", action="store_true", help="also fit a pure time delay")
-    fit.add_argument("--unit-gain", action="store_true", help="fix the steady-state gain at 1 (Eq. 5 strictly)")
-    fit.add_argument(
-        "--max-speed-variation",
-        type=float,
-        default=0.15,
-        help="largest (max - min) / mean speed over the logs (default 0.15)",
-    )
+    if _builds(command, "fit-lag"):
+        from tuning.lag_fit import CURVATURE_SOURCES
+
+        fit.add_argument("logs", type=Path, nargs="+", metavar="FILE.csv", help="vehicle logs at one speed")
+        fit.add_argument("--out", type=Path, required=True, metavar="lag.json", help="output steering-lag file")
+        fit.add_argument("--plot", type=Path, metavar="FILE.png", help="Figure 8: kinematic, actual, with lag")
+        _geometry_options(fit)
+        fit.add_argument(
+            "--curvature-from",
+            choices=CURVATURE_SOURCES,
+            default="auto",
+            help="realised curvature: of the rear-axle path x, y (auto when present) or yaw rate / speed",
+        )
+        fit.add_argument("--smooth-s", type=float, default=0.3, help="window of the path derivatives (default 0.3 s)")
+        fit.add_argument("--delay", action="store_true", help="also fit a pure time delay")
+        fit.add_argument("--unit-gain", action="store_true", help="fix the steady-state gain at 1 (Eq. 5 strictly)")
+        fit.add_argument(
+            "--max-speed-variation",
+            type=float,
+            default=0.15,
+            help="largest (max - min) / mean speed over the logs (default 0.15)",
+        )
 
     lead = sub.add_parser("design-lead", help="design the lead filter of Eq. 6 for a lag; write lead.json/.toml")
-    lead.add_argument("--lag", type=Path, required=True, metavar="lag.json", help="steering-lag file (fit-lag)")
-    lead.add_argument("--out", type=Path, required=True, metavar="lead.json", help="output lead-filter file")
-    _format_option(lead)
-    lead.add_argument("--plot", type=Path, metavar="FILE.png", help="Figure 10: Bode of plant, filter, cascade")
-    _design_options(lead)
-    lead.add_argument(
-        "--phase-at-rad-s", type=float, help="report the phases at this frequency (default: the plant's bandwidth)"
-    )
-    lead.add_argument(
-        "--validate", type=Path, nargs="+", metavar="FILE.csv", help="vehicle logs for Figure 9 (time domain)"
-    )
-    lead.add_argument(
-        "--validate-plot", type=Path, metavar="FILE.png", help="where Figure 9 goes (default: beside --out)"
-    )
-    _geometry_options(lead)
+    if _builds(command, "design-lead"):
+        lead.add_argument("--lag", type=Path, required=True, metavar="lag.json", help="steering-lag file (fit-lag)")
+        lead.add_argument("--out", type=Path, required=True, metavar="lead.json", help="output lead-filter file")
+        _format_option(lead)
+        lead.add_argument("--plot", type=Path, metavar="FILE.png", help="Figure 10: Bode of plant, filter, cascade")
+        _design_options(lead)
+        lead.add_argument(
+            "--phase-at-rad-s", type=float, help="report the phases at this frequency (default: the plant's bandwidth)"
+        )
+        lead.add_argument(
+            "--validate", type=Path, nargs="+", metavar="FILE.csv", help="vehicle logs for Figure 9 (time domain)"
+        )
+        lead.add_argument(
+            "--validate-plot", type=Path, metavar="FILE.png", help="where Figure 9 goes (default: beside --out)"
+        )
+        _geometry_options(lead)
 
     roll = sub.add_parser("rollover-limits", help="curvature at LTR = 1 per speed (Figure 6); write limits.csv")
-    _vehicle_options(roll)
-    roll.add_argument("--speeds", required=True, metavar="10,20,...,100", help="speeds, km/h")
-    roll.add_argument("--out", type=Path, required=True, metavar="limits.csv", help="output curvature-limits CSV")
-    roll.add_argument("--plot", type=Path, metavar="FILE.png", help="Figure 6")
+    if _builds(command, "rollover-limits"):
+        _vehicle_options(roll)
+        roll.add_argument("--speeds", required=True, metavar="10,20,...,100", help="speeds, km/h")
+        roll.add_argument("--out", type=Path, required=True, metavar="limits.csv", help="output curvature-limits CSV")
+        roll.add_argument("--plot", type=Path, metavar="FILE.png", help="Figure 6")
 
     steer = sub.add_parser(
         "steering-limits",
         help="curvature limits of a vehicle without a roll model: steering lock, lateral acceleration, steering "
         "rate; write limits.csv",
     )
-    _vehicle_options(steer)
-    steer.add_argument("--speeds", required=True, metavar="10,20,...,150", help="speeds, km/h")
-    steer.add_argument(
-        "--lat-accel-g",
-        type=float,
-        default=DEFAULT_LIMIT_LATERAL_ACCEL_G,
-        help=f"lateral-acceleration bound (default {DEFAULT_LIMIT_LATERAL_ACCEL_G:g} g, the controller's default)",
-    )
-    steer.add_argument("--out", type=Path, required=True, metavar="limits.csv", help="output curvature-limits CSV")
+    if _builds(command, "steering-limits"):
+        from controllers.clothoid.curvature_limits import DEFAULT_LIMIT_LATERAL_ACCEL_G
+
+        _vehicle_options(steer)
+        steer.add_argument("--speeds", required=True, metavar="10,20,...,150", help="speeds, km/h")
+        steer.add_argument(
+            "--lat-accel-g",
+            type=float,
+            default=DEFAULT_LIMIT_LATERAL_ACCEL_G,
+            help=f"lateral-acceleration bound (default {DEFAULT_LIMIT_LATERAL_ACCEL_G:g} g, the controller's default)",
+        )
+        steer.add_argument("--out", type=Path, required=True, metavar="limits.csv", help="output curvature-limits CSV")
 
     sched = sub.add_parser("schedule", help="lag and lead filter at each speed; write a scheduled lead-filter file")
-    _vehicle_options(sched)
-    sched.add_argument("--speeds", required=True, metavar="20,30,...,90", help="speeds, km/h")
-    sched.add_argument("--out", type=Path, required=True, metavar="schedule.json", help="output lead-filter file")
-    _format_option(sched)
-    sched.add_argument(
-        "--delay",
-        action="store_true",
-        help="fit the lag of Eq. 5 with a pure delay at each speed (as fit-lag --delay); per_speed records delay_s",
-    )
-    sched.add_argument(
-        "--design",
-        choices=DESIGNS,
-        default="cancel",
-        help="the lead filter at each speed: cancel (default; zeros on the path lag's poles, design-lead's) or margins "
-        "(the shortest lookahead floor of the clothoid loop with 45 deg / 6 dB margins, from the path and the "
-        "measured lag; records lookahead_floor_m and floor_without_lead_m per speed; a few s a speed)",
-    )
-    sched.add_argument(
-        "--controller-rate-hz",
-        type=float,
-        default=DEFAULT_CONTROLLER_RATE_HZ,
-        help=f"the clothoid controller's rate for --design margins (default {DEFAULT_CONTROLLER_RATE_HZ:g} Hz)",
-    )
-    sched.add_argument(
-        "--prediction-time-s",
-        type=float,
-        default=DEFAULT_PREDICTION_TIME_S,
-        help=f"its pose prediction for --design margins (default {DEFAULT_PREDICTION_TIME_S:g} s)",
-    )
-    sched.add_argument(
-        "--drop-refused",
-        action="store_true",
-        help="leave out a speed whose lag fit or lead design is refused (saying why, on stderr and in the file's "
-        "design.dropped_speeds) instead of refusing the schedule",
-    )
-    sched.add_argument(
-        "--lat-accel-g",
-        type=float,
-        default=DEFAULT_LAT_ACCEL_G,
-        help=f"kinematic lateral acceleration of the identification maneuvers (default {DEFAULT_LAT_ACCEL_G:g} g)",
-    )
-    sched.add_argument(
-        "--nominal-speed",
-        type=float,
-        metavar="KMH",
-        help="speed of the top-level filter and of --compare's fixed filter (default: the first speed; with "
-        "--compare, 30 km/h, the paper's, when it is one of the speeds)",
-    )
-    _design_options(sched)
-    sched.add_argument("--plot", type=Path, metavar="FILE.png", help="lag and filter against speed")
-    sched.add_argument(
-        "--compare",
-        metavar="60,80",
-        help="then run the clothoid controller on --compare-scenario at these speeds with the schedule, the fixed "
-        "filter of --nominal-speed and no filter, and print the tracking and whether the schedule tracks better",
-    )
-    sched.add_argument("--compare-scenario", default="dlc", help="scenario of --compare (default dlc)")
-    _add_margins_parser(sub)
+    if _builds(command, "schedule"):
+        from tuning.schedule import DEFAULT_CONTROLLER_RATE_HZ, DEFAULT_LAT_ACCEL_G, DEFAULT_PREDICTION_TIME_S, DESIGNS
+
+        _vehicle_options(sched)
+        sched.add_argument("--speeds", required=True, metavar="20,30,...,90", help="speeds, km/h")
+        sched.add_argument("--out", type=Path, required=True, metavar="schedule.json", help="output lead-filter file")
+        _format_option(sched)
+        sched.add_argument(
+            "--delay",
+            action="store_true",
+            help="fit the lag of Eq. 5 with a pure delay at each speed (as fit-lag --delay); per_speed records delay_s",
+        )
+        sched.add_argument(
+            "--design",
+            choices=DESIGNS,
+            default="cancel",
+            help="the lead filter at each speed: cancel (default; zeros on the path lag's poles, design-lead's) or "
+            "margins (the shortest lookahead floor of the clothoid loop with 45 deg / 6 dB margins, from the path and "
+            "the measured lag; records lookahead_floor_m and floor_without_lead_m per speed; a few s a speed)",
+        )
+        sched.add_argument(
+            "--controller-rate-hz",
+            type=float,
+            default=DEFAULT_CONTROLLER_RATE_HZ,
+            help=f"the clothoid controller's rate for --design margins (default {DEFAULT_CONTROLLER_RATE_HZ:g} Hz)",
+        )
+        sched.add_argument(
+            "--prediction-time-s",
+            type=float,
+            default=DEFAULT_PREDICTION_TIME_S,
+            help=f"its pose prediction for --design margins (default {DEFAULT_PREDICTION_TIME_S:g} s)",
+        )
+        sched.add_argument(
+            "--drop-refused",
+            action="store_true",
+            help="leave out a speed whose lag fit or lead design is refused (saying why, on stderr and in the file's "
+            "design.dropped_speeds) instead of refusing the schedule",
+        )
+        sched.add_argument(
+            "--lat-accel-g",
+            type=float,
+            default=DEFAULT_LAT_ACCEL_G,
+            help=f"kinematic lateral acceleration of the identification maneuvers (default {DEFAULT_LAT_ACCEL_G:g} g)",
+        )
+        sched.add_argument(
+            "--nominal-speed",
+            type=float,
+            metavar="KMH",
+            help="speed of the top-level filter and of --compare's fixed filter (default: the first speed; with "
+            "--compare, 30 km/h, the paper's, when it is one of the speeds)",
+        )
+        _design_options(sched)
+        sched.add_argument("--plot", type=Path, metavar="FILE.png", help="lag and filter against speed")
+        sched.add_argument(
+            "--compare",
+            metavar="60,80",
+            help="then run the clothoid controller on --compare-scenario at these speeds with the schedule, the fixed "
+            "filter of --nominal-speed and no filter, and print the tracking and whether the schedule tracks better",
+        )
+        sched.add_argument("--compare-scenario", default="dlc", help="scenario of --compare (default dlc)")
+    _add_margins_parser(sub, command)
     return parser
 
 
 def _vehicle(args: argparse.Namespace) -> VehicleModel:
+    from workbench.vehicles import make_vehicle
+
     if args.vehicle is None and args.vehicle_file is None:
         raise WorkbenchInputError("give --vehicle NAME or --vehicle-file FILE")
     return make_vehicle(args.vehicle, payload_kg=args.payload_kg, vehicle_file=args.vehicle_file)
 
 
-def _geometry(args: argparse.Namespace):
+def _geometry(args: argparse.Namespace) -> SteeringGeometry | VehicleGeometry:
     """The vehicle's geometry, or --wheelbase-m and --steering-ratio for a vehicle without a model here."""
+    from tuning.lag_fit import SteeringGeometry
+
     manual = (args.wheelbase_m, args.steering_ratio)
     if any(v is not None for v in manual):
         if args.vehicle is not None or args.vehicle_file is not None:
@@ -300,6 +312,9 @@ def _prepare(path: Path) -> Path:
 def _check_paths(args: argparse.Namespace) -> None:
     """Every input file must be a readable file and every output file writable (INPUT_FILES, OUTPUT_FILES; and the
     default place of design-lead's validation figure): checked before any work."""
+    from workbench.input_files import check_input_file
+    from workbench.output_dir import check_output_file
+
     for dest, (flag, what) in INPUT_FILES.items():
         value = getattr(args, dest, None)
         for path in value if isinstance(value, list) else [] if value is None else [value]:
@@ -319,6 +334,9 @@ def _validation_plot(out: Path) -> Path:
 
 def _read_lag(flag: str, path: Path):
     """A steering-lag file; its JSON read safely first (deep nesting, not JSON), then checked as a lag."""
+    from workbench.input_files import read_json
+    from workbench.vehicles.steering_lag import read_lag_file
+
     label = f"steering-lag file {str(path)!r} ({flag})"
     read_json(path, label)
     try:
@@ -328,6 +346,10 @@ def _read_lag(flag: str, path: Path):
 
 
 def _generate_data(args: argparse.Namespace) -> int:
+    from tuning.data_generation import generate_open_loop_log
+    from tuning.maneuvers import Maneuver
+    from tuning.schedule import steer_amplitude_deg
+
     vehicle = _vehicle(args)
     amplitude = args.amplitude_deg if args.amplitude_deg is not None else 90.0
     if args.lat_accel_g is not None:
@@ -366,6 +388,10 @@ def _band(text: str) -> tuple[float, float]:
 
 
 def _fit_lag(args: argparse.Namespace) -> int:
+    from tuning.lag_fit import LagFitOptions, fit_lag
+    from tuning.log_file import read_log
+    from workbench.vehicles.steering_lag import write_lag_file
+
     geometry = _geometry(args)
     options = LagFitOptions(
         curvature_from=args.curvature_from,
@@ -389,6 +415,10 @@ def _fit_lag(args: argparse.Namespace) -> int:
 
 
 def _design_lead(args: argparse.Namespace) -> int:
+    from controllers.clothoid.filter_file import write_filter_file
+    from tuning.lead_design import design_lead, validate
+    from tuning.log_file import read_log
+
     out = _filter_path(args)
     lag = _read_lag("--lag", args.lag)
     design = design_lead(
@@ -433,6 +463,9 @@ def _design_lead(args: argparse.Namespace) -> int:
 
 
 def _rollover_limits(args: argparse.Namespace) -> int:
+    from tuning.rollover import rollover_limits, table, to_curvature_limits
+    from tuning.speeds import parse_speeds
+
     vehicle = _vehicle(args)
     speeds = parse_speeds(args.speeds)
     limits = rollover_limits(vehicle, speeds)
@@ -447,6 +480,11 @@ def _rollover_limits(args: argparse.Namespace) -> int:
 
 
 def _steering_limits(args: argparse.Namespace) -> int:
+    from tuning.speeds import parse_speeds
+    from tuning.steering_limits import steering_limits
+    from tuning.steering_limits import table as steering_table
+    from tuning.steering_limits import to_curvature_limits as steering_curvature_limits
+
     vehicle = _vehicle(args)
     limits = steering_limits(vehicle.geometry, parse_speeds(args.speeds), args.lat_accel_g)
     steering_curvature_limits(limits, vehicle.name, args.lat_accel_g).write_csv(_prepare(args.out))
@@ -456,6 +494,16 @@ def _steering_limits(args: argparse.Namespace) -> int:
 
 
 def _schedule(args: argparse.Namespace) -> int:
+    from tuning.lag_fit import LagFitOptions
+    from tuning.schedule import (
+        PAPER_SPEED_KMH,
+        compare_closed_loop,
+        fixed_and_scheduled_filters,
+        identify_schedule,
+        scheduled_against_fixed,
+    )
+    from tuning.speeds import parse_speeds
+
     out = _filter_path(args)
     vehicle = _vehicle(args)
     speeds = parse_speeds(args.speeds)
@@ -508,14 +556,16 @@ def _schedule(args: argparse.Namespace) -> int:
     return 0
 
 
-def _add_margins_parser(sub: argparse._SubParsersAction) -> None:
-    from controllers.clothoid.loop_analysis import REQUIRED_GAIN_MARGIN_DB, REQUIRED_PHASE_MARGIN_DEG
-
+def _add_margins_parser(sub: argparse._SubParsersAction, command: str | None = None) -> None:
     marg = sub.add_parser(
         "margins",
         help="the clothoid loop's phase and gain margins against lookahead per speed, and the lookahead floor; "
         "write a table (CSV) and a plot",
     )
+    if not _builds(command, "margins"):
+        return
+    from controllers.clothoid.loop_analysis import REQUIRED_GAIN_MARGIN_DB, REQUIRED_PHASE_MARGIN_DEG
+
     marg.add_argument(
         "--lag", type=Path, metavar="lag.json", help="path-curvature lag (fit-lag; default: the vehicle's)"
     )
@@ -588,6 +638,7 @@ def _margins(args: argparse.Namespace) -> int:
     from controllers.clothoid.filter_file import read_filter_file
     from controllers.clothoid.loop_analysis import PlantLags
     from tuning.margins import MarginStudy, run_margins
+    from tuning.speeds import parse_speeds
     from workbench.errors import require_in_range
 
     for flag, value, low, high, unit in (
@@ -686,7 +737,8 @@ COMMANDS = {
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    args = _parser().parse_args(argv)
+    argv = sys.argv[1:] if argv is None else list(argv)
+    args = _parser(_command_word(argv)).parse_args(argv)
     try:
         _check_paths(args)
         return COMMANDS[args.command](args)

@@ -24,23 +24,19 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from controllers import CONTROLLERS, make_controller
-from controllers.config_file import config_template, read_controller_config
-from workbench.comparison import Comparison, RunSpec, compare, warn_on_stderr
+from controllers import CONTROLLERS
 from workbench.errors import WorkbenchInputError
-from workbench.fig17 import run_fig17
-from workbench.input_files import check_input_file
-from workbench.limit_cycle import detect_limit_cycle
-from workbench.output_dir import MANIFEST, OutputDir, check_study_dir
-from workbench.report import ReportSection, write_report
-from workbench.scenarios import SCENARIOS, ScenarioOptions, describe_scenarios, make_scenario
-from workbench.simulator import Simulation, SimulationConfig
-from workbench.studies.spec import DEFAULT_MAX_RUNS
-from workbench.vehicles import VEHICLES, list_presets, make_vehicle, preset_text
+from workbench.output_dir import MANIFEST
 
 if TYPE_CHECKING:
+    from workbench.comparison import Comparison
+    from workbench.output_dir import OutputDir
     from workbench.studies import StudySpec
     from workbench.studies.backends import Backend
+
+# Heavy modules (the simulator, the scenarios' paths, plotting, the controllers' solvers, the studies' backends)
+# are imported inside the command that needs them, so that `workbench --help` and `workbench scenarios` start
+# fast (issue 17; benchmarks/startup.py measures it).
 
 EXIT_INPUT_ERROR = 2
 EXIT_RUN_FAILED = 1
@@ -55,7 +51,14 @@ INPUT_FILES = {
 }
 
 
-def _parser() -> argparse.ArgumentParser:
+def _command_word(argv: Sequence[str]) -> str:
+    """The command argv names (its first word that is not an option), or "" without one."""
+    return next((word for word in argv if not word.startswith("-")), "")
+
+
+def _parser(command: str | None = None) -> argparse.ArgumentParser:
+    """The parser of every command. `command` (the one being run, "" for none) limits the imports a command's
+    options need (the studies' default size) to that command's; None: every command's, as `workbench sweep -h`."""
     parser = argparse.ArgumentParser(
         prog="workbench", description="Design, tune and compare lateral (steering) controllers."
     )
@@ -135,14 +138,14 @@ def _parser() -> argparse.ArgumentParser:
     )
     swp.add_argument("spec", type=Path, metavar="SPEC.toml", help="the study spec (see README: Studies)")
     swp.add_argument("--out", type=Path, required=True, metavar="DIR", help="output directory (rerun to resume)")
-    _backend_options(swp)
+    _backend_options(swp, command in (None, "sweep"))
     swp.add_argument("--no-plots", action="store_true", help="write the results without the figures")
     opt = sub.add_parser(
         "optimise", help="tune a controller's options against the spec's objective (optuna TPE); DIR/best.toml"
     )
     opt.add_argument("spec", type=Path, metavar="SPEC.toml", help="the study spec with an [optimise] table")
     opt.add_argument("--out", type=Path, required=True, metavar="DIR", help="output directory (rerun to resume)")
-    _backend_options(opt)
+    _backend_options(opt, command in (None, "optimise"))
     return parser
 
 
@@ -155,7 +158,15 @@ def _overwrite_option(parser: argparse.ArgumentParser) -> None:
     )
 
 
-def _backend_options(parser: argparse.ArgumentParser) -> None:
+def _backend_options(parser: argparse.ArgumentParser, shown: bool = True) -> None:
+    """The options of the study commands; `shown` False: the parser of another command is being run, and the
+    help text (the studies' default size, `workbench.studies` imported for it) is not needed."""
+    if shown:
+        from workbench.studies.spec import DEFAULT_MAX_RUNS
+
+        max_runs = f"{DEFAULT_MAX_RUNS:,}"
+    else:
+        max_runs = "the studies' default"
     parser.add_argument(
         "--backend", choices=("local", "dask"), default="local", help="local process pool (default) or dask"
     )
@@ -170,7 +181,7 @@ def _backend_options(parser: argparse.ArgumentParser) -> None:
         type=int,
         metavar="N",
         help=f"refuse a study of more runs than N (an optimisation: trials x runs; default: the spec's "
-        f"study.max_runs, else {DEFAULT_MAX_RUNS:,})",
+        f"study.max_runs, else {max_runs})",
     )
 
 
@@ -191,6 +202,9 @@ def _names(text: str, what: str) -> list[str]:
 def _check_inputs(args: argparse.Namespace) -> None:
     """Every input file the command names (INPUT_FILES, and a waypoint file given as the scenario) must be a
     readable file: checked before any work."""
+    from workbench.input_files import check_input_file
+    from workbench.scenarios import SCENARIOS
+
     for dest, flag in INPUT_FILES.items():
         value = getattr(args, dest, None)
         if value is not None:
@@ -229,6 +243,12 @@ def _print_summary(comparison: Comparison) -> None:
 
 
 def _compare(args: argparse.Namespace) -> int:
+    from workbench.comparison import RunSpec, compare, warn_on_stderr
+    from workbench.output_dir import OutputDir
+    from workbench.report import ReportSection, write_report
+    from workbench.scenarios import ScenarioOptions
+    from workbench.simulator import SimulationConfig
+
     out = OutputDir(args.out, "compare", args.overwrite)
     _check_inputs(args)
     runs = [
@@ -251,7 +271,9 @@ def _compare(args: argparse.Namespace) -> int:
 
 
 def _paper(args: argparse.Namespace) -> int:
+    from workbench.output_dir import OutputDir
     from workbench.paper import reproduce_paper
+    from workbench.scenarios import ScenarioOptions, make_scenario
 
     out = OutputDir(args.out, "paper", args.overwrite)
     _check_inputs(args)
@@ -268,6 +290,10 @@ def _paper(args: argparse.Namespace) -> int:
 
 
 def _fig17(args: argparse.Namespace) -> int:
+    from workbench.fig17 import run_fig17
+    from workbench.output_dir import OutputDir
+    from workbench.simulator import SimulationConfig
+
     out = OutputDir(args.out, "fig17", args.overwrite)
     result = run_fig17(SimulationConfig(speed_kmh=args.speed))
     with _writing(out):
@@ -298,6 +324,7 @@ def _interruptible(study: Callable[[], int], out: Path) -> int:
 def _start_study(args: argparse.Namespace, kind: str) -> tuple[StudySpec, Backend]:
     """Check the output folder (a study's resumable store: `check_study_dir`) and the spec (every file it names,
     the study's size), start nothing yet but the folder and the spec's copy in it."""
+    from workbench.output_dir import check_study_dir
     from workbench.studies import load_spec, make_backend
 
     check_study_dir(args.out)
@@ -373,6 +400,15 @@ def _optimise(args: argparse.Namespace) -> int:
 
 
 def _run(args: argparse.Namespace) -> int:
+    from controllers import make_controller
+    from controllers.config_file import read_controller_config
+    from workbench.comparison import warn_on_stderr
+    from workbench.limit_cycle import detect_limit_cycle
+    from workbench.output_dir import OutputDir
+    from workbench.scenarios import ScenarioOptions, make_scenario
+    from workbench.simulator import Simulation, SimulationConfig
+    from workbench.vehicles import make_vehicle
+
     out = OutputDir(args.out, "run", args.overwrite)
     _check_inputs(args)
     name = args.vehicle if args.vehicle or args.vehicle_file else "kinematic-bicycle"
@@ -426,29 +462,46 @@ def _run(args: argparse.Namespace) -> int:
     return 0
 
 
+def _scenarios(args: argparse.Namespace) -> None:
+    from workbench.scenarios import ScenarioOptions, describe_scenarios
+
+    _check_inputs(args)
+    for name, description in describe_scenarios(ScenarioOptions(track_file=args.track)):
+        print(f"{name:<12} {description}")
+
+
+def _vehicles(args: argparse.Namespace) -> None:
+    from workbench.vehicles import VEHICLES, list_presets, preset_text
+
+    if args.show:
+        print(preset_text(args.show), end="")
+    else:
+        for name, description in list_presets().items():
+            print(f"{name:<20} {description}\n{'':<20} {VEHICLES[name]().describe()}")
+
+
+def _controllers(args: argparse.Namespace) -> None:
+    from controllers.config_file import config_template
+
+    if args.show:
+        if args.show not in CONTROLLERS:
+            raise WorkbenchInputError(f"unknown controller {args.show!r}; choose one of {', '.join(CONTROLLERS)}")
+        print(config_template(args.show, CONTROLLERS[args.show].config_type), end="")
+        return
+    for name, cls in CONTROLLERS.items():
+        print(f"{name:<14} {cls.summary()}")
+
+
 def main(argv: Sequence[str] | None = None) -> int:
-    args = _parser().parse_args(argv)
+    argv = sys.argv[1:] if argv is None else list(argv)
+    args = _parser(_command_word(argv)).parse_args(argv)
     try:
         if args.command == "scenarios":
-            _check_inputs(args)
-            for name, description in describe_scenarios(ScenarioOptions(track_file=args.track)):
-                print(f"{name:<12} {description}")
+            _scenarios(args)
         elif args.command == "vehicles":
-            if args.show:
-                print(preset_text(args.show), end="")
-            else:
-                for name, description in list_presets().items():
-                    print(f"{name:<20} {description}\n{'':<20} {VEHICLES[name]().describe()}")
+            _vehicles(args)
         elif args.command == "controllers":
-            if args.show:
-                if args.show not in CONTROLLERS:
-                    raise WorkbenchInputError(
-                        f"unknown controller {args.show!r}; choose one of {', '.join(CONTROLLERS)}"
-                    )
-                print(config_template(args.show, CONTROLLERS[args.show].config_type), end="")
-                return 0
-            for name, cls in CONTROLLERS.items():
-                print(f"{name:<14} {cls.summary()}")
+            _controllers(args)
         elif args.command == "compare":
             return _compare(args)
         elif args.command == "fig17":
@@ -465,6 +518,15 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"workbench: error: {exc}", file=sys.stderr)
         return EXIT_INPUT_ERROR
     return 0
+
+
+def __getattr__(name: str) -> object:
+    """`workbench.cli.Simulation` (tests patch its `run`): the simulator, imported on first use."""
+    if name == "Simulation":
+        from workbench.simulator import Simulation
+
+        return Simulation
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 if __name__ == "__main__":

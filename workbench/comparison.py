@@ -28,7 +28,6 @@ import pandas as pd
 
 from controllers import CONTROLLERS, make_controller
 from controllers.config_file import read_controller_config
-from workbench import plots
 from workbench.errors import WorkbenchInputError
 from workbench.limit_cycle import LimitCycle, detect_limit_cycle
 from workbench.metrics import METRIC_KEYS
@@ -165,15 +164,23 @@ class Comparison:
 
     # Figures 17 and 18: every run on one axis; each returns the axes.
     def plot_trajectories(self, ax: Axes | None = None) -> Axes:
+        from workbench import plots
+
         return plots.trajectories(self.results, self.labels, ax)
 
     def plot_cte(self, ax: Axes | None = None) -> Axes:
+        from workbench import plots
+
         return plots.cte_comparison(self.results, self.labels, ax)
 
     def plot_speed(self, ax: Axes | None = None) -> Axes:
+        from workbench import plots
+
         return plots.speed_comparison(self.results, self.labels, ax)
 
     def plot_steering(self, ax: Axes | None = None) -> Axes:
+        from workbench import plots
+
         return plots.steering_comparison(self.results, self.labels, ax)
 
     @property

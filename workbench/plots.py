@@ -1,6 +1,9 @@
 """Plots of one run (trajectory over the reference with cones, CTE vs distance, steering vs time, speed), and of
 several runs on shared axes (the paper's Figures 17 and 18: `trajectories`, `cte_comparison`, `speed_comparison`,
-`steering_comparison`)."""
+`steering_comparison`).
+
+matplotlib.pyplot is imported where a figure is drawn, not with this module (issue 17): `workbench.result`
+and the CLI's startup need none of it."""
 
 from __future__ import annotations
 
@@ -8,7 +11,6 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-import matplotlib.pyplot as plt
 import numpy as np
 
 if TYPE_CHECKING:
@@ -19,6 +21,8 @@ if TYPE_CHECKING:
 
 def _axes(ax: Axes | None) -> Axes:
     if ax is None:
+        import matplotlib.pyplot as plt
+
         _, ax = plt.subplots(figsize=(8, 4.5), layout="constrained")
     return ax
 
@@ -87,6 +91,8 @@ RUN_PLOTS = {
 
 def save_run_plots(result: SimulationResult, out_dir: Path) -> list[Path]:
     """Write the four standard plots of a run as PNG files in out_dir."""
+    import matplotlib.pyplot as plt
+
     written = []
     for filename, draw in RUN_PLOTS.items():
         ax = draw(result, None)

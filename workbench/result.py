@@ -9,14 +9,13 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
-import pandas as pd
 
-from workbench import plots
 from workbench.metrics import Metrics, compute_metrics
 from workbench.path import ReferencePath
 from workbench.scenarios import Scenario
 
 if TYPE_CHECKING:
+    import pandas as pd
     from matplotlib.axes import Axes
 
     from workbench.simulator import SimulationConfig
@@ -69,25 +68,37 @@ class SimulationResult:
 
     def to_pandas(self) -> pd.DataFrame:
         """The trace as a DataFrame, one row per controller step."""
+        import pandas as pd
+
         return pd.DataFrame(self.trace)
 
     # Plots: each draws on the given axes (or a new figure) and returns the axes.
     def plot_trajectory(self, ax: Axes | None = None) -> Axes:
+        from workbench import plots
+
         return plots.trajectory(self, ax)
 
     def plot_cte(self, ax: Axes | None = None) -> Axes:
+        from workbench import plots
+
         return plots.cte_vs_distance(self, ax)
 
     def plot_steering(self, ax: Axes | None = None) -> Axes:
+        from workbench import plots
+
         return plots.steering_vs_time(self, ax)
 
     def plot_speed(self, ax: Axes | None = None) -> Axes:
+        from workbench import plots
+
         return plots.speed_vs_distance(self, ax)
 
     def save(self, out_dir: str | Path, with_plots: bool = True) -> list[Path]:
         """Write trace.parquet, metrics.json (plus status and message) and the PNG plots; return the paths. The
         files a run writes that are already in out_dir (an earlier run's, the plots included when with_plots is
         False) are removed first, so the folder never holds files of two runs."""
+        from workbench import plots  # matplotlib itself only when the plots are drawn
+
         out = Path(out_dir)
         out.mkdir(parents=True, exist_ok=True)
         for name in ("trace.parquet", "metrics.json", *plots.RUN_PLOTS):
