@@ -48,21 +48,25 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy import linalg, optimize, signal, sparse
+from scipy import optimize, signal, sparse
 from threadpoolctl import threadpool_limits
 
 from tuning.log_file import VehicleLog
 from tuning.savgol import savgol_matrix
 from workbench.errors import WorkbenchInputError, require_in_range, require_positive
 from workbench.vehicles.base import VehicleGeometry
-from workbench.vehicles.steering_lag import SteeringLag
+from workbench.vehicles.steering_lag import (
+    DELAY_BOUNDS,
+    GAIN_BOUNDS,
+    OMEGA_N_BOUNDS,
+    ZETA_BOUNDS,
+    SteeringLag,
+    simulate_lag,
+)
 
 CURVATURE_SOURCES = ("auto", "path", "yaw-rate")
-#: Bounds of the fitted parameters: those of the steering-lag file, and a steady-state gain in [0.05, 20].
-OMEGA_N_BOUNDS = (0.05, 200.0)
-ZETA_BOUNDS = (0.05, 10.0)
-GAIN_BOUNDS = (0.05, 20.0)
-DELAY_BOUNDS = (0.0, 2.0)
+# The bounds of the fitted parameters are those of the steering-lag file (OMEGA_N_BOUNDS, ZETA_BOUNDS, GAIN_BOUNDS,
+# DELAY_BOUNDS, imported from workbench.vehicles.steering_lag, the lag's one home, as is simulate_lag).
 #: The largest zeta of a fit with a delay (LagFitOptions.max_zeta's default then; module docstring).
 DELAY_FIT_MAX_ZETA = 2.0
 #: The coarse grid the fit starts from: omega_n (rad/s), zeta, and (fitting a delay) the delay (s).
@@ -262,41 +266,6 @@ def simulate_unit_dc(num: np.ndarray, den: np.ndarray, u: np.ndarray, dt_s: floa
     b = np.ravel(b)
     zi = signal.lfilter_zi(b, a) * u[0]
     return signal.lfilter(b, a, u, zi=zi)[0]
-
-
-def _lag_coefficients(omega_n: float, zeta: float, dt_s: float) -> tuple[np.ndarray, np.ndarray]:
-    """(b, a) of Eq. 5 discretised with a first-order hold at dt_s: scipy's cont2discrete "foh" formulas, written
-    out for the 2-state realisation x1' = x2, x2' = -wn^2 x1 - 2 zeta wn x2 + u, y = wn^2 x1 (the fit calls this
-    thousands of times; cont2discrete on a transfer function takes about five times longer)."""
-    a = np.array([[0.0, 1.0], [-(omega_n**2), -2.0 * zeta * omega_n]])
-    em = np.zeros((4, 4))
-    em[:2, :2] = a * dt_s
-    em[1, 2] = dt_s
-    em[2, 3] = 1.0
-    ms = linalg.expm(em)
-    ad, ms12, ms13 = ms[:2, :2], ms[:2, 2], ms[:2, 3]
-    bd = ms12 - ms13 + ad @ ms13
-    c = np.array([omega_n**2, 0.0])
-    dd = float(c @ ms13)
-    # transfer function C adj(zI - Ad) Bd / det(zI - Ad) + Dd, with adj(zI - Ad) = z I + [[-a22, a12], [a21, -a11]]
-    trace, det = ad[0, 0] + ad[1, 1], ad[0, 0] * ad[1, 1] - ad[0, 1] * ad[1, 0]
-    adj = np.array([[-ad[1, 1], ad[0, 1]], [ad[1, 0], -ad[0, 0]]])
-    den = np.array([1.0, -trace, det])
-    num = dd * den + np.array([0.0, float(c @ bd), float(c @ adj @ bd)])
-    return num, den
-
-
-def simulate_lag(
-    u: np.ndarray, dt_s: float, omega_n: float, zeta: float, gain: float = 1.0, delay_s: float = 0.0
-) -> np.ndarray:
-    """K G_lag(s) e^(-s delay) (Eq. 5) driven by u sampled every dt_s, from the steady state of u[0] (first-order
-    hold, as simulate_unit_dc); the delay shifts u by linear interpolation, holding u[0] before the start."""
-    u = np.asarray(u, dtype=float)
-    if delay_s > 0.0:
-        t = np.arange(u.size) * dt_s
-        u = np.interp(t - delay_s, t, u)
-    b, a = _lag_coefficients(omega_n, zeta, dt_s)
-    return gain * signal.lfilter(b, a, u, zi=signal.lfilter_zi(b, a) * u[0])[0]
 
 
 def _check_log(log: VehicleLog, options: LagFitOptions) -> None:

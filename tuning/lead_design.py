@@ -84,7 +84,6 @@ from tuning.lag_fit import (
     SteeringGeometry,
     kinematic_curvature,
     realised_curvature,
-    simulate_lag,
     simulate_unit_dc,
 )
 from tuning.log_file import VehicleLog
@@ -139,7 +138,7 @@ class LeadDesign:
     def transfer_functions(self) -> tuple[control.TransferFunction, control.TransferFunction, control.TransferFunction]:
         """(plant G_lag, compensator G_lead, cascade G_lead G_lag) as python-control transfer functions (without
         the lag's delay, if any: `frequency_response` includes it)."""
-        plant = lag_transfer_function(self.lag)
+        plant = self.lag.transfer_function(with_gain=False)
         lead = self.params.transfer_function()
         return plant, lead, lead * plant
 
@@ -200,12 +199,6 @@ class LeadDesign:
         )
 
 
-def lag_transfer_function(lag: SteeringLag) -> control.TransferFunction:
-    """Eq. 5 (without its delay) as a python-control transfer function."""
-    wn, zeta = lag.omega_n_rad_s, lag.zeta
-    return control.tf([wn**2], [1.0, 2.0 * zeta * wn, wn**2])
-
-
 def _first_crossing(w: np.ndarray, excess: np.ndarray) -> np.ndarray:
     """First frequency (log-interpolated) where `excess` (..., n), negative at w[0], becomes >= 0; w[-1] if never."""
     above = excess >= 0.0
@@ -228,11 +221,10 @@ class _Problem:
     """The design problem on a frequency grid relative to wn, vectorised over candidate filters."""
 
     def __init__(self, lag: SteeringLag, max_lead_gain: float, max_cascade_peak_db: float) -> None:
-        wn, zeta = lag.omega_n_rad_s, lag.zeta
+        wn = lag.omega_n_rad_s
         self.wn = wn
         self.w = wn * np.logspace(*_OMEGA_DECADES, _OMEGA_POINTS)
-        s = 1j * self.w
-        self.plant = wn**2 / (s * s + 2.0 * zeta * wn * s + wn**2)
+        self.plant = lag.frequency_response(self.w, with_gain=False, with_delay=False)
         self.max_lead = max_lead_gain
         self.max_cascade = 10 ** (max_cascade_peak_db / 20)
 
@@ -311,7 +303,7 @@ def _report(
     phase_frequency_rad_s: float | None,
 ) -> LeadDesign:
     """A LeadDesign for these parameters, measured with python-control independently of any search grid."""
-    plant = lag_transfer_function(lag)
+    plant = lag.transfer_function(with_gain=False)
     cascade = params.transfer_function() * plant
     plant_bw = float(control.bandwidth(plant))
     omega = phase_frequency_rad_s if phase_frequency_rad_s is not None else plant_bw
@@ -358,12 +350,10 @@ def validate(design: LeadDesign, log: VehicleLog, geometry: VehicleGeometry | St
     curvature more closely than the lagged one does."""
     lag = design.lag
     kin = kinematic_curvature(log.steer_wheel_rad, geometry)
-    lagged = simulate_lag(kin, log.dt_s, lag.omega_n_rad_s, lag.zeta, 1.0, lag.delay_s)
+    lagged = lag.simulate(kin, log.dt_s, with_gain=False)
     lead = design.params.transfer_function()
     filtered_wheel = simulate_unit_dc(lead.num[0][0], lead.den[0][0], log.steer_wheel_rad, log.dt_s)
-    compensated = simulate_lag(
-        kinematic_curvature(filtered_wheel, geometry), log.dt_s, lag.omega_n_rad_s, lag.zeta, 1.0, lag.delay_s
-    )
+    compensated = lag.simulate(kinematic_curvature(filtered_wheel, geometry), log.dt_s, with_gain=False)
     measured = None
     if log.has_positions or log.has_yaw_rate:
         measured, _ = realised_curvature(log, LagFitOptions())

@@ -182,17 +182,14 @@ def _plant_parts(
     require_positive("speed_mps", speed_mps)
     dt, v, kr = settings.sample_time_s, float(speed_mps), float(path_curvature_1pm)
     path, measured = lags.path, lags.measured or lags.path
-    wn, zeta, gain = path.omega_n_rad_s, path.zeta, path.steady_state_gain
-    mn, mz, mk = measured.omega_n_rad_s, measured.zeta, measured.steady_state_gain
-    # states: path lag (2), psi, y, measured lag (2)
+    # states: path lag (2), psi, y, measured lag (2); each lag as SteeringLag's [y, y'] realisation, its gain K here
     a_c = np.zeros((6, 6))
-    a_c[0, 1], a_c[1, 0], a_c[1, 1] = 1.0, -(wn**2), -2.0 * zeta * wn
-    a_c[2, 0], a_c[2, 3], a_c[3, 2] = v * gain, -v * kr * kr, v
-    a_c[4, 5], a_c[5, 4], a_c[5, 5] = 1.0, -(mn**2), -2.0 * mz * mn
     b_c = np.zeros((6, 2))
-    b_c[1, 0], b_c[5, 1] = wn**2, mn**2
+    a_c[0:2, 0:2], b_c[0:2, 0] = path.companion_matrices()
+    a_c[4:6, 4:6], b_c[4:6, 1] = measured.companion_matrices()
+    a_c[2, 0], a_c[2, 3], a_c[3, 2] = v * path.steady_state_gain, -v * kr * kr, v
     c_c = np.zeros((3, 6))
-    c_c[0, 3], c_c[1, 2], c_c[2, 4] = 1.0, 1.0, mk
+    c_c[0, 3], c_c[1, 2], c_c[2, 4] = 1.0, 1.0, measured.steady_state_gain
     a, b, c, d, _ = signal.cont2discrete((a_c, b_c, c_c, np.zeros((3, 2))), dt, method="zoh")
     extra = settings.measurement_delay_s
     taps = (_delay_steps(path.delay_s + extra, dt), _delay_steps(measured.delay_s + extra, dt))

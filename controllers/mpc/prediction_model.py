@@ -418,19 +418,10 @@ class PredictionModel:
             assert lag is not None
             # States are curvatures times the wheelbase (L kappa, dimensionless, about the road-wheel angle) so that
             # they are of the size of the other states: the QP then needs no scaling.
-            curvature, curvature_rate = x[2], x[3]
+            # States: L kappa_v, its rate, and the delay's first-order Pade state if any (SteeringLag's ODE).
             kinematic = lag.steady_state_gain * ca.tan(delta_c)  # K tan(delta_c): the settled L kappa
-            wn, zeta = lag.omega_n_rad_s, lag.zeta
-            if lag.delay_s > 0.0:  # first-order Pade: exp(-sT) ~ (1 - sT/2) / (1 + sT/2) = 2 w - 1, w' = 2/T (in - w)
-                w = x[4]
-                lag_input = 2.0 * w - kinematic
-                w_dot = 2.0 / lag.delay_s * (kinematic - w)
-            else:
-                lag_input = kinematic
-            states_dot = [curvature_rate, wn * wn * (lag_input - curvature) - 2.0 * zeta * wn * curvature_rate]
-            if lag.delay_s > 0.0:
-                states_dot.append(w_dot)
-            v_rear, yaw_rate = 0.0, v * curvature / wheelbase
+            states_dot = lag.state_derivatives([x[2 + i] for i in range(lag.ode_state_count)], kinematic)
+            v_rear, yaw_rate = 0.0, v * x[2] / wheelbase
         scale = ca.fmax(1.0 - kappa * e_y, _MIN_FRENET_SCALE)
         s_dot = (v * ca.cos(e_psi) - v_rear * ca.sin(e_psi)) / scale
         e_y_dot = v * ca.sin(e_psi) + v_rear * ca.cos(e_psi)
@@ -512,9 +503,7 @@ class PredictionModel:
         elif self.kind == "kinematic-lag":
             lag = prm.lag
             assert lag is not None
-            fastest = lag.omega_n_rad_s * (lag.zeta + math.sqrt(max(lag.zeta**2 - 1.0, 0.0)))
-            if lag.delay_s > 0.0:
-                fastest = max(fastest, 2.0 / lag.delay_s)
+            fastest = lag.fastest_rate_per_s
         return max(1, math.ceil(step_s * fastest / RK4_STABILITY_MARGIN - 1e-9))
 
     def discrete(self, step_s: float, substeps: int, name: str = "F") -> ca.Function:
