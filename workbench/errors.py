@@ -55,7 +55,7 @@ def require_in_range(name: str, value: float, low: float, high: float, unit: str
     """Raise WorkbenchInputError unless low <= value <= high (and finite)."""
     if is_number(value) and math.isfinite(value) and low <= value <= high:
         return  # the message is built only for a value refused (parameters are checked on every controller step)
-    bounds = f"[{value_text(low)}, {value_text(high)}] {unit}"
+    bounds = f"[{value_text(low)}, {value_text(high)}]" + (f" {unit}" if unit else "")
     if not is_number(value) or not math.isfinite(value):
         raise WorkbenchInputError(f"{name} must be a finite number in {bounds}; got {value_text(value)}")
     raise WorkbenchInputError(f"{name} must be in {bounds}; got {value_text(value)}".replace("  ", " "))

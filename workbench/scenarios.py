@@ -12,13 +12,14 @@ import os
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from workbench.clothoid_chain import ClothoidChain
 from workbench.errors import WorkbenchInputError, require_in_range
-from workbench.path import ReferencePath
-from workbench.waypoints import Waypoints
+
+if TYPE_CHECKING:
+    from workbench.path import ReferencePath
 
 #: Environment variable naming the TUMFTM Zandvoort centre-line CSV when --track is not given.
 ZANDVOORT_ENV = "WORKBENCH_ZANDVOORT_CSV"
@@ -91,6 +92,8 @@ def figure8(options: ScenarioOptions, radius_m: float = 22.0, transition_m: floa
     to zero). The straight's length is solved so that each lobe is symmetric about the x axis, which closes the
     loop exactly. Minimum radius `radius_m` (default 22 m).
     """
+    from workbench.clothoid_chain import ClothoidChain
+
     kappa = 1.0 / radius_m
     lobe_turn = 1.5 * math.pi
     arc_length = lobe_turn / kappa - transition_m  # kappa * Lc / 2 * 2 + kappa * La = lobe turn
@@ -115,8 +118,12 @@ def figure8(options: ScenarioOptions, radius_m: float = 22.0, transition_m: floa
     return Scenario(
         "figure8",
         chain.to_path("figure8", closed=True, closure_tol_m=1e-6),
-        f"figure-8, two 270-degree lobes of radius {radius_m:g} m through a self-crossing, clothoid transitions",
+        _figure8_description(radius_m),
     )
+
+
+def _figure8_description(radius_m: float = 22.0) -> str:
+    return f"figure-8, two 270-degree lobes of radius {radius_m:g} m through a self-crossing, clothoid transitions"
 
 
 # ---------------------------------------------------------------------------------------------- ISO 3888-1
@@ -175,26 +182,36 @@ class DoubleLaneChangeLayout:
 
 def double_lane_change(options: ScenarioOptions) -> Scenario:
     """ISO 3888-1 double lane change laid out for the vehicle's width, with run-in and run-out straights."""
+    from workbench.path import ReferencePath
+    from workbench.waypoints import Waypoints
+
     layout = DoubleLaneChangeLayout(options.vehicle_width_m)
     x = np.arange(0.0, layout.section_starts_m[-1] + layout.run_out_m + 1e-9, 0.5)
     path = ReferencePath.from_waypoints(Waypoints(x, layout.centre_line(x), source="dlc"), name="dlc")
+    return Scenario("dlc", path, _dlc_description(options), cones_xy=layout.cones())
+
+
+def _dlc_description(options: ScenarioOptions) -> str:
+    layout = DoubleLaneChangeLayout(options.vehicle_width_m)
     w1, w3, w5 = layout.lane_widths_m
-    return Scenario(
-        "dlc",
-        path,
+    return (
         f"ISO 3888-1 double lane change for a {options.vehicle_width_m:g} m wide vehicle "
-        f"(lanes {w1:.2f}/{w3:.2f}/{w5:.2f} m, centre-line offset {layout.offset_lane_centre_m:.2f} m)",
-        cones_xy=layout.cones(),
+        f"(lanes {w1:.2f}/{w3:.2f}/{w5:.2f} m, centre-line offset {layout.offset_lane_centre_m:.2f} m)"
     )
 
 
 # ---------------------------------------------------------------------------------------------- Figure 17
+FIG17_DESCRIPTION = "Figure 17 comparison path: S-bend of radius 30 m between straights, start 1.0 m left of the path"
+
+
 def fig17(options: ScenarioOptions) -> Scenario:
     """The controller-comparison path of the paper's Figure 17, built from clothoids (curvature-continuous).
 
     40 m straight; 20 m clothoid to 1/30 1/m (left); 30 m arc; 40 m clothoid to -1/30 1/m; 30 m arc; 20 m clothoid
     to 0; 60 m straight. The vehicle starts 1.0 m left of the path, heading along it.
     """
+    from workbench.clothoid_chain import ClothoidChain
+
     kappa = 1.0 / 30.0
     chain = (
         ClothoidChain()
@@ -209,7 +226,7 @@ def fig17(options: ScenarioOptions) -> Scenario:
     return Scenario(
         "fig17",
         chain.to_path("fig17"),
-        "Figure 17 comparison path: S-bend of radius 30 m between straights, start 1.0 m left of the path",
+        FIG17_DESCRIPTION,
         initial_offset_m=1.0,
     )
 
@@ -221,6 +238,12 @@ def zandvoort(options: ScenarioOptions) -> Scenario:
     The file is third-party data (LGPL-3.0) and is not shipped: pass it with --track FILE or set the environment
     variable WORKBENCH_ZANDVOORT_CSV.
     """
+    scenario = from_file(_zandvoort_track(options), options)
+    return Scenario("zandvoort", scenario.path, _zandvoort_description(options))
+
+
+def _zandvoort_track(options: ScenarioOptions) -> Path:
+    """The track file: --track, else $WORKBENCH_ZANDVOORT_CSV; WorkbenchInputError when neither names a file."""
     track = options.track_file or (Path(os.environ[ZANDVOORT_ENV]) if os.environ.get(ZANDVOORT_ENV) else None)
     if track is None:
         raise WorkbenchInputError(
@@ -229,13 +252,18 @@ def zandvoort(options: ScenarioOptions) -> Scenario:
         )
     if not Path(track).is_file():
         raise WorkbenchInputError(f"zandvoort: track file {str(track)!r} does not exist; expected {ZANDVOORT_SOURCE}")
-    scenario = from_file(Path(track), options)
-    return Scenario("zandvoort", scenario.path, "Zandvoort (TUMFTM racetrack-database centre line, closed loop)")
+    return Path(track)
+
+
+def _zandvoort_description(options: ScenarioOptions) -> str:
+    _zandvoort_track(options)
+    return "Zandvoort (TUMFTM racetrack-database centre line, closed loop)"
 
 
 # ---------------------------------------------------------------------------------------------- files
 def from_file(path: Path, options: ScenarioOptions) -> Scenario:
     """A scenario from any waypoint file (CSV x,y[,v]; TUMFTM racetrack CSV; GPS CSV with lat/lon columns)."""
+    from workbench.path import ReferencePath
     from workbench.waypoint_files import read_waypoints  # pandas and pyproj: only for a file (issue 17)
 
     waypoints = read_waypoints(path)
@@ -270,12 +298,21 @@ def make_scenario(name_or_file: str, options: ScenarioOptions | None = None) -> 
     )
 
 
+#: Each named scenario's one-line description, without building its path (`workbench scenarios` starts fast).
+DESCRIPTIONS: dict[str, Callable[[ScenarioOptions], str]] = {
+    "figure8": lambda _options: _figure8_description(),
+    "dlc": _dlc_description,
+    "fig17": lambda _options: FIG17_DESCRIPTION,
+    "zandvoort": _zandvoort_description,
+}
+
+
 def describe_scenarios(options: ScenarioOptions | None = None) -> list[tuple[str, str]]:
     """(name, one-line description) of every named scenario; a scenario that needs a missing file says so."""
     rows = []
     for name, factory in SCENARIOS.items():
         try:
-            rows.append((name, factory(options or ScenarioOptions()).description))
+            rows.append((name, DESCRIPTIONS[name](options or ScenarioOptions())))
         except WorkbenchInputError as exc:
             rows.append((name, f"{(factory.__doc__ or '').strip().splitlines()[0]} [unavailable: {exc}]"))
     return rows

@@ -4,7 +4,6 @@ symmetry, bad input, cost."""
 from __future__ import annotations
 
 import math
-import time
 from dataclasses import replace
 
 import numpy as np
@@ -156,16 +155,3 @@ def test_left_and_right_steer_mirror(speed: float, steer: float, accel: float) -
 def test_unphysical_parameters_are_rejected_naming_the_field(field: str, value: float, message: str) -> None:
     with pytest.raises(WorkbenchInputError, match=message):
         DynamicBicycle(replace(PRESET, **{field: value}))
-
-
-def test_advance_cost() -> None:
-    # Measured here: ~12 us per 20-substep advance.
-    state = CAR.initial_state(0.0, 0.0, 0.0, 10.0)
-    CAR.advance(state, 1.0, 0.0, 0.02, 20)
-    best = math.inf
-    for _ in range(5):
-        start = time.perf_counter()
-        for _ in range(200):
-            state = CAR.advance(state, 1.0, 0.0, 0.02, 20)
-        best = min(best, (time.perf_counter() - start) / 200)
-    assert best < 50e-6
