@@ -1,8 +1,9 @@
-"""The MPC prediction model: its parameters, taken from a vehicle preset, and its ODE in path coordinates.
+"""The MPC prediction model: its ODE in path coordinates, from the vehicle's single-track equivalent.
 
-`PredictionParams` is a frozen description of the vehicle as the MPC sees it; `prediction_params_for` builds it
-from a vehicle model, a preset's params dataclass, a preset name or a TOML file, or (when nothing else is known)
-from the `VehicleGeometry` a controller is given. `PredictionModel` turns it into CasADi expressions.
+`PredictionParams` (`workbench/vehicles/single_track.py`) is the vehicle as the MPC sees it, and every vehicle
+model provides its own (`VehicleModel.single_track`); `prediction_params_for` takes it from a vehicle model, a
+preset's params dataclass, a preset name or a TOML file, or (when nothing else is known) from the
+`VehicleGeometry` a controller is given. `PredictionModel` turns it into CasADi expressions.
 
 Three model kinds, all referenced at the rear-axle centre (where the paper measures CTE) in Frenet errors with
 respect to the path: e_y (cross-track error, left positive) and e_psi (heading error). Every kind has the
@@ -35,36 +36,30 @@ kinds) and omega the yaw rate (r, or v kappa_v in the kinematic kinds):
     e_psi' = omega - kappa s'.
 In the kinematic kinds e_psi is the error of the rear axle's course, which is its heading there.
 
-The tractor-semitrailer is predicted by an equivalent single track (`_truck_equivalent`): the tractor carrying the
-kingpin's share of the trailer (and payload) as a point mass at the fifth wheel, with the axle-group loads and
-cornering stiffnesses of the articulated model. In steady cornering this is exact for the tractor: the trailer
-pushes on the fifth wheel with m_trailer (l_t - e) / l_t times the lateral acceleration, as that point mass
-would, and the drive group's cornering stiffness already includes the kingpin load. It neglects the trailer's yaw
-transient (the articulation angle's own dynamics), which an identified lag file captures if one is given.
+The tractor-semitrailer is predicted by its equivalent single track (`TractorSemitrailer.single_track`): the
+tractor carrying the kingpin's share of the trailer as a point mass at the fifth wheel; it neglects the trailer's
+yaw transient, which an identified lag file captures if one is given.
 """
 
 from __future__ import annotations
 
-import dataclasses
 import functools
 import math
-from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
 
 import casadi as ca
 import numpy as np
 from numba import njit
 
-from workbench.errors import WorkbenchInputError, require_in_range, require_positive
+from workbench.errors import WorkbenchInputError
 from workbench.vehicles.base import VehicleGeometry, VehicleModel
-from workbench.vehicles.steering_lag import SteeringLag
+from workbench.vehicles.single_track import (
+    PredictionParams,
+    SingleTrackParams,
+    params_from_geometry,
+)
 
-G_MPS2 = 9.81
 MODEL_KINDS = ("dynamic", "kinematic", "kinematic-lag")
-#: Steering-actuator time constant (s) assumed when only the geometry is known: an electric or hydraulic power
-#: steering position loop (the workbench presets use 0.05 s for the car and 0.1 s for the truck).
-DEFAULT_STEERING_TIME_CONSTANT_S = 0.1
 #: The RK4 step of the prediction is sub-divided until h |lambda| <= this for the fastest lateral mode at the
 #: lowest prediction speed (RK4's real stability limit is 2.785; 2.0 keeps the fast modes well damped).
 RK4_STABILITY_MARGIN = 2.0
@@ -72,265 +67,25 @@ RK4_STABILITY_MARGIN = 2.0
 _MIN_FRENET_SCALE = 0.1
 
 
-@dataclass(frozen=True)
-class SingleTrackParams:
-    """Mass, yaw inertia, axle positions and axle tyres of a single-track (bicycle) model, SI units.
-
-    Axle lateral force F = D sin(C atan(B alpha - E (B alpha - atan(B alpha)))) with peak D, shape C, curvature E
-    and B = cornering stiffness / (C D), as in the workbench plants.
-    """
-
-    mass_kg: float
-    yaw_inertia_kgm2: float
-    cg_to_front_axle_m: float
-    cg_to_rear_axle_m: float
-    front_cornering_stiffness_n_per_rad: float
-    rear_cornering_stiffness_n_per_rad: float
-    front_peak_force_n: float
-    rear_peak_force_n: float
-    tyre_shape_factor: float = 1.35
-    tyre_curvature_factor: float = 0.0
-
-    def __post_init__(self) -> None:
-        require_in_range("mass_kg", self.mass_kg, 100.0, 100_000.0, "kg")
-        require_in_range("yaw_inertia_kgm2", self.yaw_inertia_kgm2, 10.0, 5.0e6, "kg m^2")
-        require_in_range("cg_to_front_axle_m", self.cg_to_front_axle_m, 0.05, 15.0, "m")
-        require_in_range("cg_to_rear_axle_m", self.cg_to_rear_axle_m, 0.05, 15.0, "m")
-        for name in (
-            "front_cornering_stiffness_n_per_rad",
-            "rear_cornering_stiffness_n_per_rad",
-            "front_peak_force_n",
-            "rear_peak_force_n",
-        ):
-            require_positive(name, getattr(self, name))
-        require_in_range("tyre_shape_factor", self.tyre_shape_factor, 1.0, 1.9)
-        require_in_range("tyre_curvature_factor", self.tyre_curvature_factor, -5.0, 0.99)
-
-    @property
-    def wheelbase_m(self) -> float:
-        return self.cg_to_front_axle_m + self.cg_to_rear_axle_m
-
-    def understeer_gradient_rad_per_mps2(self) -> float:
-        """K in delta = L kappa + K a_y (linear tyres): (m / L) (b / Cf - a / Cr)."""
-        a, b, m = self.cg_to_front_axle_m, self.cg_to_rear_axle_m, self.mass_kg
-        cf, cr = self.front_cornering_stiffness_n_per_rad, self.rear_cornering_stiffness_n_per_rad
-        return m / (a + b) * (b / cf - a / cr)
-
-    def fastest_lateral_mode_per_s(self, speed_mps: float) -> float:
-        """|lambda|max of the linear single track's (v_y, r) dynamics at this speed (1/s)."""
-        a, b, m, iz = self.cg_to_front_axle_m, self.cg_to_rear_axle_m, self.mass_kg, self.yaw_inertia_kgm2
-        cf, cr = self.front_cornering_stiffness_n_per_rad, self.rear_cornering_stiffness_n_per_rad
-        v = speed_mps
-        mat = np.array(
-            [
-                [-(cf + cr) / (m * v), -(a * cf - b * cr) / (m * v) - v],
-                [-(a * cf - b * cr) / (iz * v), -(a * a * cf + b * b * cr) / (iz * v)],
-            ]
-        )
-        return float(np.max(np.abs(np.linalg.eigvals(mat))))
-
-
-@dataclass(frozen=True)
-class PredictionParams:
-    """The vehicle as the MPC predicts it (SI units).
-
-    wheelbase_m, steering_ratio, max_road_wheel_angle_rad, max_road_wheel_rate_rad_s: as `VehicleGeometry`;
-    steering_time_constant_s: first-order steering actuator (s); single_track: mass, inertia and tyres, or None
-    when unknown (then only the kinematic kinds are available); lag: the identified steering-wheel-to-curvature
-    lag (Eq. 5), or None; source: where the numbers came from, for messages and reports.
-    """
-
-    wheelbase_m: float
-    steering_ratio: float
-    max_road_wheel_angle_rad: float
-    max_road_wheel_rate_rad_s: float
-    steering_time_constant_s: float = DEFAULT_STEERING_TIME_CONSTANT_S
-    single_track: SingleTrackParams | None = None
-    lag: SteeringLag | None = None
-    source: str = ""
-
-    def __post_init__(self) -> None:
-        require_in_range("wheelbase_m", self.wheelbase_m, 0.5, 15.0, "m")
-        require_in_range("steering_ratio", self.steering_ratio, 1.0, 60.0)
-        require_in_range("max_road_wheel_angle_rad", self.max_road_wheel_angle_rad, 0.01, 1.5, "rad")
-        require_positive("max_road_wheel_rate_rad_s", self.max_road_wheel_rate_rad_s)
-        require_in_range("steering_time_constant_s", self.steering_time_constant_s, 1e-3, 2.0, "s")
-        if self.single_track is not None and abs(self.single_track.wheelbase_m - self.wheelbase_m) > 1e-6:
-            raise WorkbenchInputError(
-                f"single_track axle positions add up to {float(self.single_track.wheelbase_m):g} m; they must "
-                f"equal wheelbase_m = {float(self.wheelbase_m):g} m"
-            )
-
-    def with_lag(self, lag: SteeringLag | None) -> PredictionParams:
-        """A copy with this identified lag (None removes it)."""
-        return dataclasses.replace(self, lag=lag)
-
-    def default_kind(self) -> str:
-        """ "kinematic-lag" with a lag, else "dynamic" when the single track is known, else "kinematic"."""
-        if self.lag is not None:
-            return "kinematic-lag"
-        return "dynamic" if self.single_track is not None else "kinematic"
-
-
 # ---------------------------------------------------------------------------------------------- from vehicles
-def params_from_geometry(geometry: VehicleGeometry) -> PredictionParams:
-    """The default when nothing but the geometry is known: a kinematic single track with the geometry's limits
-    and an assumed actuator time constant (DEFAULT_STEERING_TIME_CONSTANT_S)."""
-    return PredictionParams(
-        wheelbase_m=geometry.wheelbase_m,
-        steering_ratio=geometry.steering_ratio,
-        max_road_wheel_angle_rad=geometry.max_road_wheel_angle_rad,
-        max_road_wheel_rate_rad_s=geometry.max_steer_wheel_rate_rad_s / geometry.steering_ratio,
-        source="geometry only (kinematic single track, assumed actuator time constant)",
-    )
-
-
-def _dynamic_bicycle(p: Any, source: str) -> PredictionParams:
-    a, b = p.cg_to_front_axle_m, p.cg_to_rear_axle_m
-    fzf, fzr = p.mass_kg * G_MPS2 * b / (a + b), p.mass_kg * G_MPS2 * a / (a + b)
-    track = SingleTrackParams(
-        mass_kg=p.mass_kg,
-        yaw_inertia_kgm2=p.yaw_inertia_kgm2,
-        cg_to_front_axle_m=a,
-        cg_to_rear_axle_m=b,
-        front_cornering_stiffness_n_per_rad=p.front_cornering_coeff_per_rad * fzf,
-        rear_cornering_stiffness_n_per_rad=p.rear_cornering_coeff_per_rad * fzr,
-        front_peak_force_n=p.tyre_friction * fzf,
-        rear_peak_force_n=p.tyre_friction * fzr,
-        tyre_shape_factor=p.tyre_shape_factor,
-        tyre_curvature_factor=p.tyre_curvature_factor,
-    )
-    return PredictionParams(
-        wheelbase_m=a + b,
-        steering_ratio=p.steering_ratio,
-        max_road_wheel_angle_rad=p.max_road_wheel_angle_rad,
-        max_road_wheel_rate_rad_s=p.max_road_wheel_rate_rad_s,
-        steering_time_constant_s=p.steering_time_constant_s,
-        single_track=track,
-        source=source,
-    )
-
-
-def _kinematic_bicycle(p: Any, source: str) -> PredictionParams:
-    return PredictionParams(
-        wheelbase_m=p.wheelbase_m,
-        steering_ratio=p.steering_ratio,
-        max_road_wheel_angle_rad=p.max_road_wheel_angle_rad,
-        max_road_wheel_rate_rad_s=p.max_road_wheel_rate_rad_s,
-        steering_time_constant_s=p.steering_time_constant_s,
-        source=source,
-    )
-
-
-def _truck_equivalent(p: Any, source: str) -> PredictionParams:
-    """Equivalent single track of the tractor-semitrailer (module docstring): the tractor plus the kingpin's share
-    of the trailer as a point mass at the fifth wheel; axle loads and cornering stiffnesses of the articulated
-    model (drive group including the kingpin load)."""
-    from workbench.vehicles.tractor_semitrailer import derive
-
-    d = derive(p)
-    l1 = p.cg_to_front_axle_m + p.cg_to_drive_axle_m
-    lt = p.hitch_to_trailer_axle_m
-    king_mass = d.m2 * (lt - d.e) / lt
-    w_front, w_drive = d.loads_n[0], d.loads_n[1]
-    mass = d.m1 + king_mass
-    # Equivalent CG from the static loads (moment balance about the axles); x forward from the drive axle.
-    b_eq = l1 * w_front / (w_front + w_drive)
-    a_eq = l1 - b_eq
-    x_tractor_cg, x_hitch = d.b, p.hitch_ahead_of_drive_m
-    inertia = d.i1 + d.m1 * (x_tractor_cg - b_eq) ** 2 + king_mass * (x_hitch - b_eq) ** 2
-    track = SingleTrackParams(
-        mass_kg=mass,
-        yaw_inertia_kgm2=inertia,
-        cg_to_front_axle_m=a_eq,
-        cg_to_rear_axle_m=b_eq,
-        front_cornering_stiffness_n_per_rad=p.front_cornering_coeff_per_rad * w_front,
-        rear_cornering_stiffness_n_per_rad=p.drive_cornering_coeff_per_rad * w_drive,
-        front_peak_force_n=p.tyre_friction * w_front,
-        rear_peak_force_n=p.tyre_friction * w_drive,
-        tyre_shape_factor=p.tyre_shape_factor,
-        tyre_curvature_factor=0.0,
-    )
-    return PredictionParams(
-        wheelbase_m=l1,
-        steering_ratio=p.steering_ratio,
-        max_road_wheel_angle_rad=p.max_road_wheel_angle_rad,
-        max_road_wheel_rate_rad_s=p.max_road_wheel_rate_rad_s,
-        steering_time_constant_s=p.steering_time_constant_s,
-        single_track=track,
-        source=source + " (equivalent single track: tractor + kingpin share of the trailer at the fifth wheel)",
-    )
-
-
-def _commonroad_mb(p: Any, source: str) -> PredictionParams:
-    """CommonRoad's car parameters (vehicle 1-3) as a single track with CommonRoad's tyre coefficients."""
-    from vehiclemodels.parameters_vehicle1 import parameters_vehicle1
-    from vehiclemodels.parameters_vehicle2 import parameters_vehicle2
-    from vehiclemodels.parameters_vehicle3 import parameters_vehicle3
-
-    cr = {1: parameters_vehicle1, 2: parameters_vehicle2, 3: parameters_vehicle3}[p.vehicle_id]()
-    a, b, m = float(cr.a), float(cr.b), float(cr.m)
-    fzf, fzr = m * G_MPS2 * b / (a + b), m * G_MPS2 * a / (a + b)
-    tyre = cr.tire
-    track = SingleTrackParams(
-        mass_kg=m,
-        yaw_inertia_kgm2=float(cr.I_z),
-        cg_to_front_axle_m=a,
-        cg_to_rear_axle_m=b,
-        front_cornering_stiffness_n_per_rad=-float(tyre.p_ky1) * fzf,
-        rear_cornering_stiffness_n_per_rad=-float(tyre.p_ky1) * fzr,
-        front_peak_force_n=float(tyre.p_dy1) * fzf,
-        rear_peak_force_n=float(tyre.p_dy1) * fzr,
-        tyre_shape_factor=float(tyre.p_cy1),
-        tyre_curvature_factor=float(tyre.p_ey1),
-    )
-    return PredictionParams(
-        wheelbase_m=a + b,
-        steering_ratio=p.steering_ratio,
-        max_road_wheel_angle_rad=float(cr.steering.max),
-        max_road_wheel_rate_rad_s=float(cr.steering.v_max),
-        steering_time_constant_s=p.steering_time_constant_s,
-        single_track=track,
-        source=source + f" (CommonRoad vehicle {p.vehicle_id} as a single track)",
-    )
-
-
 def prediction_params_for(vehicle: object) -> PredictionParams:
-    """Prediction parameters for a vehicle given as a `VehicleModel`, a params dataclass of one (the fields of a
-    preset), a preset name or TOML file path (str/Path), a `VehicleGeometry` (kinematic default) or already as
-    `PredictionParams`."""
-    from workbench.vehicles import (
-        CommonRoadMBParams,
-        DynamicBicycleParams,
-        KinematicBicycleParams,
-        TractorSemitrailerParams,
-        load_vehicle,
-    )
+    """Prediction parameters for a vehicle given as a `VehicleModel` (its `single_track`), a params dataclass of
+    one (the fields of a preset), a preset name or TOML file path (str/Path), a `VehicleGeometry` (kinematic
+    default) or already as `PredictionParams`."""
+    from workbench.vehicles import load_vehicle
+    from workbench.vehicles.presets import MODEL_TYPES
 
     if isinstance(vehicle, PredictionParams):
         return vehicle
     if isinstance(vehicle, VehicleGeometry):
         return params_from_geometry(vehicle)
-    source = f"{type(vehicle).__name__} parameters"
     if isinstance(vehicle, str | Path):
-        source = f"vehicle {str(vehicle)!r}"
-        vehicle = load_vehicle(str(vehicle))
-    elif isinstance(vehicle, VehicleModel):
-        source = f"the {vehicle.name} model's parameters"
+        return load_vehicle(str(vehicle)).single_track(f"vehicle {str(vehicle)!r}")
     if isinstance(vehicle, VehicleModel):
-        params = getattr(vehicle, "params", None)
-        if params is None:  # a model without a params dataclass: its geometry is all there is
-            return params_from_geometry(vehicle.geometry)
-        vehicle = params
-    builders = (
-        (DynamicBicycleParams, _dynamic_bicycle),
-        (KinematicBicycleParams, _kinematic_bicycle),
-        (TractorSemitrailerParams, _truck_equivalent),
-        (CommonRoadMBParams, _commonroad_mb),
-    )
-    for params_type, build in builders:
-        if isinstance(vehicle, params_type):
-            return build(vehicle, source)
+        return vehicle.single_track(f"the {vehicle.name} model's parameters")
+    for model_type, params_type in MODEL_TYPES.values():
+        if type(vehicle) is params_type:
+            return model_type(vehicle).single_track(f"{type(vehicle).__name__} parameters")
     raise WorkbenchInputError(
         f"cannot build an MPC prediction model from a {type(vehicle).__name__}; give a VehicleModel, a vehicle "
         "params dataclass, a preset name or TOML file, a VehicleGeometry or PredictionParams"

@@ -16,11 +16,14 @@ import math
 from abc import ABC, abstractmethod
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any, ClassVar
+from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
 
 from workbench.errors import require_in_range, require_positive
+
+if TYPE_CHECKING:
+    from workbench.vehicles.single_track import PredictionParams
 
 #: Outputs every model provides, in this order, at the reference point (rear-axle centre).
 STANDARD_OUTPUTS: tuple[str, ...] = (
@@ -131,6 +134,13 @@ class VehicleModel(ABC):
     @property
     def output_names(self) -> tuple[str, ...]:
         return STANDARD_OUTPUTS + self.extra_output_names
+
+    def single_track(self, source: str | None = None) -> PredictionParams:
+        """The vehicle's single-track equivalent, what a model-based controller predicts with (`single_track.py`);
+        this default, for a model that knows no better, is the kinematic single track of its geometry."""
+        from workbench.vehicles.single_track import params_from_geometry
+
+        return params_from_geometry(self.geometry)
 
     def describe(self) -> str:
         """One line with the key parameters, for `workbench vehicles`."""

@@ -22,6 +22,8 @@ from workbench.errors import WorkbenchInputError, require_in_range
 from workbench.vehicles.base import VehicleGeometry, VehicleModel
 from workbench.vehicles.integration import rk4_python
 from workbench.vehicles.reference_point import reference_point_python
+from workbench.vehicles.single_track import PredictionParams, SingleTrackParams
+from workbench.vehicles.tyres import G_MPS2
 
 #: CommonRoad's names of the MB states, in order (x/y are the CG; vx/vy of the sprung mass, body frame).
 _MB_STATES: tuple[str, ...] = (
@@ -105,6 +107,35 @@ class CommonRoadMB(VehicleModel):
             max_road_wheel_angle_rad=float(cr.steering.max),
             max_steer_wheel_rate_rad_s=float(cr.steering.v_max) * p.steering_ratio,
             width_m=float(cr.w),
+        )
+
+    def single_track(self, source: str | None = None) -> PredictionParams:
+        """CommonRoad's car parameters as a single track with CommonRoad's tyre coefficients."""
+        p, cr = self.params, self._cr
+        a, b, m = float(cr.a), float(cr.b), float(cr.m)
+        fzf, fzr = m * G_MPS2 * b / (a + b), m * G_MPS2 * a / (a + b)
+        tyre = cr.tire
+        track = SingleTrackParams(
+            mass_kg=m,
+            yaw_inertia_kgm2=float(cr.I_z),
+            cg_to_front_axle_m=a,
+            cg_to_rear_axle_m=b,
+            front_cornering_stiffness_n_per_rad=-float(tyre.p_ky1) * fzf,
+            rear_cornering_stiffness_n_per_rad=-float(tyre.p_ky1) * fzr,
+            front_peak_force_n=float(tyre.p_dy1) * fzf,
+            rear_peak_force_n=float(tyre.p_dy1) * fzr,
+            tyre_shape_factor=float(tyre.p_cy1),
+            tyre_curvature_factor=float(tyre.p_ey1),
+        )
+        source = source or f"the {self.name} model's parameters"
+        return PredictionParams(
+            wheelbase_m=a + b,
+            steering_ratio=p.steering_ratio,
+            max_road_wheel_angle_rad=float(cr.steering.max),
+            max_road_wheel_rate_rad_s=float(cr.steering.v_max),
+            steering_time_constant_s=p.steering_time_constant_s,
+            single_track=track,
+            source=source + f" (CommonRoad vehicle {p.vehicle_id} as a single track)",
         )
 
     def initial_state(self, x_m: float, y_m: float, yaw_rad: float, speed_mps: float) -> np.ndarray:

@@ -26,6 +26,7 @@ from workbench.vehicles.base import CompiledVehicleModel, VehicleGeometry
 from workbench.vehicles.blend import blend, blend_weight, check_blend_speeds, pull
 from workbench.vehicles.integration import rk4
 from workbench.vehicles.reference_point import reference_point, world_velocity
+from workbench.vehicles.single_track import PredictionParams, SingleTrackParams
 from workbench.vehicles.tyres import G_MPS2, magic_formula, relaxation_rate, slip_angle, steered_slip_angle
 
 
@@ -181,3 +182,31 @@ class DynamicBicycle(CompiledVehicleModel):
         arr[P_BR] = p.rear_cornering_coeff_per_rad / (p.tyre_shape_factor * p.tyre_friction)
         self._p = arr
         self._geometry = VehicleGeometry.from_params(p, p.wheelbase_m)
+
+    def single_track(self, source: str | None = None) -> PredictionParams:
+        """This model as a single track: its axles, static axle loads, tyres (cornering stiffness = coefficient x
+        load, peak = friction x load) and actuator."""
+        p = self.params
+        a, b = p.cg_to_front_axle_m, p.cg_to_rear_axle_m
+        fzf, fzr = p.mass_kg * G_MPS2 * b / (a + b), p.mass_kg * G_MPS2 * a / (a + b)
+        track = SingleTrackParams(
+            mass_kg=p.mass_kg,
+            yaw_inertia_kgm2=p.yaw_inertia_kgm2,
+            cg_to_front_axle_m=a,
+            cg_to_rear_axle_m=b,
+            front_cornering_stiffness_n_per_rad=p.front_cornering_coeff_per_rad * fzf,
+            rear_cornering_stiffness_n_per_rad=p.rear_cornering_coeff_per_rad * fzr,
+            front_peak_force_n=p.tyre_friction * fzf,
+            rear_peak_force_n=p.tyre_friction * fzr,
+            tyre_shape_factor=p.tyre_shape_factor,
+            tyre_curvature_factor=p.tyre_curvature_factor,
+        )
+        return PredictionParams(
+            wheelbase_m=a + b,
+            steering_ratio=p.steering_ratio,
+            max_road_wheel_angle_rad=p.max_road_wheel_angle_rad,
+            max_road_wheel_rate_rad_s=p.max_road_wheel_rate_rad_s,
+            steering_time_constant_s=p.steering_time_constant_s,
+            single_track=track,
+            source=source or f"the {self.name} model's parameters",
+        )

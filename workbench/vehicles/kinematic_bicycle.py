@@ -20,6 +20,7 @@ from workbench.errors import require_in_range, require_positive
 from workbench.vehicles.actuator import realised_accel, road_wheel_rate
 from workbench.vehicles.base import CompiledVehicleModel, VehicleGeometry
 from workbench.vehicles.integration import rk4
+from workbench.vehicles.single_track import PredictionParams
 
 
 @dataclass(frozen=True)
@@ -82,3 +83,15 @@ class KinematicBicycle(CompiledVehicleModel):
         x, y, yaw, v, delta = state
         yaw_rate = v * math.tan(delta) / self.params.wheelbase_m
         return np.array([x, y, yaw, v, 0.0, yaw_rate, delta * self.params.steering_ratio, delta, v * yaw_rate])
+
+    def single_track(self, source: str | None = None) -> PredictionParams:
+        """The kinematic single track with this model's actuator (no tyres)."""
+        p = self.params
+        return PredictionParams(
+            wheelbase_m=p.wheelbase_m,
+            steering_ratio=p.steering_ratio,
+            max_road_wheel_angle_rad=p.max_road_wheel_angle_rad,
+            max_road_wheel_rate_rad_s=p.max_road_wheel_rate_rad_s,
+            steering_time_constant_s=p.steering_time_constant_s,
+            source=source or f"the {self.name} model's parameters",
+        )

@@ -38,6 +38,7 @@ from workbench.vehicles.base import CompiledVehicleModel, VehicleGeometry
 from workbench.vehicles.blend import blend, blend_weight, check_blend_speeds, pull
 from workbench.vehicles.integration import rk4
 from workbench.vehicles.reference_point import reference_point, world_velocity
+from workbench.vehicles.single_track import PredictionParams, SingleTrackParams
 from workbench.vehicles.tyres import G_MPS2, magic_formula, relaxation_rate, slip_angle, steered_slip_angle
 
 
@@ -423,6 +424,45 @@ class TractorSemitrailer(CompiledVehicleModel):
         arr[P_KF1:P_N] = np.ravel(dv.ltr_per_ay)
         self._p = arr
         self._geometry = VehicleGeometry.from_params(p, p.cg_to_front_axle_m + p.cg_to_drive_axle_m)
+
+    def single_track(self, source: str | None = None) -> PredictionParams:
+        """Equivalent single track (module docstring): the tractor plus the kingpin's share of the trailer as a
+        point mass at the fifth wheel; axle loads and cornering stiffnesses of the articulated model (drive group
+        including the kingpin load). Exact for the tractor in steady cornering; it neglects the trailer's yaw
+        transient, which an identified lag captures."""
+        p, d = self.params, self.derived
+        l1 = p.cg_to_front_axle_m + p.cg_to_drive_axle_m
+        lt = p.hitch_to_trailer_axle_m
+        king_mass = d.m2 * (lt - d.e) / lt
+        w_front, w_drive = d.loads_n[0], d.loads_n[1]
+        mass = d.m1 + king_mass
+        # Equivalent CG from the static loads (moment balance about the axles); x forward from the drive axle.
+        b_eq = l1 * w_front / (w_front + w_drive)
+        a_eq = l1 - b_eq
+        x_tractor_cg, x_hitch = d.b, p.hitch_ahead_of_drive_m
+        inertia = d.i1 + d.m1 * (x_tractor_cg - b_eq) ** 2 + king_mass * (x_hitch - b_eq) ** 2
+        track = SingleTrackParams(
+            mass_kg=mass,
+            yaw_inertia_kgm2=inertia,
+            cg_to_front_axle_m=a_eq,
+            cg_to_rear_axle_m=b_eq,
+            front_cornering_stiffness_n_per_rad=p.front_cornering_coeff_per_rad * w_front,
+            rear_cornering_stiffness_n_per_rad=p.drive_cornering_coeff_per_rad * w_drive,
+            front_peak_force_n=p.tyre_friction * w_front,
+            rear_peak_force_n=p.tyre_friction * w_drive,
+            tyre_shape_factor=p.tyre_shape_factor,
+            tyre_curvature_factor=0.0,
+        )
+        source = source or f"the {self.name} model's parameters"
+        return PredictionParams(
+            wheelbase_m=l1,
+            steering_ratio=p.steering_ratio,
+            max_road_wheel_angle_rad=p.max_road_wheel_angle_rad,
+            max_road_wheel_rate_rad_s=p.max_road_wheel_rate_rad_s,
+            steering_time_constant_s=p.steering_time_constant_s,
+            single_track=track,
+            source=source + " (equivalent single track: tractor + kingpin share of the trailer at the fifth wheel)",
+        )
 
     def describe(self) -> str:
         dv = self.derived

@@ -174,3 +174,18 @@ def test_steady_cornering_at_low_lateral_acceleration_matches_the_linear_single_
     assert out["lat_accel_mps2"] == pytest.approx(0.05 * G, rel=0.05)  # the set-up did what it says
     if k_us > 0.0:  # an understeering model turns less than the kinematic curvature of its steered unit
         assert r < u * math.tan(delta) / wb
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_the_single_track_equivalent_has_the_vehicles_geometry(name: str) -> None:
+    """What a model-based controller predicts with (`VehicleModel.single_track`) is this vehicle's: the same
+    wheelbase, steering ratio and lock; with tyres, axle positions that add up to that wheelbase."""
+    model = vehicle(name)
+    equivalent = model.single_track()
+    geometry = model.geometry
+    assert equivalent.wheelbase_m == pytest.approx(geometry.wheelbase_m, rel=1e-12)
+    assert equivalent.steering_ratio == geometry.steering_ratio
+    assert equivalent.max_road_wheel_angle_rad == pytest.approx(geometry.max_road_wheel_angle_rad, rel=1e-12)
+    assert model.name in equivalent.source
+    if equivalent.single_track is not None:
+        assert equivalent.single_track.wheelbase_m == pytest.approx(geometry.wheelbase_m, rel=1e-9)

@@ -1,0 +1,137 @@
+"""A vehicle's single-track (bicycle) equivalent: what a model-based controller predicts with.
+
+Every vehicle model offers one (`VehicleModel.single_track`): its geometry and steering actuator, and, when it has
+tyres, the mass, yaw inertia and axle tyres of a single track. The MPC's ODE is built from it (`controllers/mpc/
+prediction_model.py`), so the MPC never needs to know the vehicle classes. The tractor-semitrailer's equivalent
+carries the kingpin's share of the trailer at the fifth wheel (`TractorSemitrailer.single_track`).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from workbench.errors import WorkbenchInputError, require_in_range, require_positive
+from workbench.vehicles.steering_lag import SteeringLag
+
+if TYPE_CHECKING:
+    from workbench.vehicles.base import VehicleGeometry
+
+#: Steering-actuator time constant (s) assumed when only the geometry is known: an electric or hydraulic power
+#: steering position loop (the workbench presets use 0.05 s for the car and 0.1 s for the truck).
+DEFAULT_STEERING_TIME_CONSTANT_S = 0.1
+
+
+@dataclass(frozen=True)
+class SingleTrackParams:
+    """Mass, yaw inertia, axle positions and axle tyres of a single-track (bicycle) model, SI units.
+
+    Axle lateral force F = D sin(C atan(B alpha - E (B alpha - atan(B alpha)))) with peak D, shape C, curvature E
+    and B = cornering stiffness / (C D), as in the workbench plants.
+    """
+
+    mass_kg: float
+    yaw_inertia_kgm2: float
+    cg_to_front_axle_m: float
+    cg_to_rear_axle_m: float
+    front_cornering_stiffness_n_per_rad: float
+    rear_cornering_stiffness_n_per_rad: float
+    front_peak_force_n: float
+    rear_peak_force_n: float
+    tyre_shape_factor: float = 1.35
+    tyre_curvature_factor: float = 0.0
+
+    def __post_init__(self) -> None:
+        require_in_range("mass_kg", self.mass_kg, 100.0, 100_000.0, "kg")
+        require_in_range("yaw_inertia_kgm2", self.yaw_inertia_kgm2, 10.0, 5.0e6, "kg m^2")
+        require_in_range("cg_to_front_axle_m", self.cg_to_front_axle_m, 0.05, 15.0, "m")
+        require_in_range("cg_to_rear_axle_m", self.cg_to_rear_axle_m, 0.05, 15.0, "m")
+        for name in (
+            "front_cornering_stiffness_n_per_rad",
+            "rear_cornering_stiffness_n_per_rad",
+            "front_peak_force_n",
+            "rear_peak_force_n",
+        ):
+            require_positive(name, getattr(self, name))
+        require_in_range("tyre_shape_factor", self.tyre_shape_factor, 1.0, 1.9)
+        require_in_range("tyre_curvature_factor", self.tyre_curvature_factor, -5.0, 0.99)
+
+    @property
+    def wheelbase_m(self) -> float:
+        return self.cg_to_front_axle_m + self.cg_to_rear_axle_m
+
+    def understeer_gradient_rad_per_mps2(self) -> float:
+        """K in delta = L kappa + K a_y (linear tyres): (m / L) (b / Cf - a / Cr)."""
+        a, b, m = self.cg_to_front_axle_m, self.cg_to_rear_axle_m, self.mass_kg
+        cf, cr = self.front_cornering_stiffness_n_per_rad, self.rear_cornering_stiffness_n_per_rad
+        return m / (a + b) * (b / cf - a / cr)
+
+    def fastest_lateral_mode_per_s(self, speed_mps: float) -> float:
+        """|lambda|max of the linear single track's (v_y, r) dynamics at this speed (1/s)."""
+        a, b, m, iz = self.cg_to_front_axle_m, self.cg_to_rear_axle_m, self.mass_kg, self.yaw_inertia_kgm2
+        cf, cr = self.front_cornering_stiffness_n_per_rad, self.rear_cornering_stiffness_n_per_rad
+        v = speed_mps
+        mat = np.array(
+            [
+                [-(cf + cr) / (m * v), -(a * cf - b * cr) / (m * v) - v],
+                [-(a * cf - b * cr) / (iz * v), -(a * a * cf + b * b * cr) / (iz * v)],
+            ]
+        )
+        return float(np.max(np.abs(np.linalg.eigvals(mat))))
+
+
+@dataclass(frozen=True)
+class PredictionParams:
+    """The vehicle as the MPC predicts it (SI units).
+
+    wheelbase_m, steering_ratio, max_road_wheel_angle_rad, max_road_wheel_rate_rad_s: as `VehicleGeometry`;
+    steering_time_constant_s: first-order steering actuator (s); single_track: mass, inertia and tyres, or None
+    when unknown (then only the kinematic kinds are available); lag: the identified steering-wheel-to-curvature
+    lag (Eq. 5), or None; source: where the numbers came from, for messages and reports.
+    """
+
+    wheelbase_m: float
+    steering_ratio: float
+    max_road_wheel_angle_rad: float
+    max_road_wheel_rate_rad_s: float
+    steering_time_constant_s: float = DEFAULT_STEERING_TIME_CONSTANT_S
+    single_track: SingleTrackParams | None = None
+    lag: SteeringLag | None = None
+    source: str = ""
+
+    def __post_init__(self) -> None:
+        require_in_range("wheelbase_m", self.wheelbase_m, 0.5, 15.0, "m")
+        require_in_range("steering_ratio", self.steering_ratio, 1.0, 60.0)
+        require_in_range("max_road_wheel_angle_rad", self.max_road_wheel_angle_rad, 0.01, 1.5, "rad")
+        require_positive("max_road_wheel_rate_rad_s", self.max_road_wheel_rate_rad_s)
+        require_in_range("steering_time_constant_s", self.steering_time_constant_s, 1e-3, 2.0, "s")
+        if self.single_track is not None and abs(self.single_track.wheelbase_m - self.wheelbase_m) > 1e-6:
+            raise WorkbenchInputError(
+                f"single_track axle positions add up to {float(self.single_track.wheelbase_m):g} m; they must "
+                f"equal wheelbase_m = {float(self.wheelbase_m):g} m"
+            )
+
+    def with_lag(self, lag: SteeringLag | None) -> PredictionParams:
+        """A copy with this identified lag (None removes it)."""
+        return dataclasses.replace(self, lag=lag)
+
+    def default_kind(self) -> str:
+        """ "kinematic-lag" with a lag, else "dynamic" when the single track is known, else "kinematic"."""
+        if self.lag is not None:
+            return "kinematic-lag"
+        return "dynamic" if self.single_track is not None else "kinematic"
+
+
+def params_from_geometry(geometry: VehicleGeometry) -> PredictionParams:
+    """The default when nothing but the geometry is known: a kinematic single track with the geometry's limits
+    and an assumed actuator time constant (DEFAULT_STEERING_TIME_CONSTANT_S)."""
+    return PredictionParams(
+        wheelbase_m=geometry.wheelbase_m,
+        steering_ratio=geometry.steering_ratio,
+        max_road_wheel_angle_rad=geometry.max_road_wheel_angle_rad,
+        max_road_wheel_rate_rad_s=geometry.max_steer_wheel_rate_rad_s / geometry.steering_ratio,
+        source="geometry only (kinematic single track, assumed actuator time constant)",
+    )
