@@ -97,7 +97,7 @@ def test_from_lag_validates_its_own_arguments() -> None:
         LeadFilterParams.from_lag(-1.0, 0.8)
     with pytest.raises(WorkbenchInputError, match=r"zeta must be a finite number in \(0, 5.0\]"):
         LeadFilterParams.from_lag(4.0, -0.1)
-    with pytest.raises(WorkbenchInputError, match=r"pole_ratio must be in \[1.0, 100.0\] ; got 0.5"):
+    with pytest.raises(WorkbenchInputError, match=r"pole_ratio must be in \[1.0, 100.0\]; got 0.5"):
         LeadFilterParams.from_lag(4.0, 0.8, pole_ratio=0.5)
 
 
