@@ -69,6 +69,12 @@ def check_choice(name: str, value: object, allowed: Iterable[str]) -> None:
         raise WorkbenchInputError(f"{name} must be one of {', '.join(allowed)}; got {value_text(value)}")
 
 
+def check_optional_instance(name: str, value: object, cls: type) -> None:
+    """None, or an instance of `cls` (an object a file was read into at the boundary, never a path)."""
+    if value is not None and not isinstance(value, cls):
+        raise WorkbenchInputError(f"{name} must be a {cls.__name__} or None; got {value_text(value)}")
+
+
 def check_optional_path(name: str, value: object) -> None:
     """None, or a file path (text or a path object, not empty)."""
     if value is None:

@@ -46,7 +46,7 @@ from pathlib import Path
 import numpy as np
 
 from controllers.clothoid import ClothoidConfig, ClothoidController
-from controllers.clothoid.filter_file import FilterSchedule, write_filter_file
+from controllers.clothoid.filter_file import FilterSchedule, read_filter_file, write_filter_file
 from controllers.clothoid.loop_analysis import LoopSettings, PlantLags
 from tuning.data_generation import generate_open_loop_log
 from tuning.lag_fit import LagFit, LagFitOptions, fit_lag
@@ -482,7 +482,11 @@ def compare_closed_loop(
     for speed in speeds_kmh:
         for label, path in filters.items():
             vehicle = vehicle_factory()
-            config = ClothoidConfig(filter_file=path) if path is not None else ClothoidConfig(use_lead_filter=False)
+            config = (
+                ClothoidConfig(lead_filter=read_filter_file(path))
+                if path is not None
+                else ClothoidConfig(use_lead_filter=False)
+            )
             controller = ClothoidController(vehicle.geometry, config, vehicle=vehicle)
             scen = make_scenario(scenario, ScenarioOptions(vehicle_width_m=vehicle.geometry.width_m))
             sim_config = (

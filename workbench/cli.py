@@ -416,7 +416,7 @@ def _run(args: argparse.Namespace) -> int:
     if args.controller not in CONTROLLERS:
         make_controller(args.controller, vehicle.geometry)  # raises the unknown-name error
     options = read_controller_config(
-        args.controller_config, args.controller, CONTROLLERS[args.controller].config_type, args.set
+        args.controller_config, args.controller, CONTROLLERS[args.controller].config_type, args.set, vehicle.geometry
     )
     controller = make_controller(args.controller, vehicle.geometry, options, vehicle=vehicle)
     scenario = make_scenario(

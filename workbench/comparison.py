@@ -246,7 +246,9 @@ def compare(
             options = scenario_options or ScenarioOptions()
             scen = make_scenario(scenario, ScenarioOptions(vehicle.geometry.width_m, options.track_file))
         config_type = CONTROLLERS[spec.controller].config_type
-        options = read_controller_config(spec.config_file, spec.controller, config_type, spec.overrides)
+        options = read_controller_config(
+            spec.config_file, spec.controller, config_type, spec.overrides, vehicle.geometry
+        )
         controller = make_controller(spec.controller, vehicle.geometry, options, vehicle=vehicle)
         simulations.append(Simulation(scen, vehicle, controller, config))
     messages: list[str] = []

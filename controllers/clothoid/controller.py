@@ -49,14 +49,13 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass
-from pathlib import Path
 from typing import ClassVar
 
 import numpy as np
 
 from controllers.base import Controller, Measurement
 from controllers.clothoid.curvature_limits import CurvatureLimits
-from controllers.clothoid.filter_file import FilterSchedule, read_filter_file
+from controllers.clothoid.filter_file import FilterSchedule
 from controllers.clothoid.lead_filter import DiscreteLeadFilter, PassThroughFilter, SteeringFilter
 from controllers.clothoid.lookahead import MAX_CURVE_POINTS, adaptive_search, candidate_count, evaluate_candidate
 from controllers.clothoid.lookahead_filter import LookaheadFilter, LookaheadFilterSettings, require_rate
@@ -64,7 +63,13 @@ from controllers.clothoid.loop_analysis import LoopSettings, PlantLags, lookahea
 from controllers.clothoid.path_feedforward import FeedforwardTiming, two_degree_of_freedom_rate
 from controllers.clothoid.pose_prediction import along_arc
 from controllers.clothoid.vehicle_tuning import VehicleTuning, tuning_for
-from controllers.config_checks import check_bool, check_choice, check_number, check_optional_number, check_optional_path
+from controllers.config_checks import (
+    check_bool,
+    check_choice,
+    check_number,
+    check_optional_instance,
+    check_optional_number,
+)
 from workbench.errors import WorkbenchInputError, value_text
 from workbench.path import PathTracker, ReferencePath
 from workbench.vehicles.base import VehicleGeometry, VehicleModel
@@ -122,10 +127,12 @@ class ClothoidConfig:
     of Eq. 3, "yaw-rate", "command" or "steering"; heading: "course" or "yaw"; prediction_time_s: pose prediction
     (s; 0: off); path_feedforward: the two-degree-of-freedom form (`path_feedforward.py`; False: Eq. 3 alone);
     feedforward_window_m: the window the path's curvature rate is averaged over (m); feedforward_time_s,
-    reference_lead_s: its timings (s; None: from the vehicle's identified lags); filter_file: lead filter (JSON/TOML,
-    the `tuning design-lead` or `tuning schedule` format; None: the steered vehicle's own); use_lead_filter: False
-    switches the filter off; limits_file: curvature limits CSV (the `tuning rollover-limits` format; None: the
-    vehicle's own, else limits from its geometry, `CurvatureLimits.default_for`).
+    reference_lead_s: its timings (s; None: from the vehicle's identified lags); lead_filter: the lead filter's
+    schedule (None: the steered vehicle's own; in a config file or `--set`, `filter_file` names a file of the
+    `tuning design-lead` or `tuning schedule` format, read when the config is loaded); use_lead_filter: False
+    switches the filter off; curvature_limits: the curvature limits (None: the vehicle's own, else limits from its
+    geometry, `CurvatureLimits.default_for`; in a file, `limits_file` names a CSV of the `tuning rollover-limits`
+    format).
     """
 
     lookahead_mode: str = "adaptive"
@@ -153,9 +160,9 @@ class ClothoidConfig:
     feedforward_window_m: float = 6.0
     feedforward_time_s: float | None = None
     reference_lead_s: float | None = None
-    filter_file: Path | None = None
+    lead_filter: FilterSchedule | None = None
     use_lead_filter: bool = True
-    limits_file: Path | None = None
+    curvature_limits: CurvatureLimits | None = None
 
     def __post_init__(self) -> None:
         # Every field on its own first (`config_checks.py`), then what relates them.
@@ -184,9 +191,9 @@ class ClothoidConfig:
         check_number("feedforward_window_m", self.feedforward_window_m, 0.1, 100.0, "m")
         for name in ("feedforward_time_s", "reference_lead_s"):
             check_optional_number(name, getattr(self, name), 0.0, 5.0, "s", none_means="from the vehicle's lags")
-        check_optional_path("filter_file", self.filter_file)
+        check_optional_instance("lead_filter", self.lead_filter, FilterSchedule)
         check_bool("use_lead_filter", self.use_lead_filter)
-        check_optional_path("limits_file", self.limits_file)
+        check_optional_instance("curvature_limits", self.curvature_limits, CurvatureLimits)
         if self.max_lookahead_m < self.min_lookahead_m:
             raise WorkbenchInputError(
                 f"max_lookahead_m must be >= min_lookahead_m = {value_text(self.min_lookahead_m)} m; "
@@ -221,16 +228,16 @@ class ClothoidController(Controller):
         super().__init__(geometry, config)
         cfg = self.config
         self.tuning: VehicleTuning | None = tuning_for(vehicle) if isinstance(vehicle, VehicleModel) else None
-        if cfg.limits_file:
-            self.limits = CurvatureLimits.read_csv(cfg.limits_file, geometry)
+        if cfg.curvature_limits is not None:
+            self.limits = cfg.curvature_limits
         elif self.tuning is not None:
             self.limits = self.tuning.limits
         else:
             self.limits = CurvatureLimits.default_for(geometry)
         self.filter_schedule: FilterSchedule | None = None
         if cfg.use_lead_filter:
-            if cfg.filter_file:
-                self.filter_schedule = read_filter_file(cfg.filter_file)
+            if cfg.lead_filter is not None:
+                self.filter_schedule = cfg.lead_filter
             elif self.tuning is not None:
                 self.filter_schedule = self.tuning.filter_schedule
         self._buffers = np.empty((4, MAX_CURVE_POINTS))

@@ -23,13 +23,12 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from controllers.base import Controller, Measurement
-from controllers.config_checks import check_bool, check_choice, check_number, check_optional_path, check_whole
+from controllers.config_checks import check_bool, check_choice, check_number, check_optional_instance, check_whole
 from controllers.mpc.ocp import TrackingOCP, TrackingWeights
 from controllers.mpc.plan import Plan
 from controllers.mpc.prediction_model import (
@@ -46,7 +45,7 @@ from controllers.mpc.status import SolveStatus
 from workbench.errors import WorkbenchInputError
 from workbench.path import PathTracker, Projection, ReferencePath, wrap_angle
 from workbench.vehicles.base import VehicleGeometry
-from workbench.vehicles.steering_lag import read_lag_file
+from workbench.vehicles.steering_lag import SteeringLag
 
 #: Below this speed (m/s) yaw rate / speed and the course angle are not used (the yaw and the previous plan are).
 MIN_MEASURED_SPEED_MPS = 0.5
@@ -66,10 +65,11 @@ class MPCConfig:
     vehicle: where the prediction model's parameters come from: "auto" (the steered vehicle's own parameters when
     the caller passes its model, else the shipped preset whose geometry equals the steered vehicle's, else the
     geometry alone), "geometry" (kinematic single track from the geometry), or a preset name
-    (`workbench vehicles`); vehicle_file: a vehicle TOML file instead (overrides `vehicle`);
-    lag_file: an identified steering lag ("steering-lag/1" JSON from `tuning fit-lag`) that the prediction then
-    uses, as the clothoid controller's lead filter does; model: "auto" (kinematic-lag with a lag file, else dynamic
-    when mass and tyres are known, else kinematic), "dynamic", "kinematic" or "kinematic-lag"
+    (`workbench vehicles`); prediction_vehicle: a vehicle's single-track equivalent instead (overrides `vehicle`;
+    in a config file or `--set`, `vehicle_file` names a vehicle TOML file, read when the config is loaded);
+    lag: an identified steering lag that the prediction then uses, as the clothoid controller's lead filter does
+    (`lag_file` names a "steering-lag/1" JSON from `tuning fit-lag`); model: "auto" (kinematic-lag with a lag,
+    else dynamic when mass and tyres are known, else kinematic), "dynamic", "kinematic" or "kinematic-lag"
     (`prediction_model.py`); horizon_steps: N; step_s: prediction step h (s); weight_cte (1/m^2),
     weight_heading (1/rad^2), weight_steer_rate (s^2/rad^2, on the road-wheel rate): stage weights;
     terminal_weight_cte (1/m^2), terminal_weight_heading (1/rad^2): terminal weights; max_lat_accel_mps2: soft
@@ -80,8 +80,8 @@ class MPCConfig:
     """
 
     vehicle: str = "auto"
-    vehicle_file: Path | None = None
-    lag_file: Path | None = None
+    prediction_vehicle: PredictionParams | None = None
+    lag: SteeringLag | None = None
     model: str = "auto"
     horizon_steps: int = 30
     step_s: float = 0.05
@@ -100,8 +100,8 @@ class MPCConfig:
         from workbench.vehicles import VEHICLES
 
         check_choice("vehicle", self.vehicle, ("auto", "geometry", *VEHICLES))
-        check_optional_path("vehicle_file", self.vehicle_file)
-        check_optional_path("lag_file", self.lag_file)
+        check_optional_instance("prediction_vehicle", self.prediction_vehicle, PredictionParams)
+        check_optional_instance("lag", self.lag, SteeringLag)
         check_choice("model", self.model, ("auto", *MODEL_KINDS))
         check_whole("horizon_steps", self.horizon_steps, 2, 500)
         check_number("step_s", self.step_s, 1e-3, 1.0, "s")
@@ -127,14 +127,14 @@ class MPCConfig:
 
 
 def resolve_prediction_params(geometry: VehicleGeometry, config: MPCConfig, vehicle: object | None) -> PredictionParams:
-    """The prediction parameters for a controller, in this order: the config's vehicle_file; its vehicle when not
+    """The prediction parameters for a controller, in this order: the config's prediction_vehicle; its vehicle when not
     "auto"; the `vehicle` the caller passes (a VehicleModel, its params, ...: the steered vehicle itself); the
     shipped preset with the same geometry; the geometry alone. The config's lag file goes on top. The steering
     limits are always the steered vehicle's (`geometry`)."""
     from workbench.vehicles import VEHICLES
 
-    if config.vehicle_file is not None:
-        params = prediction_params_for(Path(config.vehicle_file))
+    if config.prediction_vehicle is not None:
+        params = config.prediction_vehicle
     elif config.vehicle == "auto" and vehicle is not None:
         params = prediction_params_for(vehicle)
     elif config.vehicle == "auto":
@@ -167,8 +167,8 @@ def resolve_prediction_params(geometry: VehicleGeometry, config: MPCConfig, vehi
         lag=params.lag,
         source=params.source,
     )
-    if config.lag_file is not None:
-        params = params.with_lag(read_lag_file(config.lag_file))
+    if config.lag is not None:
+        params = params.with_lag(config.lag)
     return params
 
 

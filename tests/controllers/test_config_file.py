@@ -9,11 +9,13 @@ import pytest
 
 from controllers import CONTROLLERS
 from controllers.clothoid import ClothoidConfig
+from controllers.clothoid.filter_file import DEFAULT_FILTER, read_filter_file, write_filter_file
 from controllers.config_file import build_config, config_template, read_controller_config
 from workbench.errors import WorkbenchInputError
 
 
 def test_file_then_overrides_with_types_and_relative_paths(tmp_path: Path) -> None:
+    write_filter_file(tmp_path / "lead.json", DEFAULT_FILTER, source="test")
     path = tmp_path / "options.toml"
     path.write_text(
         '[clothoid]\nlookahead_mode = "fixed"\nfixed_lookahead_m = 12\nfilter_file = "lead.json"\n'
@@ -22,11 +24,12 @@ def test_file_then_overrides_with_types_and_relative_paths(tmp_path: Path) -> No
     config = read_controller_config(path, "clothoid", ClothoidConfig, ["use_lead_filter=off", "min_lookahead_m=6"])
     assert config.lookahead_mode == "fixed"
     assert config.fixed_lookahead_m == 12.0 and isinstance(config.fixed_lookahead_m, float)
-    assert config.filter_file == tmp_path / "lead.json"  # relative to the config file
+    # A file option is read where the config is loaded (relative to the config file), into its object.
+    assert config.lead_filter == read_filter_file(tmp_path / "lead.json")
     assert config.use_lead_filter is False
     assert config.min_lookahead_m == 6.0
     assert read_controller_config(None, "clothoid", ClothoidConfig) == ClothoidConfig()
-    assert build_config(ClothoidConfig, {}, ["filter_file=none"]).filter_file is None
+    assert build_config(ClothoidConfig, {}, ["filter_file=none"]).lead_filter is None
 
 
 @pytest.mark.parametrize(

@@ -44,6 +44,8 @@ if TYPE_CHECKING:
 
 BEST_CONFIG = "best.toml"
 BEST_FILTER = "best_lead_filter.json"
+BEST_LIMITS = "best_limits.csv"
+BEST_LAG = "best_lag.json"
 BEST_JSON = "best.json"
 HISTORY_FILE = "history.parquet"
 HISTORY_FIGURE = "history.png"
@@ -87,14 +89,46 @@ def _toml_value(value: Any) -> str:
     return json.dumps(str(value), ensure_ascii=False)
 
 
+def _write_object(folder: Path, value: Any) -> str | None:
+    """Write an object a file option was read into beside the config (its file's name), or None when it has no
+    file form (a vehicle's single-track equivalent)."""
+    from controllers.clothoid.curvature_limits import CurvatureLimits
+    from controllers.clothoid.filter_file import FilterSchedule, write_filter_file
+    from workbench.vehicles.steering_lag import SteeringLag, write_lag_file
+
+    if isinstance(value, FilterSchedule):
+        write_filter_file(
+            folder / BEST_FILTER, value.params[0] if len(value.params) == 1 else value, source=value.source
+        )
+        return BEST_FILTER
+    if isinstance(value, CurvatureLimits):
+        value.write_csv(folder / BEST_LIMITS)
+        return BEST_LIMITS
+    if isinstance(value, SteeringLag):
+        write_lag_file(value, folder / BEST_LAG)
+        return BEST_LAG
+    return None
+
+
 def write_controller_config(path: Path, controller: str, config: Any, header: str) -> Path:
     """Write every field of a controller config as a controller-config TOML file (one [controller] table; None
-    as "none"; paths inside the file's folder relative to it, others absolute); return the path."""
+    as "none"; paths inside the file's folder relative to it, others absolute); an object a file option was read
+    into (`FILE_OPTIONS`) is written to a file beside it and named by that option; return the path."""
+    from controllers.config_file import FILE_OPTIONS
+
+    file_keys = {option.field: name for name, option in FILE_OPTIONS.items()}
     lines = [f"# {line}" for line in header.splitlines()] + ["", f"[{controller}]"]
     for f in dataclasses.fields(config):
         if not f.init:
             continue
         value = getattr(config, f.name)
+        if f.name in file_keys:
+            name = None if value is None else _write_object(path.parent, value)
+            if value is not None and name is None:
+                lines.append(f"# {file_keys[f.name]}: {type(value).__name__} has no file form; give its file again")
+            else:
+                lines.append(f"{file_keys[f.name]} = {_toml_value(name)}")
+            continue
         if isinstance(value, Path):
             value = value.resolve()
             value = value.relative_to(path.parent.resolve()) if value.is_relative_to(path.parent.resolve()) else value
@@ -223,14 +257,14 @@ def _write_best(spec: StudySpec, out: Path, best: dict[str, Any], params: dict[s
     """DIR/best.toml (and DIR/best_lead_filter.json when the trial scaled the filter) and DIR/best.json."""
     controller = spec.controllers[0]
     run = spec.plan(params)[0]  # the options are the same in every run of the trial
-    config = build_controller_config(run, out / BEST_FILTER, load_vehicle(run.vehicle))
+    config = build_controller_config(run, load_vehicle(run.vehicle))
     scales = {k: v for k, v in run.options if k in LEAD_FILTER_SCALES}
     header = (
         f"The best of {spec.optimise.trials if spec.optimise else '?'} trials of `workbench optimise`: trial "
         f"{best['trial']}, objective {best['value']!r}\n({objective_text(spec)}).\n"
         f"Use: workbench run SCENARIO --controller {controller} --controller-config {BEST_CONFIG}"
     )
-    if scales and config.filter_file is not None and config.filter_file.name == BEST_FILTER:
+    if scales and getattr(config, "lead_filter", None) is not None:
         header += f"\n{BEST_FILTER}: the lead filter with {', '.join(f'{k} = {v!r}' for k, v in scales.items())}."
     path = write_controller_config(out / BEST_CONFIG, controller, config, header)
     document = {

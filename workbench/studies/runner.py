@@ -3,8 +3,8 @@ status, message).
 
 The run is built as `workbench run` builds one: the vehicle (with its payload), the scenario sized for it (with
 the initial offset and heading error), the controller's options from the controller-config file and the run's
-options on top (`controllers.config_file.read_controller_config`, the `--set KEY=VALUE` path), a lead filter
-scaled into a temporary file when asked (`lead_filter_scaling.py`), then `Simulation(...).run()`. Nothing in it
+options on top (`controllers.config_file.read_controller_config`, the `--set KEY=VALUE` path), the lead filter
+scaled when asked (`lead_filter_scaling.py`), then `Simulation(...).run()`. Nothing in it
 is random, so the same PlannedRun gives the same row, bit for bit, on any worker, except the wall-clock fields
 (TIMING_COLUMNS). One exception: the MPCs drop a solve that overruns its wall-clock budget (`max_solve_time_s`,
 default the controller period), so on a loaded machine their runs can differ; give them a budget they never reach
@@ -19,10 +19,8 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import tempfile
 import time
 import traceback
-from pathlib import Path
 from typing import Any
 
 from controllers import CONTROLLERS, make_controller
@@ -32,7 +30,7 @@ from workbench.metrics import METRIC_KEYS
 from workbench.result import SimulationResult
 from workbench.scenarios import ScenarioOptions, make_scenario
 from workbench.simulator import Simulation, SimulationConfig
-from workbench.studies.lead_filter_scaling import write_scaled_filter
+from workbench.studies.lead_filter_scaling import scaled_filter
 from workbench.studies.spec import EXTRA_RUN_PARAMETERS, LEAD_FILTER_SCALES, PlannedRun
 from workbench.vehicles.base import VehicleModel
 from workbench.vehicles.presets import load_vehicle
@@ -58,24 +56,20 @@ def option_text(value: Any) -> str:
     return str(value)
 
 
-def build_controller_config(
-    run: PlannedRun, filter_path: Path | None = None, vehicle: VehicleModel | None = None
-) -> Any:
-    """The run's controller config: the controller-config file's table, then the run's options. With lead-filter
-    scales other than 1, the scaled filter (of the config's filter_file, else of the vehicle's own tuning) is
-    written to filter_path (required then) and named as `filter_file`."""
+def build_controller_config(run: PlannedRun, vehicle: VehicleModel | None = None) -> Any:
+    """The run's controller config: the controller-config file's table, then the run's options (file options read
+    into their objects). With lead-filter scales other than 1, the config holds the scaled filter (of its own lead
+    filter, else of the vehicle's tuning)."""
     options = dict(run.options)
     scales = {k: options.pop(k) for k in LEAD_FILTER_SCALES if k in options}
     config_type = CONTROLLERS[run.controller].config_type
     overrides = [f"{key}={option_text(value)}" for key, value in options.items()]
-    config = read_controller_config(run.controller_config, run.controller, config_type, overrides)
+    geometry = vehicle.geometry if vehicle is not None else None
+    config = read_controller_config(run.controller_config, run.controller, config_type, overrides, geometry)
     zero, pole = (scales.get(k, 1.0) for k in LEAD_FILTER_SCALES)
     if zero != 1.0 or pole != 1.0:
-        if filter_path is None:
-            raise ValueError("lead-filter scales need a path for the scaled filter file")
-        base = tuning_for(vehicle).filter_schedule if vehicle is not None and config.filter_file is None else None
-        path = write_scaled_filter(filter_path, config.filter_file, zero, pole, base)
-        config = dataclasses.replace(config, filter_file=path)
+        own = tuning_for(vehicle).filter_schedule if vehicle is not None and config.lead_filter is None else None
+        config = dataclasses.replace(config, lead_filter=scaled_filter(config.lead_filter, zero, pole, own))
     return config
 
 
@@ -90,9 +84,8 @@ def simulate(run: PlannedRun, progress: bool = False) -> SimulationResult:
     scenario = scenario.with_initial_error(
         extra["initial_offset_m"], None if heading_deg is None else math.radians(heading_deg)
     )
-    with tempfile.TemporaryDirectory(prefix="workbench-run-") as tmp:
-        options = build_controller_config(run, Path(tmp) / "lead_filter.json", vehicle)
-        controller = make_controller(run.controller, vehicle.geometry, options, vehicle=vehicle)
+    options = build_controller_config(run, vehicle)
+    controller = make_controller(run.controller, vehicle.geometry, options, vehicle=vehicle)
     return Simulation(scenario, vehicle, controller, config).run(progress=progress)
 
 

@@ -114,11 +114,12 @@ DEFAULT_MAX_RUNS = 100_000
 
 
 def controller_parameters(controller: str) -> dict[str, Any]:
-    """The parameters of a controller's runs and their types: its config fields, and the lead-filter scales when
-    it reads a lead filter."""
-    config_type = CONTROLLERS[controller].config_type
-    hints = typing.get_type_hints(config_type)
-    params = {f.name: hints[f.name] for f in dataclasses.fields(config_type) if f.init}
+    """The parameters of a controller's runs and their types: its config options (`option_types`: a file option
+    such as filter_file in place of the object it is read into), and the lead-filter scales when it reads a lead
+    filter."""
+    from controllers.config_file import option_types
+
+    params = option_types(CONTROLLERS[controller].config_type)
     if "filter_file" in params:
         params |= dict.fromkeys(LEAD_FILTER_SCALES, float)
     return params
@@ -514,8 +515,10 @@ class StudySpec:
         for controller in self.controllers:
             params = controller_parameters(controller)
             file_options = [k for k, t in params.items() if unwrap(t)[0] is Path]
-            config = read_controller_config(self.controller_config, controller, CONTROLLERS[controller].config_type)
-            named = [(f"{controller}.{k} in study.controller_config", k, getattr(config, k)) for k in file_options]
+            # Its file options are read here, into the config's objects, as a run will read them.
+            config_type = CONTROLLERS[controller].config_type
+            read_controller_config(self.controller_config, controller, config_type, (), geometry)
+            named: list[tuple[str, str, Any]] = []
             for where, table in (("grid", self.controller_grid), ("random", self.controller_random)):
                 for key, values in table.get(controller, {}).items():
                     if key in file_options:
@@ -667,24 +670,15 @@ def _vehicle_models(vehicles: Sequence[str]) -> dict[str, Any]:
 def _check_option_file(where: str, key: str, path: Path, geometry: Any) -> None:
     """Read a file a controller option names, as the controller will (lead filters, curvature limits, steering
     lags, vehicle files); any other file must at least be readable."""
-    from controllers.clothoid.curvature_limits import CurvatureLimits
-    from controllers.clothoid.filter_file import read_filter_file
-    from workbench.vehicles.presets import load_vehicle
-    from workbench.vehicles.steering_lag import read_lag_file
+    from controllers.config_file import FILE_OPTIONS
 
     label = f"{where}: {path}"
     check_input_file(path, label)
     if path.suffix.lower() == ".json":
         read_json(path, label)  # deep nesting, bad JSON: refused here, whatever reads it next
-    readers = {
-        "filter_file": read_filter_file,
-        "limits_file": lambda p: CurvatureLimits.read_csv(p, geometry),
-        "lag_file": read_lag_file,
-        "vehicle_file": lambda p: load_vehicle(str(p)),
-    }
-    if key in readers:
+    if key in FILE_OPTIONS:
         try:
-            readers[key](path)
+            FILE_OPTIONS[key].read(path, geometry)
         except WorkbenchInputError as exc:
             raise WorkbenchInputError(f"{where}: {exc}") from None
 

@@ -18,6 +18,7 @@ from controllers.clothoid import (
     LeadFilterParams,
     write_filter_file,
 )
+from controllers.config_file import build_config
 from workbench.clothoid_chain import ClothoidChain
 from workbench.errors import WorkbenchInputError
 from workbench.path import ReferencePath
@@ -142,7 +143,7 @@ def test_filter_file_is_read_and_a_schedule_follows_speed(tmp_path: Path) -> Non
     slow, fast = LeadFilterParams.from_lag(4.0, 0.8), LeadFilterParams.from_lag(2.5, 1.2)
     schedule = FilterSchedule((20.0, 80.0), (slow, fast))
     path = write_filter_file(tmp_path / "lead.toml", schedule, source="test")
-    controller = ClothoidController(GEOMETRY, ClothoidConfig(filter_file=path))
+    controller = ClothoidController(GEOMETRY, build_config(ClothoidConfig, {"filter_file": str(path)}))
     assert controller.filter_schedule.params == (slow, fast)
     controller.reset(STRAIGHT, 0.02)
     controller.step(_m(10.0, 0.0, 0.0, 50.0 / 3.6), STRAIGHT)
@@ -226,7 +227,7 @@ def test_the_analysis_floor_keeps_the_margins_at_every_lookahead_the_controller_
 
 def test_missing_filter_file_names_it(tmp_path: Path) -> None:
     with pytest.raises(WorkbenchInputError, match=r"nowhere\.json"):
-        ClothoidController(GEOMETRY, ClothoidConfig(filter_file=tmp_path / "nowhere.json"))
+        build_config(ClothoidConfig, {"filter_file": str(tmp_path / "nowhere.json")})
 
 
 def test_runs_on_the_kinematic_car_with_every_lookahead_mode() -> None:

@@ -12,7 +12,7 @@ import pytest
 from study_helpers import SerialBackend, write_spec
 
 from controllers import CONTROLLERS
-from controllers.clothoid.filter_file import read_filter_file
+from controllers.clothoid.filter_file import DEFAULT_FILTER, FilterSchedule, read_filter_file
 from controllers.clothoid.vehicle_tuning import tuning_for
 from controllers.config_file import read_controller_config
 from workbench.cli import main
@@ -68,13 +68,12 @@ def test_trial_value() -> None:
 
 def test_the_config_writer_round_trips(tmp_path: Path) -> None:
     config_type = CONTROLLERS["clothoid"].config_type
-    (tmp_path / "lead.json").write_text("{}")
-    config = config_type(
-        frechet_threshold_m=0.1 / 3, max_lookahead_growth_m_per_m=None, filter_file=tmp_path / "lead.json"
-    )
+    lead = FilterSchedule.single(DEFAULT_FILTER, source="a test filter")
+    config = config_type(frechet_threshold_m=0.1 / 3, max_lookahead_growth_m_per_m=None, lead_filter=lead)
     path = write_controller_config(tmp_path / "best.toml", "clothoid", config, "header\nsecond line")
     assert path.read_text().startswith("# header\n# second line\n\n[clothoid]\n")
-    assert 'filter_file = "lead.json"' in path.read_text()  # beside the file: relative to it
+    # The object a file option was read into is written beside the config and named by that option.
+    assert 'filter_file = "best_lead_filter.json"' in path.read_text()
     assert read_controller_config(path, "clothoid", config_type) == config
 
 
@@ -105,8 +104,9 @@ def test_optimise_writes_the_best_trial_as_a_config_that_workbench_run_reproduce
     config = read_controller_config(out / "best.toml", "clothoid", CONTROLLERS["clothoid"].config_type)
     assert config.frechet_threshold_m == result.best_params["frechet_threshold_m"]
     assert config.prediction_time_s == 0.1
-    scaled = read_filter_file(config.filter_file)
-    assert config.filter_file == (out / "best_lead_filter.json").resolve()
+    scaled = config.lead_filter  # read from best_lead_filter.json, which best.toml names
+    assert 'filter_file = "best_lead_filter.json"' in (out / "best.toml").read_text()
+    assert scaled == read_filter_file(out / "best_lead_filter.json")
     own = tuning_for(make_vehicle("kinematic-bicycle")).filter_schedule  # the vehicle's own filter is the base
     assert scaled.speeds_kmh == own.speeds_kmh
     for lead, base in zip(scaled.params, own.params, strict=True):

@@ -10,7 +10,7 @@ import pytest
 from study_helpers import write_spec
 
 from controllers import CONTROLLERS, make_controller
-from controllers.clothoid.filter_file import DEFAULT_FILTER, read_filter_file
+from controllers.clothoid.filter_file import DEFAULT_FILTER
 from controllers.config_file import read_controller_config
 from workbench.scenarios import ScenarioOptions, make_scenario
 from workbench.simulator import Simulation, SimulationConfig
@@ -80,11 +80,12 @@ def test_a_run_that_leaves_the_path_keeps_the_simulators_status() -> None:
     assert 0.3 < row["max_abs_cte_m"] <= 0.5 and row["distance_m"] < 1.0
 
 
-def test_lead_filter_scaling_writes_the_scaled_filter(tmp_path: Path) -> None:
+def test_lead_filter_scaling_gives_the_config_the_scaled_filter(tmp_path: Path) -> None:
+    """No file: the config holds the scaled filter (here of DEFAULT_FILTER: no vehicle, no configured filter)."""
     run = _run(controller="clothoid", options=(("lead_filter_zero_scale", 1.25), ("lead_filter_pole_scale", 0.8)))
-    config = build_controller_config(run, tmp_path / "lead.json")
-    assert config.filter_file == tmp_path / "lead.json"
-    (params,) = read_filter_file(config.filter_file).params
+    config = build_controller_config(run)
+    assert list(tmp_path.iterdir()) == []
+    (params,) = config.lead_filter.params
     assert params.omega_z_rad_s == DEFAULT_FILTER.omega_z_rad_s * 1.25
     assert params.omega_p_rad_s == DEFAULT_FILTER.omega_p_rad_s * 0.8
     assert params.psi == DEFAULT_FILTER.psi

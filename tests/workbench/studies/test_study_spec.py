@@ -225,7 +225,7 @@ ONE = '[study]\nscenarios = ["dlc"]\ncontrollers = ["clothoid"]\nvehicles = ["ki
         ("[clothoid]\nfrechet_threshold_m = nan\n", ["'frechet_threshold_m' must be a finite number", "got nan"]),
         (
             "[clothoid]\nfilter_file = 'none.json'\n",
-            ["clothoid.filter_file in study.controller_config", "no such file"],
+            ["controller config file", "[clothoid]: lead filter file", "none.json: no such file"],
         ),
         ("[clothoid\n", ["not valid TOML"]),
         ("[clothoid]\nx = " + "[" * 5000 + "]" * 5000 + "\n", ["nested deeper than 64 levels"]),
