@@ -6,8 +6,7 @@ logged rear-axle positions x, y, as the paper computes it ("the actual curvature
 coordinates"), kappa = (x' y'' - y' x'') / (x'^2 + y'^2)^1.5 with the derivatives from a Savitzky-Golay filter
 (cubic, window smooth_s; zero phase, so it adds no lag); or, when the log has no positions or on request, from
 yaw rate / speed. (On the articulated truck the two differ in transients: the rear axle's side-slip builds up
-after the yaw rate, so yaw rate / speed leads the path curvature and gives a faster lag: on the loaded truck at
-60 km/h omega_n 7.4 rad/s, zeta 1.5 against 3.4 rad/s, 1.2 from the path.)
+after the yaw rate, so yaw rate / speed leads the path curvature and gives a faster lag.)
 
 Model: measured = K x G_lag(s) e^(-s delay) kinematic, with G_lag of Eq. 5, simulated at the log's samples
 (exact first-order-hold discretisation, the linear interpolation scipy.signal.lsim uses, run by lfilter) from
@@ -18,15 +17,14 @@ into the steering-lag file as `steady_state_gain` (the MPC's lag model uses it; 
 DC gain and does not); `unit_gain=True` fixes K = 1. The delay is fitted only with `fit_delay=True`.
 
 A delay and the damping trade off: both add phase lag growing with frequency, and only the damping also bends
-the magnitude, so data with little energy above 1 Hz (steps, a dlc) cannot tell them apart (the loaded truck's
-zeta ran to 7-10 from 40 km/h, omega_n and the delay jumping with it). Two things separate them: a chirp in the
+the magnitude, so data with little energy above 1 Hz (steps, a dlc) cannot tell them apart. Two things separate
+them: a chirp in the
 logs (`tuning/maneuvers.py`; `tuning schedule` logs one), and with a delay an upper bound on zeta,
 DELAY_FIT_MAX_ZETA = 2, at which a fit is accepted rather than refused. Where a vehicle's response is a
 first-order lag behind a delay (the truck from 30 km/h, the cars' 0.05 s actuator), an overdamped Eq. 5 is that
 lag times a pole much faster than the data resolve, and that pole and the delay are interchangeable; at zeta = 2
-the second pole is 14 times the first. Measured against the linearised truck at 30 km/h, the bound costs
-nothing: the fitted lag is within 6 % in gain and 2 deg in phase of the truck's response from 0.5 to 8 rad/s
-(tests/tuning/test_identification_against_linearisation.py); a bound of 1 costs up to 60 % at 90 km/h.
+the second pole is 14 times the first, and the bound costs little against the vehicle's linearised response
+(tests/tuning/test_identification_against_linearisation.py; the README has the figures).
 
 Fit: scipy.optimize.least_squares over (omega_n, zeta[, K][, delay]) jointly over all logs, from each of the
 STARTS best points of a coarse grid of (omega_n, zeta[, delay]) (K solved linearly there), the lowest cost kept

@@ -23,33 +23,17 @@ rises from 1 to its peak near wp and then falls as wp^3 / (wz^2 w); its value at
 meaningful "high-frequency gain".) The second keeps the cascade free of a resonance (overshoot and ringing).
 
 Why 6 by default: it is the smallest round bound whose design at least doubles the -3 dB bandwidth of the loaded
-tractor-semitrailer's lag at 30 km/h (x2.23; x2.04 with 5), the aim of the loop shaping, with a margin for the
-scatter of an identified zeta. The closed loop, though, rewards less lead: the filter sits in the clothoid
-controller's loop, whose command changes fast whenever the lookahead does, and a larger peak gain turns that into
-steering-wheel rates at the actuator's limit, where the lead's phase advance is lost. Measured on that truck (the
-clothoid controller's defaults, the filters of `tuning schedule` at 20-90 km/h with the bound below, max |CTE| on
-the dlc at 0.3 g):
-
-    max_lead_gain                          2      2.5    3      4      5      6      10
-    30 km/h, the 30 km/h filter (m)        0.037  0.049  0.045  0.059  0.068  0.071  0.092
-    60 km/h, the schedule (m)              0.31   0.12   0.12   0.13   0.14   0.16   0.18
-    60 km/h, the 30 km/h filter (m)        0.47   0.31   0.28   0.26   0.24   0.23   0.21
-
-Below about 2.5 the scheduled filters of the higher speeds, whose lags are slower, become too slow themselves
-(wp 6.7 rad/s at 60 km/h for a bound of 2); from 4 up the scheduled loop at 60 km/h spends 13-16 % of its steps at
-the steering-wheel rate limit (3 % with 3), and with 10 the 30 km/h dlc doubles its error. 80 km/h reads as 60 km/h
-within 0.02 m. So for this truck `--max-lead-gain 3` tracks best (x1.57 the bandwidth); every bound from 2.5 to 10
-meets the tracking goals and the schedule beats the fixed filter at each. The paper's DEFAULT_FILTER (triple pole
-at 3 wn) has a peak gain of 3.5.
+tractor-semitrailer's lag at 30 km/h, with a margin for the scatter of an identified zeta. The closed loop, though,
+rewards less lead: the clothoid controller's command changes fast whenever its lookahead does, and a larger peak
+gain turns that into steering-wheel rates at the actuator's limit, where the lead's phase advance is lost (the
+README's tuning section has the measured trade-off).
 
 The design (classical loop shaping with pole-zero cancellation): the zeros cancel the lag's poles (wz = wn,
 psi = zeta), so the cascade is T = wp^3 / (s + wp)^3 (no overshoot, w_B = 0.51 wp), and wp is the largest meeting
 the bounds, found by bisection (both peaks grow with wp at every frequency, and so does w_B): the widest -3 dB and
 tracking bandwidth a cancelling Eq. 6 reaches under the bounds. It needs zeta <= 5 (LeadFilterParams' range of
-psi). With the default bound the cascade's -3 dB bandwidth is x2.23 the plant's for the loaded truck at 30 km/h
-(wp = 3.93 wn; x1.57 with a bound of 3, x2.9 with 10) and at least x2 for zeta >= 0.7; a lightly damped lag's
-resonance widens its own -3 dB bandwidth, so it gains less (x1.4 at zeta = 0.3). Under a bound of 3 a lag damped beyond
-zeta = 3.8 has no design (zeros that damped raise the gain past 3 even with wp = wz); under 6 every zeta <= 5 has.
+psi); a lightly damped lag's resonance widens its own -3 dB bandwidth, so it gains less, and under a tight bound a
+strongly damped lag may have no design (zeros that damped raise the gain past the bound even with wp = wz).
 (A free search over (wz, psi, wp) maximising either bandwidth was tried and rejected: both bandwidths are
 first crossings of a threshold, and their optima sit on a dip or an error hump just short of the threshold, so the
 "optimum" jumps with the frequency grid; cancellation is unique, smooth in the lag and gives no resonance.)

@@ -17,11 +17,9 @@ made for that vehicle by the project's own tuning chain (`tuning schedule`, `tun
   commands to run by hand and the controller options (filter_file, limits_file) to pass.
 
 The payload is left out of a vehicle's identity (it is set to its preset's, 17 t for the tractor-semitrailer,
-before comparing or hashing): the lag hardly depends on it (the loaded truck's time to 63 % after a steering
-step changes by 2.5 % between 0 and 17 t at 30 km/h), so a truck with another payload uses the preset's filter.
-Its rollover limits are those at the preset's payload, which a heavier load lowers: conservative for a lighter
-truck, a little optimistic for a heavier one (LTR = 1 at 60 km/h: 0.0239 1/m empty, 0.0158 at 17 t, 0.0149 at
-25 t).
+before comparing or hashing): the lag hardly depends on it (README: the truck's lag against payload), so a truck
+with another payload uses the preset's filter. Its rollover limits are those at the preset's payload, which a
+heavier load lowers: conservative for a lighter truck, a little optimistic for a heavier one.
 
 Files of a tuning directory:
 

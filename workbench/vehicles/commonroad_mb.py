@@ -2,9 +2,8 @@
 
 The 29-state MB model (sprung mass with roll and pitch, two unsprung axles, four wheel speeds, magic-formula
 combined-slip tyres; Althoff & Wuersching, "CommonRoad: Vehicle Models", 2020) is integrated as published, with
-fixed-step RK4 of its pure-Python derivative function, so it is slow: ~38 us per derivative evaluation, ~3 ms per
-20-substep advance, i.e. a 518 s lap at 1 kHz takes ~80 s (6x faster than real time, ~180x slower than the
-compiled models). Its inputs are the front road-wheel angle *rate* and the acceleration;
+fixed-step RK4 of its pure-Python derivative function, so it is slow (two orders of magnitude slower than the
+compiled models; `benchmarks/run.py` times it). Its inputs are the front road-wheel angle *rate* and the acceleration;
 this adapter closes the same first-order, rate-limited steering actuator as the other models around it, and
 converts its CG reference point to the rear-axle centre: p_rear = p_cg - b (cos yaw, sin yaw).
 """
