@@ -17,21 +17,14 @@ per speed, the identified lags (omega_n, zeta, the steady-state gain K and the d
 lag's prefixed measured_), the filter, and with "margins" the lookahead floor with and without the filter.
 
 With a fitted delay (`fit_options=LagFitOptions(fit_delay=True)`, `tuning schedule --delay`) Eq. 5 matches the
-plant's frequency response where it matters for the loop: the loaded truck at 30 km/h has |G(j8)| = 0.74 at
--157 deg, Eq. 5 without a delay (fitted to dlc and steps) 0.25 at -131 deg. Fitted to dlc and steps alone, the
-delay traded off with the damping (zeta 7-10 on the truck from 40 km/h, refused, dropped); with the chirp and
-zeta bounded at 2 (`tuning/lag_fit.py`) every preset's fit is accepted at every speed from 10 to 100 km/h and
-follows the vehicle's linearised response (truck at 30 km/h: 6 % and 2 deg from 0.5 to 8 rad/s; the dynamic
-bicycle 0.4 % and 0.3 deg). `drop_refused=True` (`--drop-refused`) leaves a refused speed out of the schedule and
+plant's frequency response where it matters for the loop; fitted to dlc and steps alone the delay trades off with
+the damping, so the chirp is logged and zeta bounded with a delay (`tuning/lag_fit.py`; the README has the
+measured agreement). `drop_refused=True` (`--drop-refused`) leaves a refused speed out of the schedule and
 records it with the reason in the file's `design.dropped_speeds`, instead of refusing the whole schedule.
 
 `compare_closed_loop` runs the clothoid controller on a scenario with a scheduled and with a fixed filter, to show
 which tracks better (the demonstration of issue 6, item 5), and `scheduled_against_fixed` reads the verdict off
-its rows. Measured on the loaded tractor-semitrailer with its shipped schedule (`--delay --design margins`, 10-100
-km/h) and the clothoid controller's defaults, dlc at the simulator's 0.3 g speed profile: max |CTE| 0.175 / 0.172 m
-with the schedule against 2.33 / 2.32 m with its 30 km/h filter held fixed at 60 / 80 km/h (2.80 m without a
-filter). The profile slows the truck to 35 km/h in the lane changes (the dlc's 30-45 m radii at 0.3 g), so "60"
-and "80" differ in the approach (60 and 70 km/h) more than in the lane changes.
+its rows (the README's tuning section has the measured comparison on the loaded truck).
 """
 
 from __future__ import annotations
