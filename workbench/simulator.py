@@ -323,13 +323,12 @@ class _TraceLog:
         self.n = 0
 
     def _grow(self) -> None:
-        def doubled(column: np.ndarray, fill: float) -> np.ndarray:
-            extra = np.full((self.capacity, *column.shape[1:]), fill)
-            return np.concatenate((column, extra))
+        def doubled(column: np.ndarray) -> np.ndarray:
+            return np.concatenate((column, np.full((self.capacity, *column.shape[1:]), np.nan)))
 
-        self.outputs = doubled(self.outputs, np.nan)
-        self.signals = doubled(self.signals, np.nan)
-        self.diagnostics = {key: doubled(column, np.nan) for key, column in self.diagnostics.items()}
+        self.outputs = doubled(self.outputs)
+        self.signals = doubled(self.signals)
+        self.diagnostics = {key: doubled(column) for key, column in self.diagnostics.items()}
         self.capacity *= 2
 
     SIGNALS = (

@@ -250,7 +250,8 @@ class MPCController(Controller):
             dual: tuple[np.ndarray, ...] = ()
         else:
             guess_states, guess_inputs = shifted[0], shifted[1]
-            dual = self.solver.shift_dual(plan.dual, plan.positions(m.t_s))
+            # Only IPOPT returns multipliers; the QP solvers keep their own, so no positions are computed for them.
+            dual = self.solver.shift_dual(plan.dual, plan.positions(m.t_s)) if plan.dual else ()
         result = self.solver.solve(x0, kappa, speed, guess_states, guess_inputs, dual, first)
 
         t_next = m.t_s + self._sample_time_s
