@@ -22,8 +22,8 @@ import numpy as np
 
 from controllers import CONTROLLERS, make_controller
 from controllers.config_file import build_config
-from workbench.scenarios import ZANDVOORT_ENV, ScenarioOptions, make_scenario
-from workbench.simulator import Simulation, SimulationConfig
+from workbench.simulation.scenarios import ZANDVOORT_ENV, ScenarioOptions, make_scenario
+from workbench.simulation.simulator import Simulation, SimulationConfig
 from workbench.vehicles import make_vehicle
 
 DEFAULT_TRACK = Path(__file__).resolve().parents[2] / "shared" / "tracks" / "Zandvoort_track.csv"

@@ -22,9 +22,9 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 
 from controllers import make_controller
-from workbench.comparison import converge_distance_m
-from workbench.scenarios import ZANDVOORT_ENV, ScenarioOptions, make_scenario
-from workbench.simulator import Simulation, SimulationConfig
+from workbench.apps.comparison import converge_distance_m
+from workbench.simulation.scenarios import ZANDVOORT_ENV, ScenarioOptions, make_scenario
+from workbench.simulation.simulator import Simulation, SimulationConfig
 from workbench.vehicles import make_vehicle
 
 DEFAULT_TRACK = Path(__file__).resolve().parents[2] / "shared" / "tracks" / "Zandvoort_track.csv"

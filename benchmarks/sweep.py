@@ -28,7 +28,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from workbench.studies import TIMING_COLUMNS, SweepResult, load_spec, make_backend, run_sweep
+from workbench.apps.studies import TIMING_COLUMNS, SweepResult, load_spec, make_backend, run_sweep
 
 ROOT = Path(__file__).resolve().parents[1]
 SPEEDUP_GOAL = 1.7

@@ -94,7 +94,7 @@ def make_controller(
     """Build the controller registered under `name` for a vehicle, with its default config unless one is given.
     `vehicle` (the steered `VehicleModel`) gives model-based controllers (the MPCs) their prediction parameters."""
     if name not in CONTROLLERS:
-        from workbench.errors import WorkbenchInputError
+        from workbench.base.errors import WorkbenchInputError
 
         raise WorkbenchInputError(f"unknown controller {name!r}; choose one of {', '.join(CONTROLLERS)}")
     return CONTROLLERS[name](geometry, config, vehicle=vehicle)

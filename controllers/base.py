@@ -40,8 +40,8 @@ from dataclasses import dataclass
 from types import MappingProxyType
 from typing import Any, ClassVar
 
-from workbench.errors import require_positive
-from workbench.path import ReferencePath, wrap_angle
+from workbench.base.errors import require_positive
+from workbench.base.path import ReferencePath, wrap_angle
 from workbench.vehicles.base import VehicleGeometry
 
 _NO_DIAGNOSTICS: Mapping[str, float] = MappingProxyType({})

@@ -15,7 +15,7 @@ from collections.abc import Iterable
 
 import numpy as np
 
-from workbench.errors import WorkbenchInputError, is_number, value_text
+from workbench.base.errors import WorkbenchInputError, is_number, value_text
 
 
 def shown_all(values: object) -> str:

@@ -23,9 +23,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from workbench.errors import WorkbenchInputError, value_text
-from workbench.input_files import read_toml
-from workbench.typed_tables import field_types, typed_value
+from workbench.base.errors import WorkbenchInputError, value_text
+from workbench.base.input_files import read_toml
+from workbench.base.typed_tables import field_types, typed_value
 
 if TYPE_CHECKING:
     from workbench.vehicles.base import VehicleGeometry

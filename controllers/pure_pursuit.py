@@ -15,8 +15,8 @@ from typing import ClassVar
 
 from controllers.base import Controller, Measurement
 from controllers.config_checks import check_number
-from workbench.errors import WorkbenchInputError, value_text
-from workbench.path import PathTracker, ReferencePath
+from workbench.base.errors import WorkbenchInputError, value_text
+from workbench.base.path import PathTracker, ReferencePath
 
 #: The longest lookahead (m) the options allow.
 MAX_LOOKAHEAD_M = 1000.0

@@ -14,7 +14,7 @@ from typing import ClassVar
 
 from controllers.base import Controller, Measurement
 from controllers.config_checks import check_bool, check_number
-from workbench.path import PathTracker, ReferencePath, wrap_angle
+from workbench.base.path import PathTracker, ReferencePath, wrap_angle
 
 
 @dataclass(frozen=True)

@@ -10,7 +10,7 @@
     tuning margins          the clothoid loop's margins against lookahead per speed and the lookahead floor,
                             write margins.csv
 
-Every input file and output file is checked before any work (`workbench.input_files`, `workbench.output_dir`):
+Every input file and output file is checked before any work (`workbench.base.input_files`, `workbench.base.output_dir`):
 a missing or unreadable input, a folder where a file is wanted, a parent that is a file, an unwritable folder or
 file are refused.
 
@@ -26,7 +26,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from workbench.errors import WorkbenchInputError
+from workbench.base.errors import WorkbenchInputError
 
 if TYPE_CHECKING:
     from tuning.lag_fit import SteeringGeometry
@@ -312,8 +312,8 @@ def _prepare(path: Path) -> Path:
 def _check_paths(args: argparse.Namespace) -> None:
     """Every input file must be a readable file and every output file writable (INPUT_FILES, OUTPUT_FILES; and the
     default place of design-lead's validation figure): checked before any work."""
-    from workbench.input_files import check_input_file
-    from workbench.output_dir import check_output_file
+    from workbench.base.input_files import check_input_file
+    from workbench.base.output_dir import check_output_file
 
     for dest, (flag, what) in INPUT_FILES.items():
         value = getattr(args, dest, None)
@@ -334,7 +334,7 @@ def _validation_plot(out: Path) -> Path:
 
 def _read_lag(flag: str, path: Path):
     """A steering-lag file; its JSON read safely first (deep nesting, not JSON), then checked as a lag."""
-    from workbench.input_files import read_json
+    from workbench.base.input_files import read_json
     from workbench.vehicles.steering_lag import read_lag_file
 
     label = f"steering-lag file {str(path)!r} ({flag})"
@@ -639,7 +639,7 @@ def _margins(args: argparse.Namespace) -> int:
     from controllers.clothoid.loop_analysis import PlantLags
     from tuning.margins import MarginStudy, run_margins
     from tuning.speeds import parse_speeds
-    from workbench.errors import require_in_range
+    from workbench.base.errors import require_in_range
 
     for flag, value, low, high, unit in (
         ("--prediction-time-s", args.prediction_time_s, 0.0, 2.0, "s"),

@@ -14,8 +14,8 @@ import pandas as pd
 
 from tuning.log_file import LOG_COLUMNS
 from tuning.maneuvers import Maneuver
-from workbench.errors import require_in_range
-from workbench.speed_control import PISpeedController
+from workbench.base.errors import require_in_range
+from workbench.simulation.speed_control import PISpeedController
 from workbench.vehicles.base import VehicleModel
 
 __all__ = ["LOG_COLUMNS", "generate_open_loop_log"]

@@ -51,7 +51,7 @@ from threadpoolctl import threadpool_limits
 
 from tuning.log_file import VehicleLog
 from tuning.savgol import savgol_matrix
-from workbench.errors import WorkbenchInputError, require_in_range, require_positive
+from workbench.base.errors import WorkbenchInputError, require_in_range, require_positive
 from workbench.vehicles.base import VehicleGeometry
 from workbench.vehicles.steering_lag import (
     DELAY_BOUNDS,

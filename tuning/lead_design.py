@@ -71,7 +71,7 @@ from tuning.lag_fit import (
     simulate_unit_dc,
 )
 from tuning.log_file import VehicleLog
-from workbench.errors import WorkbenchInputError, require_in_range
+from workbench.base.errors import WorkbenchInputError, require_in_range
 from workbench.vehicles.base import VehicleGeometry
 from workbench.vehicles.steering_lag import SteeringLag
 

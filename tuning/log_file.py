@@ -30,8 +30,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from workbench.errors import WorkbenchInputError, value_text
-from workbench.input_files import check_input_file
+from workbench.base.errors import WorkbenchInputError, value_text
+from workbench.base.input_files import check_input_file
 
 #: Columns `generate-data` writes, in this order.
 LOG_COLUMNS = ("t_s", "steer_wheel_deg", "speed_mps", "x_m", "y_m", "yaw_rad", "yaw_rate_rad_s")

@@ -25,7 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from workbench.errors import WorkbenchInputError, require_in_range, require_positive
+from workbench.base.errors import WorkbenchInputError, require_in_range, require_positive
 
 #: Time step (s) of the slew-rate limiter of max_rate_deg_s.
 _SLEW_STEP_S = 1e-3

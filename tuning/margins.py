@@ -34,7 +34,7 @@ from controllers.clothoid.loop_analysis import (
     loop_transfer,
     predicted_limit_cycle,
 )
-from workbench.errors import WorkbenchInputError, require_in_range
+from workbench.base.errors import WorkbenchInputError, require_in_range
 from workbench.vehicles.base import VehicleGeometry
 
 if TYPE_CHECKING:

@@ -19,7 +19,7 @@ from tuning.lead_design import LeadDesign, ValidationTrace
 from tuning.margins import MarginResult
 from tuning.rollover import RolloverLimit
 from tuning.schedule import ScheduleResult
-from workbench.errors import WorkbenchInputError
+from workbench.base.errors import WorkbenchInputError
 
 
 def _save(fig: plt.Figure, path: str | Path) -> Path:

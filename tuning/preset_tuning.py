@@ -60,7 +60,7 @@ from tuning.schedule import (
 from tuning.speeds import check_speeds
 from tuning.steering_limits import steering_limits
 from tuning.steering_limits import to_curvature_limits as steering_curvature_limits
-from workbench.errors import WorkbenchInputError, require_in_range
+from workbench.base.errors import WorkbenchInputError, require_in_range
 from workbench.vehicles import list_presets, make_vehicle
 from workbench.vehicles.base import VehicleModel
 

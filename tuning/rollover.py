@@ -22,7 +22,7 @@ from dataclasses import dataclass
 
 from controllers.clothoid.curvature_limits import CurvatureLimits
 from tuning.speeds import check_speeds
-from workbench.errors import WorkbenchInputError, require_in_range
+from workbench.base.errors import WorkbenchInputError, require_in_range
 from workbench.vehicles.base import VehicleModel
 
 LTR_OUTPUT = "ltr"

@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 from scipy import signal, sparse
 
-from workbench.errors import WorkbenchInputError
+from workbench.base.errors import WorkbenchInputError
 
 
 def savgol_matrix(n: int, window: int, deriv: int, dt_s: float, order: int = 3) -> sparse.csr_matrix:

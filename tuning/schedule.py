@@ -54,9 +54,9 @@ from tuning.lead_design import (
 from tuning.log_file import VehicleLog
 from tuning.maneuvers import Maneuver
 from tuning.speeds import check_speeds
-from workbench.errors import WorkbenchInputError, require_in_range
-from workbench.scenarios import ScenarioOptions, make_scenario
-from workbench.simulator import Simulation, SimulationConfig
+from workbench.base.errors import WorkbenchInputError, require_in_range
+from workbench.simulation.scenarios import ScenarioOptions, make_scenario
+from workbench.simulation.simulator import Simulation, SimulationConfig
 from workbench.vehicles.base import VehicleModel
 from workbench.vehicles.steering_lag import SteeringLag
 

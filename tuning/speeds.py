@@ -6,7 +6,7 @@ import itertools
 import math
 from collections.abc import Sequence
 
-from workbench.errors import WorkbenchInputError, require_in_range
+from workbench.base.errors import WorkbenchInputError, require_in_range
 
 ELLIPSIS = "..."
 MAX_SPEEDS = 200

@@ -36,7 +36,7 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from workbench.errors import WorkbenchInputError, value_text
+from workbench.base.errors import WorkbenchInputError, value_text
 
 FIT_OK = 0
 FIT_SATURATED = 1

@@ -70,8 +70,8 @@ from controllers.config_checks import (
     check_optional_instance,
     check_optional_number,
 )
-from workbench.errors import WorkbenchInputError, value_text
-from workbench.path import PathTracker, ReferencePath
+from workbench.base.errors import WorkbenchInputError, value_text
+from workbench.base.path import PathTracker, ReferencePath
 from workbench.vehicles.base import VehicleGeometry, VehicleModel
 
 LOOKAHEAD_MODES = ("adaptive", "fixed", "speed")

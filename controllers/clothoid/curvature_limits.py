@@ -24,8 +24,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from workbench.errors import WorkbenchInputError, require_positive, value_text
-from workbench.input_files import check_input_file
+from workbench.base.errors import WorkbenchInputError, require_positive, value_text
+from workbench.base.input_files import check_input_file
 from workbench.vehicles.base import VehicleGeometry
 
 REQUIRED_COLUMNS = ("speed_kmh", "max_curvature_1pm")

@@ -27,9 +27,9 @@ from types import MappingProxyType
 from typing import Any
 
 from controllers.clothoid.lead_filter import LeadFilterParams
-from workbench.errors import WorkbenchInputError, require_in_range
-from workbench.input_files import read_json, read_toml
-from workbench.typed_tables import check_keys
+from workbench.base.errors import WorkbenchInputError, require_in_range
+from workbench.base.input_files import read_json, read_toml
+from workbench.base.typed_tables import check_keys
 
 FORMAT_TAG = "lead-filter/1"
 PARAM_KEYS = ("omega_z_rad_s", "psi", "omega_p_rad_s")

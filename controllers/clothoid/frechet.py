@@ -39,7 +39,7 @@ import math
 import numpy as np
 from numba import njit
 
-from workbench.errors import WorkbenchInputError
+from workbench.base.errors import WorkbenchInputError
 
 # Squared distances within [_SQ_LOW, _SQ_HIGH] are normal floats whose square root is as accurate as hypot's;
 # outside it (distances < 1e-140 or > 1e140) squaring may have underflowed or overflowed somewhere.

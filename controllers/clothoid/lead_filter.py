@@ -26,7 +26,7 @@ import control
 import numpy as np
 from scipy import optimize, signal
 
-from workbench.errors import WorkbenchInputError, require_in_range, require_positive, value_text
+from workbench.base.errors import WorkbenchInputError, require_in_range, require_positive, value_text
 
 #: Sane ranges of the corner frequencies (rad/s) and of the zero damping psi (exclusive of 0).
 OMEGA_RANGE_RAD_S = (0.01, 1000.0)

@@ -26,8 +26,8 @@ from numba import njit
 
 from controllers.clothoid.clothoid_fit import FIT_UNREACHABLE, fit_kernel, sample_kernel
 from controllers.clothoid.frechet import frechet_kernel
-from workbench.path import ReferencePath
-from workbench.path_search import first_beyond
+from workbench.base.path import ReferencePath
+from workbench.base.path_search import first_beyond
 
 #: Most points per sampled curve (the Fréchet cost grows with its square).
 MAX_CURVE_POINTS = 64

@@ -38,7 +38,7 @@ from scipy import signal
 
 from controllers.clothoid.clothoid_fit import fit_kernel
 from controllers.clothoid.lead_filter import DiscreteLeadFilter, LeadFilterParams
-from workbench.errors import WorkbenchInputError, require_in_range, require_positive, value_text
+from workbench.base.errors import WorkbenchInputError, require_in_range, require_positive, value_text
 from workbench.vehicles.steering_lag import SteeringLag
 
 #: Design requirement the controller keeps at every lookahead it may pick (issue 15): phase margin (deg), and gain

@@ -30,8 +30,8 @@ from dataclasses import dataclass
 
 from controllers.clothoid.clothoid_fit import fit_kernel
 from controllers.clothoid.pose_prediction import along_arc
-from workbench.errors import require_in_range
-from workbench.path import Projection, ReferencePath
+from workbench.base.errors import require_in_range
+from workbench.base.path import Projection, ReferencePath
 
 #: Saturation of the reference fit's kappa' (1/m^2): far above any path's, so the fit is never clipped.
 _REFERENCE_KDOT_MAX = 1e6

@@ -60,9 +60,9 @@ from typing import TYPE_CHECKING, Any
 from controllers.clothoid.curvature_limits import CurvatureLimits
 from controllers.clothoid.filter_file import FilterSchedule, read_filter_file
 from controllers.config_checks import shown_all
-from workbench.errors import WorkbenchInputError, value_text
-from workbench.input_files import read_json
-from workbench.user_cache import user_cache_dir
+from workbench.base.errors import WorkbenchInputError, value_text
+from workbench.base.input_files import read_json
+from workbench.base.user_cache import user_cache_dir
 from workbench.vehicles.base import VehicleModel
 from workbench.vehicles.presets import MODEL_TYPES, params_from_toml, preset_text
 from workbench.vehicles.steering_lag import SteeringLag

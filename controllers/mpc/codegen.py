@@ -21,7 +21,7 @@ from pathlib import Path
 import casadi as ca
 import numpy as np
 
-from workbench.user_cache import user_cache_dir
+from workbench.base.user_cache import user_cache_dir
 
 #: Environment variable naming the directory compiled libraries are cached in.
 CACHE_ENV = "WORKBENCH_MPC_CACHE"

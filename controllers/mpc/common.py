@@ -42,8 +42,8 @@ from controllers.mpc.prediction_model import (
 from controllers.mpc.preview import PathPreview
 from controllers.mpc.solver import MPCSolver
 from controllers.mpc.status import SolveStatus
-from workbench.errors import WorkbenchInputError
-from workbench.path import PathTracker, Projection, ReferencePath, wrap_angle
+from workbench.base.errors import WorkbenchInputError
+from workbench.base.path import PathTracker, Projection, ReferencePath, wrap_angle
 from workbench.vehicles.base import VehicleGeometry
 from workbench.vehicles.steering_lag import SteeringLag
 

@@ -32,7 +32,7 @@ from controllers.mpc.common import MPCConfig, MPCController
 from controllers.mpc.ocp import TrackingOCP
 from controllers.mpc.sparse_qp import OsqpSettings
 from controllers.mpc.status import SolveResult
-from workbench.errors import WorkbenchInputError, value_text
+from workbench.base.errors import WorkbenchInputError, value_text
 from workbench.vehicles.base import VehicleGeometry
 
 

@@ -24,7 +24,7 @@ from controllers.config_checks import check_whole
 from controllers.mpc.codegen import CompiledFunction, FastFunction, compile_function
 from controllers.mpc.prediction_model import PredictionModel
 from controllers.mpc.sparse_qp import OsqpSettings, SparseMPCQP
-from workbench.errors import WorkbenchInputError, require_in_range, require_positive
+from workbench.base.errors import WorkbenchInputError, require_in_range, require_positive
 
 
 @dataclass(frozen=True)

@@ -51,7 +51,7 @@ import casadi as ca
 import numpy as np
 from numba import njit
 
-from workbench.errors import WorkbenchInputError
+from workbench.base.errors import WorkbenchInputError
 from workbench.vehicles.base import VehicleGeometry, VehicleModel
 from workbench.vehicles.single_track import (
     PredictionParams,

@@ -18,7 +18,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from workbench.path import ReferencePath
+from workbench.base.path import ReferencePath
 
 
 class PathPreview:

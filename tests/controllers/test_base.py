@@ -10,8 +10,8 @@ import pytest
 
 from controllers import base
 from controllers.base import Controller, Measurement
-from workbench.clothoid_chain import ClothoidChain
-from workbench.path import ReferencePath
+from workbench.base.clothoid_chain import ClothoidChain
+from workbench.base.path import ReferencePath
 from workbench.vehicles import KinematicBicycle
 
 PATH = ClothoidChain().straight(50.0).to_path("straight")
@@ -152,7 +152,7 @@ def test_the_flags_are_there_before_the_first_step() -> None:
 
 
 def test_a_bad_sample_time_is_refused_for_every_controller() -> None:
-    from workbench.errors import WorkbenchInputError
+    from workbench.base.errors import WorkbenchInputError
 
     with pytest.raises(WorkbenchInputError, match="sample_time_s"):
         _Scripted(GEOMETRY).reset(PATH, 0.0)

@@ -11,7 +11,7 @@ from controllers import CONTROLLERS
 from controllers.clothoid import ClothoidConfig
 from controllers.clothoid.filter_file import DEFAULT_FILTER, read_filter_file, write_filter_file
 from controllers.config_file import build_config, config_template, read_controller_config
-from workbench.errors import WorkbenchInputError
+from workbench.base.errors import WorkbenchInputError
 
 
 def test_file_then_overrides_with_types_and_relative_paths(tmp_path: Path) -> None:

@@ -13,8 +13,8 @@ import pytest
 from controllers import CONTROLLERS, make_controller
 from controllers.base import Measurement
 from controllers.mpc import MPCConfig
-from workbench.clothoid_chain import ClothoidChain
-from workbench.errors import WorkbenchInputError, value_text
+from workbench.base.clothoid_chain import ClothoidChain
+from workbench.base.errors import WorkbenchInputError, value_text
 from workbench.vehicles import KinematicBicycle
 
 CONFIGS = {cls.config_type.__name__: (name, cls.config_type) for name, cls in CONTROLLERS.items()}

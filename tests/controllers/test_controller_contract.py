@@ -11,10 +11,10 @@ import pytest
 
 from controllers import CONTROLLERS, make_controller
 from controllers.base import Measurement
-from workbench.clothoid_chain import ClothoidChain
-from workbench.errors import WorkbenchInputError
-from workbench.scenarios import make_scenario
-from workbench.simulator import Simulation, SimulationConfig
+from workbench.base.clothoid_chain import ClothoidChain
+from workbench.base.errors import WorkbenchInputError
+from workbench.simulation.scenarios import make_scenario
+from workbench.simulation.simulator import Simulation, SimulationConfig
 from workbench.vehicles import KinematicBicycle
 
 NAMES = sorted(CONTROLLERS)

@@ -24,9 +24,9 @@ from test_controller_contract import PATH as CONTRACT_PATH
 
 from controllers import CONTROLLERS, make_controller
 from controllers.base import MAX_SPEED_MPS, STEER_SENSOR_MARGIN, Measurement
-from workbench.errors import WorkbenchInputError
-from workbench.path import ReferencePath
-from workbench.scenarios import make_scenario
+from workbench.base.errors import WorkbenchInputError
+from workbench.base.path import ReferencePath
+from workbench.simulation.scenarios import make_scenario
 from workbench.vehicles import KinematicBicycle
 from workbench.vehicles.base import VehicleGeometry
 

@@ -12,7 +12,7 @@ import pytest
 from tuning.cli import main
 from tuning.data_generation import LOG_COLUMNS, generate_open_loop_log
 from tuning.maneuvers import Maneuver
-from workbench.errors import WorkbenchInputError
+from workbench.base.errors import WorkbenchInputError
 from workbench.vehicles import KinematicBicycle
 
 

@@ -23,7 +23,7 @@ from tuning.lag_fit import (
 )
 from tuning.log_file import VehicleLog
 from tuning.schedule import identification_logs
-from workbench.errors import WorkbenchInputError
+from workbench.base.errors import WorkbenchInputError
 from workbench.vehicles import make_vehicle
 
 KINDS = ("dlc", "step-series", "chirp")

@@ -15,7 +15,7 @@ from controllers.clothoid.lead_filter import LeadFilterParams
 from controllers.clothoid.loop_analysis import LoopSettings, Margins, PlantLags, loop_margins
 from tuning.lead_design import design_lead, design_lead_for_margins, margin_score, validate
 from tuning.log_file import VehicleLog
-from workbench.errors import WorkbenchInputError
+from workbench.base.errors import WorkbenchInputError
 from workbench.vehicles.steering_lag import SteeringLag
 
 G3 = 10 ** (-3 / 20)  # python-control's -3 dB

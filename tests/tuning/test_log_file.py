@@ -10,7 +10,7 @@ import pytest
 from synthetic_logs import synthetic_frame
 
 from tuning.log_file import LOG_COLUMNS, VehicleLog, read_log
-from workbench.errors import WorkbenchInputError
+from workbench.base.errors import WorkbenchInputError
 
 
 def frame() -> pd.DataFrame:

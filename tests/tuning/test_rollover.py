@@ -9,7 +9,7 @@ import pytest
 
 from controllers.clothoid.curvature_limits import CurvatureLimits
 from tuning.rollover import rollover_limit, rollover_limits, step_steer, to_curvature_limits
-from workbench.errors import WorkbenchInputError
+from workbench.base.errors import WorkbenchInputError
 from workbench.vehicles import make_vehicle
 
 G = 9.80665

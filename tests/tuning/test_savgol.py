@@ -9,7 +9,7 @@ from hypothesis import strategies as st
 from scipy import signal
 
 from tuning.savgol import savgol_matrix
-from workbench.errors import WorkbenchInputError
+from workbench.base.errors import WorkbenchInputError
 
 
 @settings(max_examples=30, deadline=None)

@@ -18,7 +18,7 @@ from tuning.schedule import (
     scheduled_against_fixed,
     steer_amplitude_deg,
 )
-from workbench.errors import WorkbenchInputError
+from workbench.base.errors import WorkbenchInputError
 from workbench.vehicles import make_vehicle
 
 

@@ -12,7 +12,7 @@ import tuning.schedule
 from controllers.clothoid.curvature_limits import CurvatureLimits
 from tuning.cli import main
 from tuning.steering_limits import steering_limits
-from workbench.errors import WorkbenchInputError
+from workbench.base.errors import WorkbenchInputError
 from workbench.vehicles import make_vehicle
 
 

@@ -242,7 +242,7 @@ def test_unusable_files_and_folders_are_refused_before_any_work(
 
 
 def test_an_unwritable_output_folder_is_refused(tmp_path: Path, capsys, monkeypatch) -> None:
-    monkeypatch.setattr("workbench.output_dir.os.access", lambda *_args, **_kw: False)  # as without permission
+    monkeypatch.setattr("workbench.base.output_dir.os.access", lambda *_args, **_kw: False)  # as without permission
     assert main([*GENERATE, "--out", str(tmp_path / "new" / "log.csv")]) == 2
     assert f"the folder {str(tmp_path)!r} is not writable (permission denied)" in capsys.readouterr().err
     assert not (tmp_path / "new").exists()

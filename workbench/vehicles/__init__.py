@@ -11,7 +11,7 @@ from collections.abc import Callable
 from functools import partial
 from os import PathLike
 
-from workbench.errors import WorkbenchInputError
+from workbench.base.errors import WorkbenchInputError
 from workbench.vehicles.base import STANDARD_OUTPUTS, VehicleGeometry, VehicleModel
 from workbench.vehicles.commonroad_mb import CommonRoadMB, CommonRoadMBParams
 from workbench.vehicles.dynamic_bicycle import DynamicBicycle, DynamicBicycleParams

@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
 
-from workbench.errors import require_in_range, require_positive
+from workbench.base.errors import require_in_range, require_positive
 
 if TYPE_CHECKING:
     from workbench.vehicles.single_track import PredictionParams

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 from numba import njit
 
-from workbench.errors import WorkbenchInputError
+from workbench.base.errors import WorkbenchInputError
 
 #: Time constant (s) with which the blended kinematic branch pulls the lateral states onto the no-slip values.
 KINEMATIC_PULL_S = 0.02

@@ -17,7 +17,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from workbench.errors import WorkbenchInputError, require_in_range
+from workbench.base.errors import WorkbenchInputError, require_in_range
 from workbench.vehicles.base import VehicleGeometry, VehicleModel
 from workbench.vehicles.integration import rk4_python
 from workbench.vehicles.reference_point import reference_point_python

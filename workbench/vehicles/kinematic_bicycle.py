@@ -16,7 +16,7 @@ from typing import ClassVar
 import numpy as np
 from numba import njit
 
-from workbench.errors import require_in_range, require_positive
+from workbench.base.errors import require_in_range, require_positive
 from workbench.vehicles.actuator import realised_accel, road_wheel_rate
 from workbench.vehicles.base import CompiledVehicleModel, VehicleGeometry
 from workbench.vehicles.integration import rk4

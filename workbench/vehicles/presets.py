@@ -20,9 +20,9 @@ from importlib import resources
 from pathlib import Path
 from typing import Any
 
-from workbench.errors import WorkbenchInputError, value_text
-from workbench.input_files import parse_toml, read_text
-from workbench.typed_tables import check_keys, dataclass_from_table
+from workbench.base.errors import WorkbenchInputError, value_text
+from workbench.base.input_files import parse_toml, read_text
+from workbench.base.typed_tables import check_keys, dataclass_from_table
 from workbench.vehicles.base import VehicleModel
 from workbench.vehicles.commonroad_mb import CommonRoadMB, CommonRoadMBParams
 from workbench.vehicles.dynamic_bicycle import DynamicBicycle, DynamicBicycleParams

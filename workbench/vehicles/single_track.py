@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from workbench.errors import WorkbenchInputError, require_in_range, require_positive
+from workbench.base.errors import WorkbenchInputError, require_in_range, require_positive
 from workbench.vehicles.steering_lag import SteeringLag
 
 if TYPE_CHECKING:

@@ -42,8 +42,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from workbench.errors import WorkbenchInputError, require_in_range
-from workbench.input_files import read_json
+from workbench.base.errors import WorkbenchInputError, require_in_range
+from workbench.base.input_files import read_json
 
 if TYPE_CHECKING:  # python-control and scipy.signal are imported where used: they take long to import
     import control

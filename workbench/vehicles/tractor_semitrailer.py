@@ -32,7 +32,7 @@ from typing import ClassVar
 import numpy as np
 from numba import njit
 
-from workbench.errors import WorkbenchInputError, require_in_range
+from workbench.base.errors import WorkbenchInputError, require_in_range
 from workbench.vehicles.actuator import realised_accel, road_wheel_rate
 from workbench.vehicles.base import CompiledVehicleModel, VehicleGeometry
 from workbench.vehicles.blend import blend, blend_weight, check_blend_speeds, pull

@@ -21,7 +21,7 @@ from controllers.clothoid.clothoid_fit import (
     fit_kernel,
     sample_kernel,
 )
-from workbench.errors import WorkbenchInputError
+from workbench.base.errors import WorkbenchInputError
 
 WIDE_RATE = 10.0  # 1/m^2: never binding for the feasible targets below
 

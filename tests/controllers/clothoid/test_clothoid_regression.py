@@ -4,7 +4,7 @@
 On each run the controller, with the vehicle's own tuning (`make_controller(..., vehicle=vehicle)`):
   - completes the run and tracks (max |CTE| under MAX_ABS_CTE_M, a generous bound: the reference controllers stay
     well under 0.1 m on both courses);
-  - does not limit-cycle (`workbench.limit_cycle.detect_limit_cycle` on the steering wheel, the metric
+  - does not limit-cycle (`workbench.simulation.limit_cycle.detect_limit_cycle` on the steering wheel, the metric
     `limit_cycle`);
   - steers no more restlessly than a reference controller on the same run: the steering oscillation
     (`steer_oscillation_deg`, the RMS of the steering wheel about its 1 s moving average) at most
@@ -25,10 +25,10 @@ import pytest
 
 from controllers import make_controller
 from controllers.mpc import NMPCConfig
-from workbench.clothoid_chain import ClothoidChain
-from workbench.metrics import Metrics
-from workbench.scenarios import Scenario, ScenarioOptions, make_scenario
-from workbench.simulator import Simulation, SimulationConfig
+from workbench.base.clothoid_chain import ClothoidChain
+from workbench.simulation.metrics import Metrics
+from workbench.simulation.scenarios import Scenario, ScenarioOptions, make_scenario
+from workbench.simulation.simulator import Simulation, SimulationConfig
 from workbench.vehicles import make_vehicle
 
 VEHICLES = ("kinematic-bicycle", "dynamic-bicycle", "tractor-semitrailer", "commonroad-mb")

@@ -19,9 +19,9 @@ from controllers.clothoid import (
     write_filter_file,
 )
 from controllers.config_file import build_config
-from workbench.clothoid_chain import ClothoidChain
-from workbench.errors import WorkbenchInputError
-from workbench.path import ReferencePath
+from workbench.base.clothoid_chain import ClothoidChain
+from workbench.base.errors import WorkbenchInputError
+from workbench.base.path import ReferencePath
 from workbench.vehicles import KinematicBicycle, make_vehicle
 
 TRUCK = make_vehicle("tractor-semitrailer")
@@ -231,8 +231,8 @@ def test_missing_filter_file_names_it(tmp_path: Path) -> None:
 
 
 def test_runs_on_the_kinematic_car_with_every_lookahead_mode() -> None:
-    from workbench.scenarios import make_scenario
-    from workbench.simulator import Simulation, SimulationConfig
+    from workbench.simulation.scenarios import make_scenario
+    from workbench.simulation.simulator import Simulation, SimulationConfig
 
     vehicle = KinematicBicycle()
     for mode in ("adaptive", "fixed", "speed"):

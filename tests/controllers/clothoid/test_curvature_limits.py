@@ -12,7 +12,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from controllers.clothoid.curvature_limits import G_MPS2, CurvatureLimits
-from workbench.errors import WorkbenchInputError
+from workbench.base.errors import WorkbenchInputError
 from workbench.vehicles import make_vehicle
 
 TRUCK = make_vehicle("tractor-semitrailer").geometry

@@ -22,7 +22,7 @@ from controllers.clothoid.filter_file import (
     write_filter_file,
 )
 from controllers.clothoid.lead_filter import LeadFilterParams
-from workbench.errors import WorkbenchInputError
+from workbench.base.errors import WorkbenchInputError
 
 SLOW, FAST = LeadFilterParams(5.0, 0.7, 15.0), LeadFilterParams(3.0, 0.9, 12.0)
 SCHEDULE = FilterSchedule((20.0, 60.0), (SLOW, FAST))

@@ -13,7 +13,7 @@ from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
 from controllers.clothoid.frechet import discrete_frechet, frechet_kernel, frechet_with_early_exit
-from workbench.errors import WorkbenchInputError
+from workbench.base.errors import WorkbenchInputError
 
 # The kernel returns sqrt of one pairwise squared distance; references computed another way (hypot, scipy's
 # minkowski) differ from it by a few ulps at most.

@@ -13,7 +13,7 @@ from hypothesis import strategies as st
 from scipy import signal
 
 from controllers.clothoid.lead_filter import DiscreteLeadFilter, LeadFilterParams, PassThroughFilter
-from workbench.errors import WorkbenchInputError
+from workbench.base.errors import WorkbenchInputError
 
 PAPER_LIKE = LeadFilterParams.from_lag(4.44, 0.80)  # wz = 4.44, psi = 0.8, wp = 13.32 rad/s
 DESIGNS = [PAPER_LIKE, LeadFilterParams(2.0, 0.3, 9.0), LeadFilterParams(10.0, 2.0, 25.0), LeadFilterParams(1, 1, 1)]

@@ -16,7 +16,7 @@ from controllers.clothoid.lookahead import (
     adaptive_search,
     candidate_lookaheads,
 )
-from workbench.clothoid_chain import ClothoidChain
+from workbench.base.clothoid_chain import ClothoidChain
 
 BEND = ClothoidChain().straight(20.0).clothoid_to(1 / 12, 8.0).arc(40.0).to_path("sharp bend")
 KDOT_MAX = 0.05

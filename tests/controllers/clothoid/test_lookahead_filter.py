@@ -7,7 +7,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from controllers.clothoid.lookahead_filter import LookaheadFilter, LookaheadFilterSettings
-from workbench.errors import WorkbenchInputError
+from workbench.base.errors import WorkbenchInputError
 
 
 def test_first_choice_is_taken_within_the_floor_and_ceiling() -> None:

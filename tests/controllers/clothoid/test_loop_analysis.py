@@ -25,7 +25,7 @@ from controllers.clothoid.loop_analysis import (
     predicted_limit_cycle,
     saturation_describing_function,
 )
-from workbench.errors import WorkbenchInputError
+from workbench.base.errors import WorkbenchInputError
 from workbench.vehicles.steering_lag import SteeringLag
 
 #: The loaded truck's lags at 30 km/h as `tuning fit-lag --delay` identifies them (path curvature and yaw rate).

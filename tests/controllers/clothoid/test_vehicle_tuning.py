@@ -35,7 +35,7 @@ from controllers.clothoid.vehicle_tuning import (
 from tuning.cli import _parser as tuning_parser
 from tuning.lag_fit import DELAY_FIT_MAX_ZETA
 from tuning.preset_tuning import PRESET_TUNING_OPTIONS, PresetTuningOptions, regenerate_command
-from workbench.errors import WorkbenchInputError
+from workbench.base.errors import WorkbenchInputError
 from workbench.vehicles import list_presets, make_vehicle, preset_text
 from workbench.vehicles.presets import params_from_toml
 from workbench.vehicles.steering_lag import SteeringLag

@@ -14,10 +14,10 @@ from hypothesis import strategies as st
 from controllers.base import Measurement
 from controllers.config_file import build_config
 from controllers.mpc import LMPCConfig, LMPCController, NMPCConfig, NMPCController, SolveStatus
-from workbench.clothoid_chain import ClothoidChain
-from workbench.errors import WorkbenchInputError
-from workbench.scenarios import Scenario, ScenarioOptions, make_scenario
-from workbench.simulator import Simulation, SimulationConfig
+from workbench.base.clothoid_chain import ClothoidChain
+from workbench.base.errors import WorkbenchInputError
+from workbench.simulation.scenarios import Scenario, ScenarioOptions, make_scenario
+from workbench.simulation.simulator import Simulation, SimulationConfig
 from workbench.vehicles import VehicleGeometry, make_vehicle, preset_text
 from workbench.vehicles.steering_lag import SteeringLag, write_lag_file
 

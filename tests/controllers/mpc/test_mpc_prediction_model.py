@@ -18,7 +18,7 @@ from controllers.mpc.prediction_model import (
     params_from_geometry,
     prediction_params_for,
 )
-from workbench.errors import WorkbenchInputError
+from workbench.base.errors import WorkbenchInputError
 from workbench.vehicles import (
     VEHICLES,
     DynamicBicycleParams,

@@ -8,8 +8,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from controllers.mpc.preview import PathPreview
-from workbench.clothoid_chain import ClothoidChain
-from workbench.path import ReferencePath
+from workbench.base.clothoid_chain import ClothoidChain
+from workbench.base.path import ReferencePath
 
 OPEN = ClothoidChain().straight(10.0).clothoid_to(1 / 25, 12.0).arc(20.0).clothoid_to(0.0, 12.0).to_path("open")
 OPEN = OPEN.with_speed(np.linspace(4.0, 12.0, OPEN.curvature_1pm.size))

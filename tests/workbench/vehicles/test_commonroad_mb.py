@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from workbench.errors import WorkbenchInputError
+from workbench.base.errors import WorkbenchInputError
 from workbench.vehicles import CommonRoadMB, CommonRoadMBParams, DynamicBicycle
 
 MB = CommonRoadMB()

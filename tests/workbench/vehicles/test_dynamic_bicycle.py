@@ -11,7 +11,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from workbench.errors import WorkbenchInputError
+from workbench.base.errors import WorkbenchInputError
 from workbench.vehicles import DynamicBicycle, DynamicBicycleParams
 
 G = 9.81

@@ -15,7 +15,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from tuning import lag_fit
-from workbench.errors import WorkbenchInputError
+from workbench.base.errors import WorkbenchInputError
 from workbench.vehicles.steering_lag import (
     DELAY_BOUNDS,
     GAIN_BOUNDS,

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from workbench.errors import WorkbenchInputError
+from workbench.base.errors import WorkbenchInputError
 from workbench.vehicles import VEHICLES, list_presets, load_vehicle, make_vehicle, preset_text
 from workbench.vehicles.presets import MODEL_TYPES
 

@@ -1,0 +1,533 @@
+"""The `workbench` command line: list scenarios, vehicles and controllers; run a closed-loop simulation; compare
+controllers side by side (`compare`, and the paper's Figure 17 set-up, `fig17`); run parameter sweeps and tune
+controllers from a study spec (`sweep`, `optimise`; `workbench.apps.studies`).
+
+Every input file and output folder is checked before any work starts (`workbench.base.input_files`,
+`workbench.base.output_dir`): a missing or unreadable file, a folder where a file is wanted or a file where a folder is,
+a parent that is a file, an unwritable folder, and a non-empty output folder without --overwrite are refused with
+`workbench: error: ...` and exit code 2.
+
+Exit codes: 0 done; 1 a run did not complete (run, compare, fig17), a sweep run raised an error, no optimisation
+trial completed, or a study's worker died; 2 bad input; 130 interrupted.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import shutil
+import signal
+import sys
+from collections.abc import Callable, Iterator, Sequence
+from contextlib import contextmanager
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from controllers import CONTROLLERS
+from workbench.base.errors import WorkbenchInputError
+from workbench.base.output_dir import MANIFEST
+
+if TYPE_CHECKING:
+    from workbench.apps.comparison import Comparison
+    from workbench.apps.studies import StudySpec
+    from workbench.apps.studies.backends import Backend
+    from workbench.base.output_dir import OutputDir
+
+# Heavy modules (the simulator, the scenarios' paths, plotting, the controllers' solvers, the studies' backends)
+# are imported inside the command that needs them, so that `workbench --help` and `workbench scenarios` start
+# fast (issue 17; benchmarks/startup.py measures it).
+
+EXIT_INPUT_ERROR = 2
+EXIT_RUN_FAILED = 1
+EXIT_INTERRUPTED = 130
+
+#: The input-file options of the commands (argparse dest -> what the message calls it).
+INPUT_FILES = {
+    "track": "--track",
+    "controller_config": "--controller-config",
+    "vehicle_file": "--vehicle-file",
+    "spec": "the spec",
+}
+
+
+def _command_word(argv: Sequence[str]) -> str:
+    """The command argv names (its first word that is not an option), or "" without one."""
+    return next((word for word in argv if not word.startswith("-")), "")
+
+
+def _parser(command: str | None = None) -> argparse.ArgumentParser:
+    """The parser of every command. `command` (the one being run, "" for none) limits the imports a command's
+    options need (the studies' default size) to that command's; None: every command's, as `workbench sweep -h`."""
+    parser = argparse.ArgumentParser(
+        prog="workbench", description="Design, tune and compare lateral (steering) controllers."
+    )
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+
+    scen = sub.add_parser("scenarios", help="list the named scenarios")
+    scen.add_argument("--track", type=Path, help="Zandvoort track CSV (TUMFTM racetrack-database format)")
+    veh = sub.add_parser("vehicles", help="list the vehicle models and presets")
+    veh.add_argument("--show", metavar="NAME", help="print a preset's TOML (copy, edit, pass with --vehicle-file)")
+    ctl = sub.add_parser("controllers", help="list the controllers")
+    ctl.add_argument("--show", metavar="NAME", help="print a controller's options as TOML (for --controller-config)")
+
+    run = sub.add_parser("run", help="simulate one controller on one vehicle along one scenario")
+    run.add_argument("scenario", help="a scenario name (see `workbench scenarios`) or a waypoint CSV file")
+    run.add_argument("--controller", default="pure-pursuit", help="controller name (default: pure-pursuit)")
+    run.add_argument(
+        "--controller-config",
+        type=Path,
+        metavar="FILE.toml",
+        help="controller options: a TOML file with a [<controller name>] table (see `workbench controllers --show`)",
+    )
+    run.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help="a controller option, over the config file (repeatable), e.g. --set frechet_threshold_m=0.3",
+    )
+    run.add_argument("--vehicle", default=None, help="vehicle model (default: kinematic-bicycle)")
+    run.add_argument("--vehicle-file", type=Path, help="a vehicle TOML file (see `workbench vehicles --show`)")
+    run.add_argument("--payload-kg", type=float, help="payload of vehicles that carry one (tractor-semitrailer)")
+    run.add_argument("--speed", type=float, default=30.0, metavar="KMH", help="target speed, km/h (default 30)")
+    run.add_argument("--out", type=Path, required=True, metavar="DIR", help="output directory")
+    run.add_argument("--track", type=Path, help="track CSV for the zandvoort scenario")
+    run.add_argument("--laps", type=int, default=1, help="laps of a closed path (default 1)")
+    run.add_argument("--controller-rate-hz", type=float, default=50.0, help="controller rate (default 50 Hz)")
+    run.add_argument("--plant-rate-hz", type=float, default=1000.0, help="plant integration rate (default 1 kHz)")
+    run.add_argument("--lat-accel-g", type=float, default=0.3, help="speed-profile lateral bound (default 0.3 g)")
+    run.add_argument("--no-plots", action="store_true", help="write the trace and metrics only")
+    _overwrite_option(run)
+
+    cmp = sub.add_parser("compare", help="run several controllers (and vehicles) on one scenario; write a report")
+    cmp.add_argument("scenario", help="a scenario name (see `workbench scenarios`) or a waypoint CSV file")
+    cmp.add_argument(
+        "--controllers",
+        required=True,
+        metavar="A,B,...",
+        help=f"comma-separated controller names ({', '.join(CONTROLLERS)})",
+    )
+    cmp.add_argument(
+        "--vehicle", required=True, metavar="NAME[,NAME...]", help="vehicle preset(s); each controller runs on each"
+    )
+    cmp.add_argument(
+        "--controller-config",
+        type=Path,
+        metavar="FILE.toml",
+        help="controller options: a TOML file with a table per controller name",
+    )
+    cmp.add_argument("--out", type=Path, required=True, metavar="DIR", help="output directory")
+    _sim_options(cmp)
+    _overwrite_option(cmp)
+
+    fig = sub.add_parser(
+        "fig17", help="the paper's Figure 17/18 comparison: clothoid vs NMPC, as published and each on each plant"
+    )
+    fig.add_argument("--out", type=Path, required=True, metavar="DIR", help="output directory (report.html in it)")
+    fig.add_argument("--speed", type=float, default=30.0, metavar="KMH", help="target speed, km/h (default 30)")
+    _overwrite_option(fig)
+
+    paper = sub.add_parser("paper", help="regenerate the paper's figures 4b-16 and a table of ours against its numbers")
+    paper.add_argument("--out", type=Path, required=True, metavar="DIR", help="output directory")
+    paper.add_argument("--track", type=Path, help="Zandvoort track CSV (Figures 15-16)")
+    _overwrite_option(paper)
+
+    swp = sub.add_parser(
+        "sweep", help="run every run a study spec plans (grids, random draws); resumes; DIR/results.parquet"
+    )
+    swp.add_argument("spec", type=Path, metavar="SPEC.toml", help="the study spec (see README: Studies)")
+    swp.add_argument("--out", type=Path, required=True, metavar="DIR", help="output directory (rerun to resume)")
+    _backend_options(swp, command in (None, "sweep"))
+    swp.add_argument("--no-plots", action="store_true", help="write the results without the figures")
+    opt = sub.add_parser(
+        "optimise", help="tune a controller's options against the spec's objective (optuna TPE); DIR/best.toml"
+    )
+    opt.add_argument("spec", type=Path, metavar="SPEC.toml", help="the study spec with an [optimise] table")
+    opt.add_argument("--out", type=Path, required=True, metavar="DIR", help="output directory (rerun to resume)")
+    _backend_options(opt, command in (None, "optimise"))
+    return parser
+
+
+def _overwrite_option(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--overwrite",
+        action="store_true",
+        help="write into a non-empty DIR: first remove the files an earlier workbench output there wrote (listed in "
+        f"its {MANIFEST}); other files are kept",
+    )
+
+
+def _backend_options(parser: argparse.ArgumentParser, shown: bool = True) -> None:
+    """The options of the study commands; `shown` False: the parser of another command is being run, and the
+    help text (the studies' default size, `workbench.apps.studies` imported for it) is not needed."""
+    if shown:
+        from workbench.apps.studies.spec import DEFAULT_MAX_RUNS
+
+        max_runs = f"{DEFAULT_MAX_RUNS:,}"
+    else:
+        max_runs = "the studies' default"
+    parser.add_argument(
+        "--backend", choices=("local", "dask"), default="local", help="local process pool (default) or dask"
+    )
+    parser.add_argument(
+        "--scheduler", metavar="ADDRESS", help="a dask scheduler (e.g. tcp://host:8786); default: a LocalCluster"
+    )
+    parser.add_argument(
+        "--workers", type=int, metavar="N", help="worker processes (local pool or LocalCluster; default: the CPUs)"
+    )
+    parser.add_argument(
+        "--max-runs",
+        type=int,
+        metavar="N",
+        help=f"refuse a study of more runs than N (an optimisation: trials x runs; default: the spec's "
+        f"study.max_runs, else {max_runs})",
+    )
+
+
+def _sim_options(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--speed", type=float, default=30.0, metavar="KMH", help="target speed, km/h (default 30)")
+    parser.add_argument("--track", type=Path, help="track CSV for the zandvoort scenario")
+    parser.add_argument("--laps", type=int, default=1, help="laps of a closed path (default 1)")
+    parser.add_argument("--lat-accel-g", type=float, default=0.3, help="speed-profile lateral bound (default 0.3 g)")
+
+
+def _names(text: str, what: str) -> list[str]:
+    names = [n.strip() for n in text.split(",") if n.strip()]
+    if not names:
+        raise WorkbenchInputError(f"--{what} needs at least one name; got {text!r}")
+    return names
+
+
+def _check_inputs(args: argparse.Namespace) -> None:
+    """Every input file the command names (INPUT_FILES, and a waypoint file given as the scenario) must be a
+    readable file: checked before any work."""
+    from workbench.base.input_files import check_input_file
+    from workbench.simulation.scenarios import SCENARIOS
+
+    for dest, flag in INPUT_FILES.items():
+        value = getattr(args, dest, None)
+        if value is not None:
+            check_input_file(value, f"{flag} {str(value)!r}" if flag.startswith("--") else f"spec file {str(value)!r}")
+    scenario = getattr(args, "scenario", None)
+    if scenario is not None and scenario not in SCENARIOS:
+        if os.path.lexists(scenario) or Path(scenario).suffix.lower() in (".csv", ".txt"):
+            check_input_file(scenario, f"waypoint file {scenario!r}")
+
+
+@contextmanager
+def _writing(out: OutputDir) -> Iterator[None]:
+    """Write a command's output into its folder (`OutputDir.writing`: the earlier output removed first, a
+    manifest of what was written); an OSError while writing is reported as an error naming the folder; files the
+    workbench did not write, kept there, are named."""
+    try:
+        with out.writing():
+            yield
+    except OSError as exc:
+        raise WorkbenchInputError(f"--out {str(out.path)!r}: cannot write the output ({exc})") from None
+    if out.foreign:
+        shown = ", ".join(out.foreign[:5]) + (f" and {len(out.foreign) - 5} more" if len(out.foreign) > 5 else "")
+        what = "an entry" if len(out.foreign) == 1 else f"{len(out.foreign)} entries"
+        note = f"workbench: note: {out.path} also holds {what} the workbench did not write, kept: {shown}"
+        print(note, file=sys.stderr)
+
+
+def _print_summary(comparison: Comparison) -> None:
+    table = comparison.summary()
+    columns = ["controller", "vehicle", "status", "max_abs_cte_m", "rms_cte_m", "converge_distance_m"]
+    columns += ["rms_steer_rate_deg_s", "steer_oscillation_deg", "step_time_median_us", "step_time_ratio"]
+    print(table[columns].to_string(index=False, float_format=lambda v: f"{v:.3g}"))
+    for spec, cycle in zip(comparison.specs, comparison.limit_cycles(), strict=True):
+        if cycle.detected:
+            print(f"  WARNING: steering limit cycle: {spec.label} at {cycle.describe()}")
+
+
+def _compare(args: argparse.Namespace) -> int:
+    from workbench.apps.comparison import RunSpec, compare, warn_on_stderr
+    from workbench.apps.report import ReportSection, write_report
+    from workbench.base.output_dir import OutputDir
+    from workbench.simulation.scenarios import ScenarioOptions
+    from workbench.simulation.simulator import SimulationConfig
+
+    out = OutputDir(args.out, "compare", args.overwrite)
+    _check_inputs(args)
+    runs = [
+        RunSpec(controller, vehicle, config_file=args.controller_config)
+        for vehicle in _names(args.vehicle, "vehicle")
+        for controller in _names(args.controllers, "controllers")
+    ]
+    config = SimulationConfig(speed_kmh=args.speed, laps=args.laps, max_lateral_accel_g=args.lat_accel_g)
+    comparison = compare(args.scenario, runs, config, ScenarioOptions(track_file=args.track), warn=warn_on_stderr)
+    with _writing(out):
+        comparison.save(args.out)
+        report = write_report(
+            args.out / "report.html",
+            f"{comparison.scenario.name}: {', '.join(dict.fromkeys(r.controller for r in runs))}",
+            [ReportSection("Side by side", "", comparison)],
+        )
+    _print_summary(comparison)
+    print(f"wrote {report} and summary.csv, figures and runs/ beside it")
+    return 0 if all(r.completed for r in comparison.results) else EXIT_RUN_FAILED
+
+
+def _paper(args: argparse.Namespace) -> int:
+    from workbench.apps.paper import reproduce_paper
+    from workbench.base.output_dir import OutputDir
+    from workbench.simulation.scenarios import ScenarioOptions, make_scenario
+
+    out = OutputDir(args.out, "paper", args.overwrite)
+    _check_inputs(args)
+    options = ScenarioOptions(track_file=args.track)
+    if args.track is not None:
+        make_scenario("zandvoort", options)  # a track that cannot be used is refused before any work
+    with _writing(out):
+        result = reproduce_paper(args.out, options)
+    print(result.table.to_string(index=False, float_format=lambda v: f"{v:.3g}"))
+    for reason in result.skipped:
+        print(f"skipped: {reason}")
+    print(f"wrote {len(result.files)} files to {args.out}")
+    return 0
+
+
+def _fig17(args: argparse.Namespace) -> int:
+    from workbench.apps.fig17 import run_fig17
+    from workbench.base.output_dir import OutputDir
+    from workbench.simulation.simulator import SimulationConfig
+
+    out = OutputDir(args.out, "fig17", args.overwrite)
+    result = run_fig17(SimulationConfig(speed_kmh=args.speed))
+    with _writing(out):
+        written = result.save(args.out)
+    print("Figure 17, fair set (each controller on each plant):")
+    _print_summary(result.fair)
+    print(f"report: {written[-1]}")
+    return 0 if all(r.completed for r in result.fair.results) else EXIT_RUN_FAILED
+
+
+def _interruptible(study: Callable[[], int], out: Path) -> int:
+    """Run a study; SIGTERM stops it as Ctrl-C does: the rows written so far stay and the same command resumes."""
+    from workbench.apps.studies.backends import BackendError
+
+    previous = signal.signal(signal.SIGTERM, signal.default_int_handler)
+    try:
+        return study()
+    except KeyboardInterrupt:
+        print(f"workbench: interrupted; finished runs are kept in {out / 'runs'}: rerun to resume", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    except BackendError as exc:
+        print(f"workbench: {exc}; finished runs are kept in {out / 'runs'}: rerun to resume", file=sys.stderr)
+        return EXIT_RUN_FAILED
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
+def _start_study(args: argparse.Namespace, kind: str) -> tuple[StudySpec, Backend]:
+    """Check the output folder (a study's resumable store: `check_study_dir`) and the spec (every file it names,
+    the study's size), start nothing yet but the folder and the spec's copy in it."""
+    from workbench.apps.studies import load_spec, make_backend
+    from workbench.base.output_dir import check_study_dir
+
+    check_study_dir(args.out)
+    _check_inputs(args)
+    if args.max_runs is not None and args.max_runs < 1:
+        raise WorkbenchInputError(f"--max-runs must be a whole number >= 1; got {args.max_runs}")
+    spec = load_spec(args.spec, kind, max_runs=args.max_runs)
+    backend = make_backend(args.backend, args.scheduler, args.workers)
+    copy = args.out / "spec.toml"
+    try:
+        args.out.mkdir(parents=True, exist_ok=True)
+        if not copy.exists() or not copy.samefile(args.spec):
+            shutil.copyfile(args.spec, copy)
+    except OSError as exc:
+        raise WorkbenchInputError(f"--out {str(args.out)!r}: cannot write the spec's copy ({exc})") from None
+    return spec, backend
+
+
+def _sweep(args: argparse.Namespace) -> int:
+    from workbench.apps.studies import run_sweep
+
+    spec, backend = _start_study(args, "sweep")
+    n = spec.run_count()
+
+    def study() -> int:
+        print(f"{n} runs; running those not yet in {args.out} on the {backend.describe()}")
+        result = run_sweep(spec, args.out, backend, progress=sys.stderr.isatty())
+        written = [args.out / "results.parquet"] + ([] if args.no_plots else result.save_figures(args.out))
+        counts = ", ".join(f"{v} {k}" for k, v in result.status_counts().items())
+        print(f"{n} runs ({n - result.ran} already done, {result.ran} run now): {counts}")
+        print(result.summary().to_string(index=False, float_format=lambda v: f"{v:.3g}"))
+        errors = result.errors()
+        for message in list(dict.fromkeys(errors["message"]))[:3]:
+            print(f"  error: {message}")
+        print(f"wrote {', '.join(str(p) for p in written)}")
+        if len(errors):
+            print(
+                f"workbench: {len(errors)} of {n} runs raised an error (status error; the first messages above, each "
+                f"run's message and traceback in {args.out / 'results.parquet'}): exit code {EXIT_RUN_FAILED}",
+                file=sys.stderr,
+            )
+            return EXIT_RUN_FAILED
+        return 0
+
+    return _interruptible(study, args.out)
+
+
+def _optimise(args: argparse.Namespace) -> int:
+    from workbench.apps.studies import run_optimisation
+    from workbench.apps.studies.optimise import objective_text
+
+    spec, backend = _start_study(args, "optimise")
+    trials = spec.optimise.trials if spec.optimise else 0
+
+    def study() -> int:
+        print(
+            f"{trials} trials of {spec.run_count()} runs each, minimising {objective_text(spec)}, "
+            f"on the {backend.describe()}"
+        )
+        result = run_optimisation(spec, args.out, backend, progress=sys.stderr.isatty())
+        failed = int((result.history["state"] == "failed").sum())
+        print(f"{len(result.history)} trials ({failed} failed); {result.ran} runs run now")
+        if result.best_trial is None:
+            reasons = list(dict.fromkeys(result.history["reason"]))[:3]
+            print(f"workbench: no trial completed: {'; '.join(reasons)}", file=sys.stderr)
+            return EXIT_RUN_FAILED
+        params = ", ".join(f"{k} = {v!r}" for k, v in result.best_params.items())
+        print(f"best: trial {result.best_trial}, objective {result.best_value:.6g}: {params}")
+        print(f"wrote {result.config_file} (use with --controller-config), best.json, history.parquet, results.parquet")
+        return 0
+
+    return _interruptible(study, args.out)
+
+
+def _run(args: argparse.Namespace) -> int:
+    from controllers import make_controller
+    from controllers.config_file import read_controller_config
+    from workbench.apps.comparison import warn_on_stderr
+    from workbench.base.output_dir import OutputDir
+    from workbench.simulation.limit_cycle import detect_limit_cycle
+    from workbench.simulation.scenarios import ScenarioOptions, make_scenario
+    from workbench.simulation.simulator import Simulation, SimulationConfig
+    from workbench.vehicles import make_vehicle
+
+    out = OutputDir(args.out, "run", args.overwrite)
+    _check_inputs(args)
+    name = args.vehicle if args.vehicle or args.vehicle_file else "kinematic-bicycle"
+    vehicle = make_vehicle(name, payload_kg=args.payload_kg, vehicle_file=args.vehicle_file)
+    if args.controller not in CONTROLLERS:
+        make_controller(args.controller, vehicle.geometry)  # raises the unknown-name error
+    options = read_controller_config(
+        args.controller_config, args.controller, CONTROLLERS[args.controller].config_type, args.set, vehicle.geometry
+    )
+    controller = make_controller(args.controller, vehicle.geometry, options, vehicle=vehicle)
+    scenario = make_scenario(
+        args.scenario, ScenarioOptions(vehicle_width_m=vehicle.geometry.width_m, track_file=args.track)
+    )
+    config = SimulationConfig(
+        speed_kmh=args.speed,
+        laps=args.laps,
+        controller_rate_hz=args.controller_rate_hz,
+        plant_rate_hz=args.plant_rate_hz,
+        max_lateral_accel_g=args.lat_accel_g,
+    )
+    simulation = Simulation(scenario, vehicle, controller, config)
+    for warning in simulation.warnings(f"{scenario.name}: {controller.name} on {vehicle.name}"):
+        warn_on_stderr(warning)
+    result = simulation.run(progress=sys.stderr.isatty())
+    with _writing(out):
+        written = result.save(args.out, with_plots=not args.no_plots)
+    m = result.metrics
+
+    def fmt(value: float | None, unit: str) -> str:
+        return "n/a" if value is None or (isinstance(value, float) and math.isnan(value)) else f"{value:.3f} {unit}"
+
+    print(f"{scenario.name}: {controller.name} on {vehicle.name} at {args.speed:g} km/h -> {result.status.value}")
+    print(f"  distance {fmt(m.distance_m, 'm')} of {fmt(m.path_length_m, 'm')}")
+    print(f"  max |CTE| {fmt(m.max_abs_cte_m, 'm')}, RMS CTE {fmt(m.rms_cte_m, 'm')}")
+    print(
+        f"  max |steering-wheel angle| {fmt(m.max_abs_steer_wheel_deg, 'deg')}, "
+        f"max |lateral acceleration| {fmt(m.max_abs_lat_accel_g, 'g')}"
+    )
+    print(
+        f"  steering oscillation {fmt(m.steer_oscillation_deg, 'deg')} (RMS about its 1 s average), "
+        f"RMS steering rate {fmt(m.rms_steer_rate_deg_s, 'deg/s')}"
+    )
+    cycle = detect_limit_cycle(result.trace["t_s"], result.trace["steer_wheel_rad"])
+    if cycle.detected:
+        print(f"  WARNING: steering limit cycle at {cycle.describe()}")
+    print(f"  controller step median {fmt(m.step_time_median_us, 'us')}, p99 {fmt(m.step_time_p99_us, 'us')}")
+    print(f"  wrote {len(written)} files to {args.out}")
+    if not result.completed:
+        print(f"workbench: run did not complete: {result.message} (partial trace kept in {args.out})", file=sys.stderr)
+        return EXIT_RUN_FAILED
+    return 0
+
+
+def _scenarios(args: argparse.Namespace) -> None:
+    from workbench.simulation.scenarios import ScenarioOptions, describe_scenarios
+
+    _check_inputs(args)
+    for name, description in describe_scenarios(ScenarioOptions(track_file=args.track)):
+        print(f"{name:<12} {description}")
+
+
+def _vehicles(args: argparse.Namespace) -> None:
+    from workbench.vehicles import VEHICLES, list_presets, preset_text
+
+    if args.show:
+        print(preset_text(args.show), end="")
+    else:
+        for name, description in list_presets().items():
+            print(f"{name:<20} {description}\n{'':<20} {VEHICLES[name]().describe()}")
+
+
+def _controllers(args: argparse.Namespace) -> None:
+    from controllers.config_file import config_template
+
+    if args.show:
+        if args.show not in CONTROLLERS:
+            raise WorkbenchInputError(f"unknown controller {args.show!r}; choose one of {', '.join(CONTROLLERS)}")
+        print(config_template(args.show, CONTROLLERS[args.show].config_type), end="")
+        return
+    for name, cls in CONTROLLERS.items():
+        print(f"{name:<14} {cls.summary()}")
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    argv = sys.argv[1:] if argv is None else list(argv)
+    args = _parser(_command_word(argv)).parse_args(argv)
+    try:
+        if args.command == "scenarios":
+            _scenarios(args)
+        elif args.command == "vehicles":
+            _vehicles(args)
+        elif args.command == "controllers":
+            _controllers(args)
+        elif args.command == "compare":
+            return _compare(args)
+        elif args.command == "fig17":
+            return _fig17(args)
+        elif args.command == "paper":
+            return _paper(args)
+        elif args.command == "sweep":
+            return _sweep(args)
+        elif args.command == "optimise":
+            return _optimise(args)
+        else:
+            return _run(args)
+    except WorkbenchInputError as exc:
+        print(f"workbench: error: {exc}", file=sys.stderr)
+        return EXIT_INPUT_ERROR
+    return 0
+
+
+def __getattr__(name: str) -> object:
+    """`workbench.apps.cli.Simulation` (tests patch its `run`): the simulator, imported on first use."""
+    if name == "Simulation":
+        from workbench.simulation.simulator import Simulation
+
+        return Simulation
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,270 @@
+"""Side-by-side runs: several controllers (and plants) on one scenario, their metrics in one table, their traces
+on shared axes (the paper's Figure 17: tracked trajectories and CTE against distance; Figure 18: speed and
+steering).
+
+`compare(scenario, runs)` simulates each (controller, vehicle) pair with the same `SimulationConfig` and returns a
+`Comparison`: `summary()` is a DataFrame with one row per pair (the metrics.json fields, the distance to converge
+within `CONVERGED_CTE_M` of the path, and each controller's step-time ratio to a reference controller), and the
+`plot_*` methods draw every run on one axis. A run that fails (a controller error, the vehicle leaving the path)
+keeps its row with its status and message: nothing is dropped. `workbench compare` and `workbench fig17` write
+the result with `save` (traces, metrics, summary.csv, figures) and `workbench.apps.report.write_report` (report.html).
+
+Every run is built (vehicle, scenario, controller options and files) before the first one is simulated, so a bad
+input is refused before any work, and what each run's `Simulation.warnings` says (stretches of the path the
+vehicle cannot turn, a run that may be very long) is announced first.
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import numpy as np
+import pandas as pd
+
+from controllers import CONTROLLERS, make_controller
+from controllers.config_file import read_controller_config
+from workbench.base.errors import WorkbenchInputError
+from workbench.simulation.limit_cycle import LimitCycle, detect_limit_cycle
+from workbench.simulation.metrics import METRIC_KEYS
+from workbench.simulation.result import SimulationResult
+from workbench.simulation.scenarios import Scenario, ScenarioOptions, make_scenario
+from workbench.simulation.simulator import Simulation, SimulationConfig
+from workbench.vehicles import VEHICLES, make_vehicle
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+
+#: |CTE| (m) within which a run counts as converged onto the path (the fig17 scenario starts 1 m off it).
+CONVERGED_CTE_M = 0.1
+#: The comparison figures: file name, Comparison method (Figures 17a, 17b, 18a, 18b).
+FIGURES: tuple[tuple[str, str], ...] = (
+    ("trajectories.png", "plot_trajectories"),
+    ("cte_vs_distance.png", "plot_cte"),
+    ("speed_vs_distance.png", "plot_speed"),
+    ("steering_vs_time.png", "plot_steering"),
+)
+
+
+@dataclass(frozen=True)
+class RunSpec:
+    """One run of a comparison: a registered controller, a vehicle preset, and controller options: a TOML file
+    with a table per controller name (`config_file`, as `workbench run --controller-config`; a controller without
+    a table gets its defaults) and KEY=VALUE overrides on top (as `--set`)."""
+
+    controller: str
+    vehicle: str
+    overrides: tuple[str, ...] = ()
+    config_file: Path | None = None
+
+    def __post_init__(self) -> None:
+        if self.controller not in CONTROLLERS:
+            raise WorkbenchInputError(f"unknown controller {self.controller!r}; choose one of {', '.join(CONTROLLERS)}")
+        if self.vehicle not in VEHICLES:
+            raise WorkbenchInputError(f"unknown vehicle {self.vehicle!r}; choose one of {', '.join(VEHICLES)}")
+
+    @property
+    def label(self) -> str:
+        options = f" ({', '.join(self.overrides)})" if self.overrides else ""
+        return f"{self.controller}{options} on {self.vehicle}"
+
+    @property
+    def slug(self) -> str:
+        """A directory name for the run's files."""
+        text = f"{self.controller}-{self.vehicle}" + "".join(f"-{o}" for o in self.overrides)
+        return "".join(c if c.isalnum() or c in "-_." else "_" for c in text)
+
+
+def converge_distance_m(progress_m: np.ndarray, cte_m: np.ndarray, tolerance_m: float = CONVERGED_CTE_M) -> float:
+    """Distance along the path (m) after which |CTE| stays within tolerance_m to the end of the run; 0 if it never
+    left it; NaN if it is outside at the end (never converged)."""
+    outside = np.flatnonzero(np.abs(cte_m) > tolerance_m)
+    if outside.size == 0:
+        return 0.0
+    last = int(outside[-1])
+    if last + 1 >= cte_m.size:
+        return math.nan
+    return float(progress_m[last + 1] - progress_m[0])
+
+
+def step_time_ratios(table: pd.DataFrame, reference_controller: str | None) -> list[float]:
+    """Each row's step_time_median_us over the reference controller's on the same vehicle (the median over its
+    runs there, which may differ in options), or over all its runs when it did not run on that vehicle; NaN
+    without a reference or a step time."""
+    if reference_controller is None or reference_controller not in set(table["controller"]):
+        return [math.nan] * len(table)
+    ref_rows = table[table["controller"] == reference_controller]
+    per_vehicle = ref_rows.groupby("vehicle")["step_time_median_us"].median()
+    overall = float(ref_rows["step_time_median_us"].median())
+    return [
+        float(row.step_time_median_us) / float(per_vehicle.get(row.vehicle, overall))
+        if row.step_time_median_us is not None and math.isfinite(row.step_time_median_us)
+        else math.nan
+        for row in table.itertuples()
+    ]
+
+
+@dataclass(frozen=True, eq=False)
+class Comparison:
+    """The runs of one scenario, in the order asked. `reference_controller` is the controller whose step time the
+    others are divided by in `summary()` (the clothoid controller when present)."""
+
+    scenario: Scenario
+    specs: tuple[RunSpec, ...]
+    results: tuple[SimulationResult, ...]
+    config: SimulationConfig
+    reference_controller: str | None = None
+    _summary: list[pd.DataFrame] = field(default_factory=list, repr=False)
+
+    def select(self, specs: Sequence[RunSpec]) -> Comparison:
+        """The sub-comparison of these runs (e.g. the paper's published pairs out of the full cross product)."""
+        index = [self.specs.index(s) for s in specs]
+        return Comparison(
+            self.scenario,
+            tuple(self.specs[i] for i in index),
+            tuple(self.results[i] for i in index),
+            self.config,
+            self.reference_controller,
+        )
+
+    def summary(self) -> pd.DataFrame:
+        """One row per run: the metrics.json fields, status and message, the distance to converge within
+        CONVERGED_CTE_M, and step_time_ratio (`step_time_ratios`)."""
+        if not self._summary:
+            rows = []
+            for spec, result in zip(self.specs, self.results, strict=True):
+                row = {k: v for k, v in result.metrics.to_dict().items() if k in METRIC_KEYS}
+                row |= {"options": " ".join(spec.overrides), "status": result.status.value, "message": result.message}
+                row["converge_distance_m"] = converge_distance_m(result.trace["progress_m"], result.trace["cte_m"])
+                rows.append(row)
+            table = pd.DataFrame(rows)
+            table["step_time_ratio"] = step_time_ratios(table, self.reference_controller)
+            self._summary.append(table)
+        return self._summary[0].copy()
+
+    def limit_cycles(self) -> list[LimitCycle]:
+        """Each run's steering limit cycle (`simulation/limit_cycle.py`; the summary's limit_cycle fields, plus when it
+        starts and how long it lasts), in the runs' order."""
+        return [detect_limit_cycle(r.trace["t_s"], r.trace["steer_wheel_rad"]) for r in self.results]
+
+    def to_pandas(self) -> pd.DataFrame:
+        """Every run's trace stacked, with `controller`, `vehicle` and `run` columns."""
+        frames = []
+        for spec, result in zip(self.specs, self.results, strict=True):
+            frame = result.to_pandas()
+            frame.insert(0, "run", spec.label)
+            frame.insert(1, "controller", spec.controller)
+            frame.insert(2, "vehicle", spec.vehicle)
+            frames.append(frame)
+        return pd.concat(frames, ignore_index=True)
+
+    # Figures 17 and 18: every run on one axis; each returns the axes.
+    def plot_trajectories(self, ax: Axes | None = None) -> Axes:
+        from workbench.simulation import plots
+
+        return plots.trajectories(self.results, self.labels, ax)
+
+    def plot_cte(self, ax: Axes | None = None) -> Axes:
+        from workbench.simulation import plots
+
+        return plots.cte_comparison(self.results, self.labels, ax)
+
+    def plot_speed(self, ax: Axes | None = None) -> Axes:
+        from workbench.simulation import plots
+
+        return plots.speed_comparison(self.results, self.labels, ax)
+
+    def plot_steering(self, ax: Axes | None = None) -> Axes:
+        from workbench.simulation import plots
+
+        return plots.steering_comparison(self.results, self.labels, ax)
+
+    @property
+    def labels(self) -> list[str]:
+        return [s.label for s in self.specs]
+
+    def save_figures(self, out_dir: str | Path, prefix: str = "") -> list[Path]:
+        """Write the four comparison figures as PNG; return their paths."""
+        import matplotlib.pyplot as plt
+
+        out = Path(out_dir)
+        out.mkdir(parents=True, exist_ok=True)
+        written = []
+        for name, method in FIGURES:
+            ax = getattr(self, method)()
+            path = out / f"{prefix}{name}"
+            ax.figure.savefig(path, dpi=110)
+            plt.close(ax.figure)
+            written.append(path)
+        return written
+
+    def save(self, out_dir: str | Path) -> list[Path]:
+        """Write each run's trace and metrics under DIR/runs/<controller>-<vehicle>/, DIR/summary.csv and the
+        figures; return the paths."""
+        out = Path(out_dir)
+        written = []
+        for spec, result in zip(self.specs, self.results, strict=True):
+            written += result.save(out / "runs" / spec.slug, with_plots=False)
+        summary_path = out / "summary.csv"
+        self.summary().to_csv(summary_path, index=False)
+        written.append(summary_path)
+        return written + self.save_figures(out)
+
+
+def warn_on_stderr(message: str) -> None:
+    """Print a warning as the CLI does: `workbench: warning: ...` on stderr."""
+    print(f"workbench: warning: {message}", file=sys.stderr, flush=True)
+
+
+def compare(
+    scenario: str | Scenario,
+    runs: Sequence[RunSpec],
+    config: SimulationConfig | None = None,
+    scenario_options: ScenarioOptions | None = None,
+    reference_controller: str | None = "clothoid",
+    warn: Callable[[str], None] | None = warn_on_stderr,
+) -> Comparison:
+    """Simulate each run on `scenario` (a name, a waypoint file or a Scenario) with the same config. Every run is
+    built first (a bad input is refused before any simulation); what a vehicle cannot follow
+    and each run that may be long (`Simulation.warnings`) are announced through `warn`
+    before the first run (None: silent)."""
+    if not runs:
+        raise WorkbenchInputError("a comparison needs at least one (controller, vehicle) run; got none")
+    if len(set(runs)) != len(runs):
+        raise WorkbenchInputError(f"each run may appear once; got {[r.label for r in runs]}")
+    config = config or SimulationConfig()
+    simulations = []
+    for spec in runs:
+        vehicle = make_vehicle(spec.vehicle)
+        if isinstance(scenario, Scenario):
+            scen = scenario
+        else:
+            options = scenario_options or ScenarioOptions()
+            scen = make_scenario(scenario, ScenarioOptions(vehicle.geometry.width_m, options.track_file))
+        config_type = CONTROLLERS[spec.controller].config_type
+        options = read_controller_config(
+            spec.config_file, spec.controller, config_type, spec.overrides, vehicle.geometry
+        )
+        controller = make_controller(spec.controller, vehicle.geometry, options, vehicle=vehicle)
+        simulations.append(Simulation(scen, vehicle, controller, config))
+    messages: list[str] = []
+    for spec, simulation in zip(runs, simulations, strict=True):
+        messages += simulation.warnings(spec.label)
+    for message in dict.fromkeys(messages) if warn is not None else ():
+        warn(message)
+    results = [simulation.run() for simulation in simulations]
+    return Comparison(results[0].scenario, tuple(runs), tuple(results), config, reference_controller)
+
+
+__all__ = [
+    "CONVERGED_CTE_M",
+    "Comparison",
+    "RunSpec",
+    "compare",
+    "converge_distance_m",
+    "warn_on_stderr",
+]

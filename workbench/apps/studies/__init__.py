@@ -1,0 +1,38 @@
+"""Studies at scale: parameter sweeps (`workbench sweep`) and controller optimisation (`workbench optimise`).
+
+A TOML spec (`spec.py`) names scenarios, controllers, vehicles and parameter grids or seeded random draws
+(`distributions.py`); it plans independent, deterministic runs with stable ids. `runner.py` executes one run into
+a row (its parameters and the metrics.json fields; an exception becomes an "error" row), `backends.py` runs them on
+a local process pool or on Dask, `store.py` keeps each row as it finishes (so a restarted study resumes) and
+assembles DIR/results.parquet, `results.py` and `plots.py` summarise and draw them, and `optimise.py` tunes a
+controller's options with optuna through the same machinery.
+
+    from workbench.apps.studies import load_spec, run_sweep, make_backend
+    result = run_sweep(load_spec("examples/sweep_dlc.toml"), "runs/sweep", make_backend("local", workers=2))
+    result.to_pandas(); result.plot_cte_vs_speed(); result.plot_pareto()
+"""
+
+from __future__ import annotations
+
+from workbench.apps.studies.backends import BACKENDS, DaskBackend, LocalBackend, make_backend
+from workbench.apps.studies.optimise import OptimisationResult, run_optimisation
+from workbench.apps.studies.results import SweepResult
+from workbench.apps.studies.runner import TIMING_COLUMNS, execute_run
+from workbench.apps.studies.spec import PlannedRun, StudySpec, load_spec
+from workbench.apps.studies.sweep import run_sweep
+
+__all__ = [
+    "BACKENDS",
+    "TIMING_COLUMNS",
+    "DaskBackend",
+    "LocalBackend",
+    "OptimisationResult",
+    "PlannedRun",
+    "StudySpec",
+    "SweepResult",
+    "execute_run",
+    "load_spec",
+    "make_backend",
+    "run_optimisation",
+    "run_sweep",
+]

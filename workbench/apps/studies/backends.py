@@ -1,0 +1,293 @@
+"""Where a study's runs execute: a local process pool (default) or a Dask cluster.
+
+Both take PlannedRuns and yield their rows as they finish (completion order; the caller stores them and orders
+the table by the study's order). Every run is independent and deterministic, so the backend and the number of
+workers change how fast a study runs, never its rows (but for the wall-clock TIMING_COLUMNS).
+
+- `LocalBackend(workers)`: a `concurrent.futures.ProcessPoolExecutor` of `workers` processes (default: the CPUs
+  this process may use), forked from this process when it runs a single thread, else started from a fork server
+  that has imported the workbench once (`start_context`), so a worker starts in milliseconds. Each worker ignores
+  Ctrl-C (the study's process stops the pool) and leaves when the process that started the pool is gone.
+- `DaskBackend(scheduler, workers)`: `dask.distributed`; with no scheduler address a `LocalCluster` of `workers`
+  single-threaded worker processes, else the cluster at that address (its workers must have this package
+  installed and see the files the spec names). Workers of either backend run BLAS/OpenMP on one thread each
+  (`threadpoolctl`; a Dask worker plugin). A run whose worker dies each time it runs it (Dask's
+  `KilledWorker`) is recorded as an error row; any other failure of the machinery stops the study, keeping the
+  rows already written.
+
+Use a backend as a context manager (it starts its pool or client on entry and stops it on exit) and call
+`map_runs(runs)`; one backend serves many batches (the optimiser's trials).
+"""
+
+from __future__ import annotations
+
+import logging
+import multiprocessing
+import os
+import signal
+import threading
+import time
+from collections.abc import Iterator, Sequence
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from concurrent.futures.process import BrokenProcessPool
+from types import TracebackType
+from typing import Any, Protocol, Self
+
+from threadpoolctl import threadpool_limits
+
+from workbench.apps.studies.runner import execute_run, failed_row
+from workbench.apps.studies.spec import PlannedRun
+from workbench.base.errors import WorkbenchInputError
+
+BACKENDS = ("local", "dask")
+
+
+class BackendError(RuntimeError):
+    """The machinery failed (a worker process died, a cluster could not run a task): the study stops; the rows
+    already written stay, and the same command resumes."""
+
+
+#: How often (s) a local worker checks that the process which started it is still there.
+ORPHAN_CHECK_S = 1.0
+
+
+class Backend(Protocol):
+    name: str
+    workers: int | None
+
+    @property
+    def started(self) -> bool: ...
+
+    def start(self) -> None: ...
+
+    def close(self) -> None: ...
+
+    def __enter__(self) -> Backend: ...
+
+    def __exit__(self, *exc: object) -> None: ...
+
+    def map_runs(self, runs: Sequence[PlannedRun]) -> Iterator[dict[str, Any]]: ...
+
+    def describe(self) -> str: ...
+
+
+def default_workers() -> int:
+    """The CPUs this process may run on."""
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:  # not on Linux
+        return os.cpu_count() or 1
+
+
+def _require_workers(workers: int | None) -> None:
+    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
+        raise WorkbenchInputError(f"workers must be a whole number >= 1; got {workers!r}")
+
+
+def _init_worker(parent_pid: int) -> None:
+    """A local worker runs its numerical libraries on one thread (a run is one CPU's work: OpenBLAS would otherwise
+    start a thread per CPU in every worker, and the workers would compete for the CPUs), ignores Ctrl-C (the study's
+    process stops the pool) and leaves when the study's process is gone (killed without cleaning up)."""
+    threadpool_limits(1)
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+    def watch() -> None:
+        while True:
+            time.sleep(ORPHAN_CHECK_S)
+            try:
+                os.kill(parent_pid, 0)
+            except ProcessLookupError:
+                os._exit(1)
+            except PermissionError:  # the pid was taken by another user's process: ours is gone
+                os._exit(1)
+
+    threading.Thread(target=watch, name="workbench-orphan-watch", daemon=True).start()
+
+
+def start_context() -> multiprocessing.context.BaseContext:
+    """How local workers start. "fork" when this process runs one thread: a worker is a copy of it, the workbench
+    already imported (and its compiled kernels loaded, if it ran a simulation), nothing of the caller's script
+    re-run. Forking a process with other threads (a Dask client's, a GUI's) can deadlock the child, so then a fork
+    server ("forkserver", importing the workbench once; the calling script must guard its top level with
+    `if __name__ == "__main__":`, as for any non-fork start), or "spawn" where neither exists."""
+    methods = multiprocessing.get_all_start_methods()
+    if "fork" in methods and threading.active_count() == 1:
+        return multiprocessing.get_context("fork")
+    if "forkserver" in methods:
+        context = multiprocessing.get_context("forkserver")
+        context.set_forkserver_preload(["workbench.apps.studies.runner"])
+        return context
+    return multiprocessing.get_context("spawn")
+
+
+class _StartedInWith:
+    """`with backend:` starts it and closes it, whatever happens inside."""
+
+    def start(self) -> None:
+        raise NotImplementedError
+
+    def close(self) -> None:
+        raise NotImplementedError
+
+    def __enter__(self) -> Self:
+        self.start()
+        return self
+
+    def __exit__(
+        self, exc_type: type[BaseException] | None, exc: BaseException | None, tb: TracebackType | None
+    ) -> None:
+        self.close()
+
+
+class LocalBackend(_StartedInWith):
+    """A process pool on this machine (module docstring)."""
+
+    name = "local"
+
+    def __init__(self, workers: int | None = None) -> None:
+        _require_workers(workers)
+        self.workers = workers or default_workers()
+        self._pool: ProcessPoolExecutor | None = None
+
+    def describe(self) -> str:
+        return f"local process pool, {self.workers} worker{'s' if self.workers != 1 else ''}"
+
+    @property
+    def started(self) -> bool:
+        return self._pool is not None
+
+    def start(self) -> None:
+        """Start the pool: workers forked from this process when that is safe (POSIX, one thread), else from a
+        fork server that imports the workbench once."""
+        if self._pool is None:
+            context = start_context()
+            self._pool = ProcessPoolExecutor(
+                self.workers, mp_context=context, initializer=_init_worker, initargs=(os.getpid(),)
+            )
+
+    def close(self) -> None:
+        """Stop the pool: queued runs are cancelled, runs in progress finish (their rows are not kept)."""
+        if self._pool is not None:
+            self._pool.shutdown(wait=True, cancel_futures=True)
+            self._pool = None
+
+    def map_runs(self, runs: Sequence[PlannedRun]) -> Iterator[dict[str, Any]]:
+        if self._pool is None:
+            raise RuntimeError("start the backend first: with LocalBackend(...) as backend: ...")
+        futures = {self._pool.submit(execute_run, run): run for run in runs}
+        try:
+            for future in as_completed(futures):
+                try:
+                    row = future.result()  # execute_run returns rows; only the machinery raises here
+                except BrokenProcessPool as exc:
+                    raise BackendError(
+                        f"a worker process died (killed, out of memory, or crashed in native code) while running "
+                        f"{futures[future].run_id} or another run: {exc}"
+                    ) from None
+                yield row
+        finally:
+            for future in futures:
+                future.cancel()
+
+
+class DaskBackend(_StartedInWith):
+    """dask.distributed: a LocalCluster, or the scheduler at `scheduler` (module docstring)."""
+
+    name = "dask"
+
+    def __init__(self, scheduler: str | None = None, workers: int | None = None) -> None:
+        _require_workers(workers)
+        if scheduler is not None and workers is not None:
+            raise WorkbenchInputError(
+                f"workers ({workers}) applies to a LocalCluster; with a scheduler ({scheduler}) the cluster's own "
+                "workers run the study: drop one"
+            )
+        if scheduler is not None and (not isinstance(scheduler, str) or not scheduler.strip()):
+            raise WorkbenchInputError(f"scheduler must be an address such as tcp://host:8786; got {scheduler!r}")
+        self.scheduler = scheduler
+        self.workers = None if scheduler else workers or default_workers()
+        self._client: Any = None
+        self._cluster: Any = None
+
+    def describe(self) -> str:
+        if self.scheduler:
+            return f"dask scheduler {self.scheduler}"
+        return f"dask LocalCluster, {self.workers} single-threaded worker process{'es' if self.workers != 1 else ''}"
+
+    @property
+    def started(self) -> bool:
+        return self._client is not None
+
+    def start(self) -> None:
+        """Connect to the scheduler, or start a LocalCluster and connect to it."""
+        from distributed import Client, LocalCluster
+
+        if self._client is not None:
+            return
+        if self.scheduler:
+            try:
+                self._client = Client(self.scheduler, timeout="10s")
+            except (OSError, TimeoutError) as exc:
+                raise WorkbenchInputError(f"cannot reach the dask scheduler {self.scheduler!r}: {exc}") from None
+        else:
+            self._cluster = LocalCluster(
+                n_workers=self.workers,
+                threads_per_worker=1,
+                processes=True,
+                dashboard_address=None,
+                silence_logs=logging.ERROR,
+            )
+            self._client = Client(self._cluster)
+        from workbench.apps.studies.dask_worker import SingleThreadedLibraries
+
+        self._client.register_plugin(SingleThreadedLibraries())
+
+    def close(self) -> None:
+        """Disconnect, and stop the LocalCluster if this backend started one."""
+        if self._client is not None:
+            self._client.close()
+            self._client = None
+        if self._cluster is not None:
+            self._cluster.close()
+            self._cluster = None
+
+    def map_runs(self, runs: Sequence[PlannedRun]) -> Iterator[dict[str, Any]]:
+        from distributed import as_completed
+        from distributed.scheduler import KilledWorker
+
+        if self._client is None:
+            raise RuntimeError("start the backend first: with DaskBackend(...) as backend: ...")
+        by_key = {}
+        futures = []
+        for run in runs:
+            future = self._client.submit(execute_run, run, key=f"workbench-run-{run.run_id}", pure=False)
+            by_key[future.key] = run
+            futures.append(future)
+        try:
+            for future in as_completed(futures):
+                try:
+                    row = future.result()
+                except KilledWorker as exc:
+                    row = failed_row(by_key[future.key], f"the dask worker died each time it ran this run: {exc}")
+                except Exception as exc:  # the cluster could not run it (e.g. the workbench missing on a worker)
+                    raise BackendError(
+                        f"the dask cluster could not run {by_key[future.key].run_id}: {type(exc).__name__}: {exc}"
+                    ) from exc
+                future.release()
+                yield row
+        finally:
+            self._client.cancel([f for f in futures if not f.done()])
+
+
+def make_backend(name: str = "local", scheduler: str | None = None, workers: int | None = None) -> Backend:
+    """A backend by name: "local" (workers processes) or "dask" (a LocalCluster, or the scheduler given)."""
+    if name not in BACKENDS:
+        raise WorkbenchInputError(f"unknown backend {name!r}; choose one of {', '.join(BACKENDS)}")
+    if name == "local":
+        if scheduler is not None:
+            raise WorkbenchInputError(f"a scheduler address ({scheduler}) needs the dask backend (--backend dask)")
+        return LocalBackend(workers)
+    return DaskBackend(scheduler, workers)
+
+
+__all__ = ["BACKENDS", "Backend", "BackendError", "DaskBackend", "LocalBackend", "default_workers", "make_backend"]

@@ -1,0 +1,290 @@
+"""Controller tuning: optuna's TPE sampler, seeded, proposes a controller's options; each trial runs the study's
+runs (its scenarios, vehicles, speeds and other run parameters) with them, through the same backends and run
+store as a sweep, and scores them by the spec's objective.
+
+The objective: per run, the weighted sum of metrics in [optimise.objective] (e.g. rms_cte_m + 0.002 x
+rms_steer_rate_deg_s), then the mean (or the max, `aggregate`) over the trial's runs; minimised. A trial with a
+run that did not complete (left the path, timed out, an error...) or whose metric is null is marked failed: it is
+in the history, never the best, and the sampler does not model it.
+
+Trials go in batches of `batch_size` (ask/tell): the batch's runs go to the backend together, then the trials are
+told in order. The batch size is part of the spec, not of the machine, and the runs are deterministic, so a study
+proposes the same trials on any backend and any number of workers; a restarted study replays the sampler and finds
+its runs in DIR/runs/, so it resumes where it stopped.
+
+Writes DIR/best.toml (the best trial's options as a controller-config file, `workbench run --controller-config`;
+a scaled lead filter beside it as DIR/best_lead_filter.json), DIR/best.json (trial, value, options, objective),
+DIR/history.parquet (one row per trial), DIR/results.parquet (every run, with its trial), DIR/runs/ and
+DIR/history.png.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+import pandas as pd
+
+from workbench.apps.studies.backends import Backend, LocalBackend
+from workbench.apps.studies.results import SweepResult
+from workbench.apps.studies.runner import build_controller_config
+from workbench.apps.studies.spec import LEAD_FILTER_SCALES, StudySpec
+from workbench.apps.studies.store import RunStore, write_results
+from workbench.apps.studies.sweep import execute_runs
+from workbench.base.errors import WorkbenchInputError, value_text
+from workbench.vehicles.presets import load_vehicle
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+
+BEST_CONFIG = "best.toml"
+BEST_FILTER = "best_lead_filter.json"
+BEST_LIMITS = "best_limits.csv"
+BEST_LAG = "best_lag.json"
+BEST_JSON = "best.json"
+HISTORY_FILE = "history.parquet"
+HISTORY_FIGURE = "history.png"
+
+
+def objective_text(spec: StudySpec) -> str:
+    """The objective in words, e.g. "mean over runs of 1 x rms_cte_m + 0.002 x rms_steer_rate_deg_s"."""
+    settings = spec.optimise
+    if settings is None:
+        raise WorkbenchInputError("the spec has no [optimise] table")
+    terms = " + ".join(f"{w:g} x {k}" for k, w in settings.objective.items())
+    return f"{settings.aggregate} over runs of {terms}"
+
+
+def trial_value(rows: list[dict[str, Any]], weights: dict[str, float], aggregate: str) -> tuple[float | None, str]:
+    """(the trial's objective, "") or (None, why it failed) from its runs' rows."""
+    bad = [r for r in rows if r["status"] != "completed"]
+    if bad:
+        first = bad[0]
+        return None, f"{len(bad)} of {len(rows)} runs did not complete (e.g. {first['status']}: {first['message']})"
+    values = []
+    for row in rows:
+        total = 0.0
+        for key, weight in weights.items():
+            value = row.get(key)
+            if value is None or not math.isfinite(value):
+                where = f"run {row['run_id']} ({row['vehicle']}, {row['scenario']})"
+                return None, f"metric {key} is {value_text(value)} for {where}"
+            total += weight * value
+        values.append(total)
+    return float(np.mean(values) if aggregate == "mean" else np.max(values)), ""
+
+
+def _toml_value(value: Any) -> str:
+    if value is None:
+        return '"none"'
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, int | float):
+        return repr(value)
+    return json.dumps(str(value), ensure_ascii=False)
+
+
+def _write_object(folder: Path, value: Any) -> str | None:
+    """Write an object a file option was read into beside the config (its file's name), or None when it has no
+    file form (a vehicle's single-track equivalent)."""
+    from controllers.clothoid.curvature_limits import CurvatureLimits
+    from controllers.clothoid.filter_file import FilterSchedule, write_filter_file
+    from workbench.vehicles.steering_lag import SteeringLag, write_lag_file
+
+    if isinstance(value, FilterSchedule):
+        write_filter_file(
+            folder / BEST_FILTER, value.params[0] if len(value.params) == 1 else value, source=value.source
+        )
+        return BEST_FILTER
+    if isinstance(value, CurvatureLimits):
+        value.write_csv(folder / BEST_LIMITS)
+        return BEST_LIMITS
+    if isinstance(value, SteeringLag):
+        write_lag_file(value, folder / BEST_LAG)
+        return BEST_LAG
+    return None
+
+
+def write_controller_config(path: Path, controller: str, config: Any, header: str) -> Path:
+    """Write every field of a controller config as a controller-config TOML file (one [controller] table; None
+    as "none"; paths inside the file's folder relative to it, others absolute); an object a file option was read
+    into (`FILE_OPTIONS`) is written to a file beside it and named by that option; return the path."""
+    from controllers.config_file import FILE_OPTIONS
+
+    file_keys = {option.field: name for name, option in FILE_OPTIONS.items()}
+    lines = [f"# {line}" for line in header.splitlines()] + ["", f"[{controller}]"]
+    for f in dataclasses.fields(config):
+        if not f.init:
+            continue
+        value = getattr(config, f.name)
+        if f.name in file_keys:
+            name = None if value is None else _write_object(path.parent, value)
+            if value is not None and name is None:
+                lines.append(f"# {file_keys[f.name]}: {type(value).__name__} has no file form; give its file again")
+            else:
+                lines.append(f"{file_keys[f.name]} = {_toml_value(name)}")
+            continue
+        if isinstance(value, Path):
+            value = value.resolve()
+            value = value.relative_to(path.parent.resolve()) if value.is_relative_to(path.parent.resolve()) else value
+            value = value.as_posix()
+        lines.append(f"{f.name} = {_toml_value(value)}")
+    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    return path
+
+
+@dataclass(frozen=True, eq=False)
+class OptimisationResult:
+    """history: one row per trial (number, state, value, the options as "<controller>.<option>", runs, failed
+    runs, why it failed, and the mean of each objective metric over its runs); best_trial / best_value /
+    best_params: the best completed trial (None if none completed); config_file: DIR/best.toml; runs: every run of
+    every trial, with its trial number; ran: runs executed in this call."""
+
+    history: pd.DataFrame
+    best_trial: int | None
+    best_value: float | None
+    best_params: dict[str, Any]
+    config_file: Path | None
+    runs: SweepResult
+    objective: str
+    ran: int = 0
+
+    def to_pandas(self) -> pd.DataFrame:
+        return self.history.copy()
+
+    def plot_history(self, ax: Axes | None = None) -> Axes:
+        """Each trial's objective (failed trials not drawn) and the best so far."""
+        import matplotlib.pyplot as plt
+
+        if ax is None:
+            _, ax = plt.subplots(figsize=(7, 4.5), layout="constrained")
+        done = self.history[self.history["state"] == "complete"]
+        ax.plot(done["trial"], done["value"], "o", ms=4, alpha=0.6, label="trial")
+        best = self.history["value"].where(self.history["state"] == "complete").cummin()
+        ax.plot(self.history["trial"], best, "-", color="C3", label="best so far")
+        ax.set(xlabel="trial", ylabel="objective", title=f"Optimisation: {self.objective}")
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize="small")
+        return ax
+
+
+def run_optimisation(
+    spec: StudySpec, out_dir: str | Path, backend: Backend | None = None, progress: bool = False
+) -> OptimisationResult:
+    """Run (or resume) the optimisation the spec's [optimise] table describes into out_dir (module docstring)."""
+    import optuna
+
+    settings = spec.optimise
+    if settings is None:
+        raise WorkbenchInputError("the spec has no [optimise] table; `workbench optimise` needs one")
+    controller = spec.controllers[0]
+    out = Path(out_dir)
+    store = RunStore(out)
+    optuna.logging.set_verbosity(optuna.logging.WARNING)
+    sampler = optuna.samplers.TPESampler(
+        seed=spec.seed if settings.seed is None else settings.seed, n_startup_trials=settings.startup_trials
+    )
+    study = optuna.create_study(direction="minimize", sampler=sampler)
+    distributions = {k: d.to_optuna() for k, d in settings.search.items()}
+    weights = dict(settings.objective)
+    history: list[dict[str, Any]] = []
+    all_rows: list[dict[str, Any]] = []
+    ran = 0
+    backend = backend or LocalBackend()
+    started_here = not backend.started
+    try:
+        while len(history) < settings.trials:
+            batch = [study.ask(distributions) for _ in range(min(settings.batch_size, settings.trials - len(history)))]
+            plans = [spec.plan(trial.params) for trial in batch]
+            rows, n = execute_runs(
+                [r for plan in plans for r in plan],
+                store,
+                backend,
+                progress,
+                f"trials {batch[0].number}-{batch[-1].number}",
+            )
+            ran += n
+            start = 0
+            for trial, plan in zip(batch, plans, strict=True):
+                trial_rows, start = rows[start : start + len(plan)], start + len(plan)
+                value, reason = trial_value(trial_rows, weights, settings.aggregate)
+                if value is None:
+                    study.tell(trial, state=optuna.trial.TrialState.FAIL)
+                else:
+                    study.tell(trial, value)
+                entry = {"trial": trial.number, "state": "complete" if value is not None else "failed", "value": value}
+                entry |= {f"{controller}.{k}": v for k, v in trial.params.items()}
+                entry |= {"runs": len(trial_rows), "failed_runs": sum(r["status"] != "completed" for r in trial_rows)}
+                entry["reason"] = reason
+                for key in weights:
+                    numbers = [r.get(key) for r in trial_rows]
+                    entry[f"mean_{key}"] = (
+                        float(np.mean(numbers)) if all(isinstance(x, int | float) for x in numbers) else None
+                    )
+                history.append(entry)
+                all_rows += [{"trial": trial.number} | r for r in trial_rows]
+            pd.DataFrame(history).to_parquet(out / HISTORY_FILE, index=False)
+    finally:
+        if started_here:
+            backend.close()
+    write_results(out, all_rows)
+    complete = [h for h in history if h["state"] == "complete"]
+    best = min(complete, key=lambda h: (h["value"], h["trial"])) if complete else None
+    best_params = {} if best is None else dict(study.trials[best["trial"]].params)
+    config_file = None
+    if best is not None:
+        config_file = _write_best(spec, out, best, best_params)
+    result = OptimisationResult(
+        history=pd.DataFrame(history),
+        best_trial=None if best is None else best["trial"],
+        best_value=None if best is None else best["value"],
+        best_params=best_params,
+        config_file=config_file,
+        runs=SweepResult.from_rows(all_rows, out, ran),
+        objective=objective_text(spec),
+        ran=ran,
+    )
+    _save_history_figure(result, out)
+    return result
+
+
+def _write_best(spec: StudySpec, out: Path, best: dict[str, Any], params: dict[str, Any]) -> Path:
+    """DIR/best.toml (and DIR/best_lead_filter.json when the trial scaled the filter) and DIR/best.json."""
+    controller = spec.controllers[0]
+    run = spec.plan(params)[0]  # the options are the same in every run of the trial
+    config = build_controller_config(run, load_vehicle(run.vehicle))
+    scales = {k: v for k, v in run.options if k in LEAD_FILTER_SCALES}
+    header = (
+        f"The best of {spec.optimise.trials if spec.optimise else '?'} trials of `workbench optimise`: trial "
+        f"{best['trial']}, objective {best['value']!r}\n({objective_text(spec)}).\n"
+        f"Use: workbench run SCENARIO --controller {controller} --controller-config {BEST_CONFIG}"
+    )
+    if scales and getattr(config, "lead_filter", None) is not None:
+        header += f"\n{BEST_FILTER}: the lead filter with {', '.join(f'{k} = {v!r}' for k, v in scales.items())}."
+    path = write_controller_config(out / BEST_CONFIG, controller, config, header)
+    document = {
+        "trial": best["trial"],
+        "value": best["value"],
+        "objective": objective_text(spec),
+        "controller": controller,
+        "params": params,
+        "config_file": BEST_CONFIG,
+    }
+    (out / BEST_JSON).write_text(json.dumps(document, indent=2) + "\n", encoding="utf-8")
+    return path
+
+
+def _save_history_figure(result: OptimisationResult, out: Path) -> None:
+    import matplotlib.pyplot as plt
+
+    ax = result.plot_history()
+    ax.figure.savefig(out / HISTORY_FIGURE, dpi=110)
+    plt.close(ax.figure)
+
+
+__all__ = ["OptimisationResult", "objective_text", "run_optimisation", "trial_value", "write_controller_config"]

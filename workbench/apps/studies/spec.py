@@ -1,0 +1,753 @@
+"""A study spec (TOML) and the runs it plans: which scenarios, controllers and vehicles, over which parameter grids
+and seeded random draws; for `workbench optimise` also the objective and the search space.
+
+    [study]
+    scenarios = ["dlc"]                     # names (`workbench scenarios`) or waypoint files
+    controllers = ["clothoid"]              # registered names (`workbench controllers`)
+    vehicles = ["tractor-semitrailer"]      # preset names (`workbench vehicles`) or vehicle TOML files
+    # controller_config = "options.toml"    # as `workbench run --controller-config`; the spec's options go on top
+    # track_file = "Zandvoort.csv"          # for the zandvoort scenario
+    # seed = 0                              # of the random draws
+    # samples = 20                          # random draws; required with [random], not allowed without
+    # max_runs = 100000                     # refuse a larger study (default DEFAULT_MAX_RUNS; `--max-runs N`)
+
+    [grid]                                  # run parameters: a list is an axis, a single value is fixed
+    speed_kmh = [20, 30, 40]
+    initial_offset_m = [0.0, 0.5]
+
+    [grid.clothoid]                         # options of one controller (its config fields), on its runs only
+    frechet_threshold_m = [0.01, 0.02, 0.05]
+
+    [random]                                # run parameters drawn `samples` times (`distributions.py`)
+    payload_kg = { uniform = [0, 17000] }
+
+    [random.clothoid]
+    lead_filter_pole_scale = { uniform = [0.8, 1.25] }
+
+Run parameters (RUN_PARAMETERS) are the fields of `SimulationConfig` (speed_kmh, max_lateral_accel_g,
+controller_rate_hz, plant_rate_hz, laps, max_time_s, ...), payload_kg (vehicles with a payload),
+initial_offset_m (m, left of the path positive) and initial_heading_error_deg (deg): omitted, the scenario's own
+(fig17 starts 1.0 m left of the path). Controller parameters are the controller's options (`workbench controllers
+--show NAME`) and, for a controller that reads a lead filter (`filter_file`), lead_filter_zero_scale and
+lead_filter_pole_scale: factors on the filter's zero and pole frequencies (`lead_filter_scaling.py`).
+
+Planned runs are the product, per scenario, vehicle and controller, of the run-parameter axes, that controller's
+axes and the random samples (draw i of every key together). Each run's id is a hash of its canonical parameters
+(files by their path relative to the spec and a hash of their content), so the same run always has the same id
+and a restarted or extended study finds the runs it already has.
+
+The spec is checked before any run starts: unknown tables and keys, unknown names, missing files, empty lists,
+NaN, wrong types and misplaced keys are WorkbenchInputError naming the key and what is allowed. Every file the
+spec names is read as the runs will read it (`_check_files`): the controller-config file (its keys and values, for
+each controller), vehicle files, waypoint files, the track file, and the files the controllers' options name
+(lead filters, limits, lags, vehicle files, from the config file or the grid). A study planning more runs than
+max_runs (counted from the axes' sizes, `run_count`, before anything is planned; an optimisation: trials x runs)
+is refused saying how many. A value that a run's vehicle, scenario, simulation or controller refuses only in
+combination (out of range, inconsistent) is that run's error.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import itertools
+import json
+import math
+import os
+import typing
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from types import MappingProxyType
+from typing import Any
+
+from controllers import CONTROLLERS
+from workbench.apps.studies.distributions import SEARCHABLE, Distribution, key_rng
+from workbench.base.errors import WorkbenchInputError, value_text
+from workbench.base.input_files import check_input_file, read_json, read_toml
+from workbench.base.typed_tables import type_name, typed_value, unwrap
+from workbench.simulation.metrics import METRIC_KEYS
+from workbench.simulation.scenarios import SCENARIOS, ZANDVOORT_ENV, ZANDVOORT_SOURCE, ScenarioOptions
+from workbench.simulation.simulator import SimulationConfig
+from workbench.vehicles import VEHICLES
+
+#: The run parameters besides SimulationConfig's fields, with their types.
+EXTRA_RUN_PARAMETERS: dict[str, Any] = {
+    "payload_kg": float,
+    "initial_offset_m": float,
+    "initial_heading_error_deg": float,
+}
+#: Every run parameter and its type: SimulationConfig's fields, then the extras.
+RUN_PARAMETERS: dict[str, Any] = {
+    **{f.name: typing.get_type_hints(SimulationConfig)[f.name] for f in dataclasses.fields(SimulationConfig)},
+    **EXTRA_RUN_PARAMETERS,
+}
+#: Factors on a lead filter's zero and pole frequencies, parameters of controllers that read one (`filter_file`).
+LEAD_FILTER_SCALES = ("lead_filter_zero_scale", "lead_filter_pole_scale")
+#: Metrics an objective may weigh: the numeric metrics.json fields except the wall-clock step times and the limit
+#: cycle's frequency and amplitude (null for a run without one, which would fail the trial). limit_cycle counts as
+#: 1 or 0 (a penalty on runs that limit-cycle).
+OBJECTIVE_METRICS = tuple(
+    k
+    for k in METRIC_KEYS
+    if k not in ("scenario", "controller", "vehicle", "completed", "step_time_median_us", "step_time_p99_us")
+    and k not in ("limit_cycle_hz", "limit_cycle_amplitude_deg")
+)
+AGGREGATES = ("mean", "max")
+STUDY_KEYS = (
+    "scenarios",
+    "controllers",
+    "vehicles",
+    "controller_config",
+    "track_file",
+    "seed",
+    "samples",
+    "description",
+    "max_runs",
+)
+OPTIMISE_KEYS = ("trials", "batch_size", "seed", "startup_trials", "aggregate", "objective", "search")
+SCENARIO_FILE_SUFFIXES = (".csv", ".txt")
+RUN_FORMAT = "workbench-run/1"
+#: The most runs a study may plan (an optimisation: trials x runs per trial) unless study.max_runs or
+#: `--max-runs N` allows more: 100 000 runs take hours on a workstation (about 0.2 s each on one core).
+DEFAULT_MAX_RUNS = 100_000
+
+
+def controller_parameters(controller: str) -> dict[str, Any]:
+    """The parameters of a controller's runs and their types: its config options (`option_types`: a file option
+    such as filter_file in place of the object it is read into), and the lead-filter scales when it reads a lead
+    filter."""
+    from controllers.config_file import option_types
+
+    params = option_types(CONTROLLERS[controller].config_type)
+    if "filter_file" in params:
+        params |= dict.fromkeys(LEAD_FILTER_SCALES, float)
+    return params
+
+
+def _check_distribution(where: str, dist: Distribution, annotation: Any, base_dir: Path) -> Distribution:
+    base, _ = unwrap(annotation)
+    if dist.produces == "choice":
+        return Distribution(
+            "choice", tuple(typed_value(f"{where} choice", v, annotation, base_dir) for v in dist.values)
+        )
+    if (dist.produces == "int" and base in (int, float)) or (dist.produces == "float" and base is float):
+        return dist
+    raise WorkbenchInputError(
+        f"{where}: {dist.kind} draws {'whole numbers' if dist.produces == 'int' else 'numbers'}, but the parameter "
+        f"is a {type_name(annotation)}"
+        + ("; use integers = [low, high]" if base is int else "; use choice = [...]" if base is not float else "")
+    )
+
+
+def _names(key: str, value: object) -> tuple[str, ...]:
+    if isinstance(value, str):
+        value = [value]
+    if not isinstance(value, list | tuple) or not all(isinstance(v, str) and v for v in value):
+        raise WorkbenchInputError(f"study.{key} must be a list of names; got {value!r}")
+    if not value:
+        raise WorkbenchInputError(f"study.{key} is empty; give at least one")
+    if len(set(value)) != len(value):
+        raise WorkbenchInputError(f"study.{key} names one twice: {list(value)}")
+    return tuple(value)
+
+
+def _resolve_name(key: str, name: str, known: Sequence[str], suffixes: tuple[str, ...], base_dir: Path) -> str:
+    """A registered name as it is, or a file (relative to base_dir) as its absolute path."""
+    if name in known:
+        return name
+    path = Path(name).expanduser()
+    path = path if path.is_absolute() else base_dir / path
+    if path.suffix.lower() in suffixes or os.path.lexists(path):
+        if not os.path.lexists(path):
+            raise WorkbenchInputError(f"study.{key}: file {name!r} does not exist (looked for {path})")
+        return str(check_input_file(path, f"study.{key}: file {name!r} ({path})"))
+    kinds = " or ".join(f"a {s} file" for s in suffixes)
+    raise WorkbenchInputError(f"study.{key}: unknown name {name!r}; choose one of {', '.join(known)} or give {kinds}")
+
+
+def _axes(where: str, table: Mapping[str, Any], allowed: Mapping[str, Any], base_dir: Path) -> dict[str, tuple]:
+    axes = {}
+    for key, values in table.items():
+        if key not in allowed:
+            raise WorkbenchInputError(f"unknown parameter {where}.{key}; allowed: {', '.join(allowed)}")
+        values = list(values) if isinstance(values, list | tuple) else [values]
+        if not values:
+            raise WorkbenchInputError(f"{where}.{key} is empty; give at least one value")
+        typed = tuple(typed_value(f"{where}.{key}[{i}]", v, allowed[key], base_dir) for i, v in enumerate(values))
+        if len({repr(v) for v in typed}) != len(typed):
+            raise WorkbenchInputError(f"{where}.{key} lists a value twice: {values}")
+        axes[key] = typed
+    return axes
+
+
+def _draws(where: str, table: Mapping[str, Any], allowed: Mapping[str, Any], base_dir: Path) -> dict:
+    out = {}
+    for key, dist in table.items():
+        if key not in allowed:
+            raise WorkbenchInputError(f"unknown parameter {where}.{key}; allowed: {', '.join(allowed)}")
+        if not isinstance(dist, Distribution):
+            dist = Distribution.parse(f"{where}.{key}", dist)
+        out[key] = _check_distribution(f"{where}.{key}", dist, allowed[key], base_dir)
+    return out
+
+
+def _split(where: str, table: Mapping[str, Any], controllers: Sequence[str]) -> tuple[dict, dict[str, dict]]:
+    """A [grid] or [random] table: (run-parameter entries, {controller: its entries})."""
+    if not isinstance(table, Mapping):
+        raise WorkbenchInputError(f"[{where}] must be a table; got {table!r}")
+    run, per_controller = {}, {}
+    for key, value in table.items():
+        if key in CONTROLLERS:
+            if key not in controllers:
+                raise WorkbenchInputError(
+                    f"[{where}.{key}] sets options of {key!r}, which study.controllers does not run "
+                    f"({', '.join(controllers)})"
+                )
+            if not isinstance(value, Mapping):
+                raise WorkbenchInputError(f"[{where}.{key}] must be a table of {key}'s options; got {value!r}")
+            per_controller[key] = dict(value)
+        elif key in RUN_PARAMETERS:
+            run[key] = value
+        else:
+            raise WorkbenchInputError(
+                f"unknown parameter {where}.{key}; allowed: the run parameters {', '.join(RUN_PARAMETERS)}, or a "
+                f"table named by a controller ({', '.join(CONTROLLERS)}) for its options"
+            )
+    return run, per_controller
+
+
+def _file_digest(path: Path, cache: dict[Path, str | None]) -> str | None:
+    if path not in cache:
+        try:
+            cache[path] = hashlib.sha256(path.read_bytes()).hexdigest()
+        except OSError:
+            cache[path] = None
+    return cache[path]
+
+
+@dataclass(frozen=True)
+class PlannedRun:
+    """One run of a study, everything a worker needs: scenario (a name or an absolute waypoint-file path),
+    controller, vehicle (a preset name or an absolute vehicle-file path), values (run parameters given, typed),
+    options (controller parameters given, typed), sample (the random draw's index, None without draws),
+    controller_config (a controller-options TOML), track_file; run_id (hash of the canonical parameters) and
+    index (its place in the study's order)."""
+
+    run_id: str
+    index: int
+    scenario: str
+    controller: str
+    vehicle: str
+    values: tuple[tuple[str, Any], ...] = ()
+    options: tuple[tuple[str, Any], ...] = ()
+    sample: int | None = None
+    controller_config: Path | None = None
+    track_file: Path | None = None
+
+    def parameters(self) -> dict[str, Any]:
+        """The run's columns before its metrics: ids, names, speed_kmh (always) and each given parameter
+        (controller options as "<controller>.<option>"), paths as text."""
+
+        def plain(v: Any) -> Any:
+            return str(v) if isinstance(v, Path) else v
+
+        row: dict[str, Any] = {
+            "run_id": self.run_id,
+            "index": self.index,
+            "scenario": self.scenario,
+            "controller": self.controller,
+            "vehicle": self.vehicle,
+            "sample": self.sample,
+            "speed_kmh": SimulationConfig.speed_kmh,
+        }
+        row |= {k: plain(v) for k, v in self.values}
+        row |= {f"{self.controller}.{k}": plain(v) for k, v in self.options}
+        return row
+
+
+@dataclass(frozen=True)
+class OptimiseSettings:
+    """The [optimise] table: trials (total), batch_size (trials asked and run together; fixed by the spec, not by
+    the workers, so a study is the same on any machine), seed (the sampler's; None: the study's seed),
+    startup_trials (random trials before TPE models the results), aggregate ("mean" or "max" of a trial's runs),
+    objective (metric -> weight, summed per run) and search (controller parameter -> distribution)."""
+
+    trials: int
+    objective: Mapping[str, float]
+    search: Mapping[str, Distribution]
+    batch_size: int = 4
+    seed: int | None = None
+    startup_trials: int = 10
+    aggregate: str = "mean"
+
+    def __post_init__(self) -> None:
+        for name, low in (("trials", 1), ("batch_size", 1), ("startup_trials", 0)):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, int) or value < low:
+                raise WorkbenchInputError(f"optimise.{name} must be a whole number >= {low}; got {value_text(value)}")
+        if self.seed is not None and (isinstance(self.seed, bool) or not isinstance(self.seed, int) or self.seed < 0):
+            raise WorkbenchInputError(f"optimise.seed must be a whole number >= 0; got {value_text(self.seed)}")
+        if self.aggregate not in AGGREGATES:
+            raise WorkbenchInputError(
+                f"optimise.aggregate must be one of {', '.join(AGGREGATES)}; got {self.aggregate!r}"
+            )
+        if not isinstance(self.objective, Mapping) or not self.objective:
+            raise WorkbenchInputError(
+                "optimise.objective must be a table of metric weights, e.g. {rms_cte_m = 1.0, rms_steer_rate_deg_s = "
+                f"0.002}}; allowed metrics: {', '.join(OBJECTIVE_METRICS)}; got {self.objective!r}"
+            )
+        weights = {}
+        for key, weight in self.objective.items():
+            if key not in OBJECTIVE_METRICS:
+                raise WorkbenchInputError(
+                    f"unknown metric optimise.objective.{key}; allowed: {', '.join(OBJECTIVE_METRICS)} (the wall-clock "
+                    "step times are not: they differ between runs and machines; nor limit_cycle_hz and "
+                    "limit_cycle_amplitude_deg: null for a run without a limit cycle; weigh limit_cycle)"
+                )
+            weights[key] = typed_value(f"optimise.objective.{key}", weight, float, Path())
+        if not any(weights.values()):
+            raise WorkbenchInputError(f"optimise.objective needs a weight other than 0; got {weights}")
+        object.__setattr__(self, "objective", MappingProxyType(weights))
+        if not isinstance(self.search, Mapping) or not self.search:
+            raise WorkbenchInputError(
+                "optimise.search must be a table of controller parameters and distributions, e.g. "
+                "{frechet_threshold_m = {log_uniform = [0.005, 0.5]}}"
+            )
+        search = {}
+        for key, dist in self.search.items():
+            dist = dist if isinstance(dist, Distribution) else Distribution.parse(f"optimise.search.{key}", dist)
+            if dist.kind not in SEARCHABLE:
+                raise WorkbenchInputError(
+                    f"optimise.search.{key}: an optimiser needs a bounded distribution ({', '.join(SEARCHABLE)}); "
+                    f"got {dist.kind}"
+                )
+            search[key] = dist
+        object.__setattr__(self, "search", MappingProxyType(search))
+
+    @classmethod
+    def from_table(cls, table: object) -> OptimiseSettings:
+        if not isinstance(table, Mapping):
+            raise WorkbenchInputError(f"[optimise] must be a table; got {table!r}")
+        unknown = [k for k in table if k not in OPTIMISE_KEYS]
+        if unknown:
+            raise WorkbenchInputError(
+                f"unknown key(s) optimise.{', optimise.'.join(unknown)}; allowed: {', '.join(OPTIMISE_KEYS)}"
+            )
+        for key in ("trials", "objective", "search"):
+            if key not in table:
+                raise WorkbenchInputError(f"[optimise] needs {key}; it has {', '.join(table) or 'nothing'}")
+        return cls(**table)
+
+
+@dataclass(frozen=True)
+class StudySpec:
+    """A study: see the module docstring. base_dir: the folder relative paths are taken from (the spec file's).
+    grid / random: run-parameter axes / distributions; controller_grid / controller_random: the same per
+    controller; max_runs: the most runs the study may plan (an optimisation: trials x runs per trial). Values are
+    checked and typed on construction (paths made absolute, the files they name read)."""
+
+    scenarios: Sequence[str]
+    controllers: Sequence[str]
+    vehicles: Sequence[str]
+    grid: Mapping[str, Any] = field(default_factory=dict)
+    controller_grid: Mapping[str, Mapping[str, Any]] = field(default_factory=dict)
+    random: Mapping[str, Any] = field(default_factory=dict)
+    controller_random: Mapping[str, Mapping[str, Any]] = field(default_factory=dict)
+    seed: int = 0
+    samples: int | None = None
+    controller_config: Path | None = None
+    track_file: Path | None = None
+    description: str = ""
+    base_dir: Path = field(default_factory=Path.cwd)
+    optimise: OptimiseSettings | None = None
+    max_runs: int = DEFAULT_MAX_RUNS
+
+    def __post_init__(self) -> None:
+        base = Path(self.base_dir).resolve()
+        object.__setattr__(self, "base_dir", base)
+        controllers = _names("controllers", self.controllers)
+        for name in controllers:
+            if name not in CONTROLLERS:
+                raise WorkbenchInputError(
+                    f"study.controllers: unknown controller {name!r}; choose one of {', '.join(CONTROLLERS)}"
+                )
+        scenarios = tuple(
+            _resolve_name("scenarios", n, tuple(SCENARIOS), SCENARIO_FILE_SUFFIXES, base)
+            for n in _names("scenarios", self.scenarios)
+        )
+        vehicles = tuple(
+            _resolve_name("vehicles", n, tuple(VEHICLES), (".toml",), base) for n in _names("vehicles", self.vehicles)
+        )
+        object.__setattr__(self, "controllers", controllers)
+        object.__setattr__(self, "scenarios", scenarios)
+        object.__setattr__(self, "vehicles", vehicles)
+        if "zandvoort" in scenarios and self.track_file is None:
+            if not os.environ.get(ZANDVOORT_ENV):
+                raise WorkbenchInputError(
+                    f"study.scenarios has zandvoort, which needs {ZANDVOORT_SOURCE}: give study.track_file "
+                    f"or set the environment variable {ZANDVOORT_ENV}"
+                )
+            object.__setattr__(self, "track_file", os.environ[ZANDVOORT_ENV])
+        for name in ("controller_config", "track_file"):
+            value = getattr(self, name)
+            if value is not None:
+                path = typed_value(f"study.{name}", value, Path, base)
+                if not os.path.lexists(path):
+                    raise WorkbenchInputError(f"study.{name}: file {str(value)!r} does not exist (looked for {path})")
+                object.__setattr__(self, name, check_input_file(path, f"study.{name}: file {str(value)!r}"))
+        if not isinstance(self.description, str):
+            raise WorkbenchInputError(f"study.description must be text; got {self.description!r}")
+        if isinstance(self.seed, bool) or not isinstance(self.seed, int) or self.seed < 0:
+            raise WorkbenchInputError(f"study.seed must be a whole number >= 0; got {value_text(self.seed)}")
+
+        grid = _axes("grid", self.grid, RUN_PARAMETERS, base)
+        random = _draws("random", self.random, RUN_PARAMETERS, base)
+        controller_grid, controller_random = {}, {}
+        for where, table, out, parse in (
+            ("grid", self.controller_grid, controller_grid, _axes),
+            ("random", self.controller_random, controller_random, _draws),
+        ):
+            for name, entries in table.items():
+                if name not in controllers:
+                    raise WorkbenchInputError(
+                        f"[{where}.{name}] sets options of {name!r}, which study.controllers does not run "
+                        f"({', '.join(controllers)})"
+                    )
+                out[name] = MappingProxyType(parse(f"{where}.{name}", entries, controller_parameters(name), base))
+        for where, axes, draws in [("", grid, random)] + [
+            (f".{c}", controller_grid.get(c, {}), controller_random.get(c, {})) for c in controllers
+        ]:
+            both = sorted(set(axes) & set(draws))
+            if both:
+                raise WorkbenchInputError(
+                    f"{', '.join(both)} is both in [grid{where}] and in [random{where}]; keep one"
+                )
+        models = _vehicle_models(vehicles)  # reads the vehicle files: a file a run cannot use is refused now
+        if "payload_kg" in grid or "payload_kg" in random:
+            others = [v for v in vehicles if not _has_payload(models[v])]
+            if others:
+                raise WorkbenchInputError(
+                    f"payload_kg is given but vehicle(s) {', '.join(others)} have no payload; a payload applies to "
+                    f"{', '.join(n for n in VEHICLES if _has_payload(n))}: run the others in a separate study"
+                )
+        object.__setattr__(self, "grid", MappingProxyType(grid))
+        object.__setattr__(self, "random", MappingProxyType(random))
+        object.__setattr__(self, "controller_grid", MappingProxyType(controller_grid))
+        object.__setattr__(self, "controller_random", MappingProxyType(controller_random))
+        has_draws = bool(random) or any(controller_random.values())
+        if self.samples is not None:
+            if isinstance(self.samples, bool) or not isinstance(self.samples, int) or self.samples < 1:
+                raise WorkbenchInputError(f"study.samples must be a whole number >= 1; got {value_text(self.samples)}")
+            if not has_draws:
+                raise WorkbenchInputError(f"study.samples = {self.samples} but [random] draws nothing; drop samples")
+        elif has_draws:
+            raise WorkbenchInputError("[random] draws parameters: give study.samples, the number of draws")
+        if self.optimise is not None:
+            object.__setattr__(self, "optimise", self._checked_optimise(self.optimise))
+        if isinstance(self.max_runs, bool) or not isinstance(self.max_runs, int) or self.max_runs < 1:
+            raise WorkbenchInputError(f"study.max_runs must be a whole number >= 1; got {value_text(self.max_runs)}")
+        self._check_size()
+        self._check_files(models)
+
+    # ------------------------------------------------------------------------------------------- checks
+    def run_count(self) -> int:
+        """How many runs `plan()` gives, counted from the axes' sizes without planning them: per scenario and
+        vehicle, the sum over controllers of the product of the run-parameter axes, that controller's axes and
+        the samples. (An optimisation runs this many per trial.)"""
+        runs_per_controller = sum(self._runs_per_controller().values())
+        return len(self.scenarios) * len(self.vehicles) * runs_per_controller
+
+    def _runs_per_controller(self) -> dict[str, int]:
+        grid = math.prod(len(values) for values in self.grid.values())
+        samples = self.samples or 1
+        return {
+            c: grid * math.prod(len(v) for v in self.controller_grid.get(c, {}).values()) * samples
+            for c in self.controllers
+        }
+
+    def total_runs(self) -> int:
+        """The runs the whole study executes: run_count(), times the trials of an optimisation."""
+        return self.run_count() * (self.optimise.trials if self.optimise is not None else 1)
+
+    def _check_size(self) -> None:
+        total = self.total_runs()
+        if total <= self.max_runs:
+            return
+        axes = [f"{len(self.scenarios)} scenario(s)", f"{len(self.vehicles)} vehicle(s)"]
+        per_controller = self._runs_per_controller()
+        axes.append(
+            " + ".join(f"{c} {n:,}" for c, n in per_controller.items()) + " runs per scenario and vehicle"
+            if len(per_controller) > 1
+            else f"{next(iter(per_controller.values())):,} runs per scenario and vehicle"
+        )
+        sizes = [f"{k} {len(v)}" for k, v in self.grid.items()]
+        sizes += [f"{c}.{k} {len(v)}" for c, axes_c in self.controller_grid.items() for k, v in axes_c.items()]
+        if self.samples:
+            sizes.append(f"samples {self.samples:,}")
+        trials = f" x {self.optimise.trials:,} trials" if self.optimise is not None else ""
+        raise WorkbenchInputError(
+            f"the study plans {total:,} runs ({' x '.join(axes)}{trials}; axes: {', '.join(sizes) or 'none'}), "
+            f"more than the limit of {self.max_runs:,}: shrink the grid, the samples or the trials, or raise the "
+            "limit with study.max_runs or --max-runs N"
+        )
+
+    def _check_files(self, models: Mapping[str, Any]) -> None:
+        """Read every file the runs will read, as they will: the controller-config file for each controller
+        (its keys and values), waypoint and track files, and each file a controller option names (in the config
+        file, the grid or a choice). A WorkbenchInputError names the key and the file."""
+        from controllers.config_file import read_controller_config
+        from workbench.simulation.scenarios import make_scenario
+
+        for scenario in self.scenarios:
+            if scenario not in SCENARIOS:
+                try:
+                    make_scenario(scenario)
+                except WorkbenchInputError as exc:
+                    raise WorkbenchInputError(f"study.scenarios: {exc}") from None
+        if "zandvoort" in self.scenarios:
+            try:
+                make_scenario("zandvoort", ScenarioOptions(track_file=self.track_file))
+            except WorkbenchInputError as exc:
+                raise WorkbenchInputError(f"study.track_file: {exc}") from None
+        geometry = next(iter(models.values())).geometry
+        checked: set[Path] = set()
+        for controller in self.controllers:
+            params = controller_parameters(controller)
+            file_options = [k for k, t in params.items() if unwrap(t)[0] is Path]
+            # Its file options are read here, into the config's objects, as a run will read them.
+            config_type = CONTROLLERS[controller].config_type
+            read_controller_config(self.controller_config, controller, config_type, (), geometry)
+            named: list[tuple[str, str, Any]] = []
+            for where, table in (("grid", self.controller_grid), ("random", self.controller_random)):
+                for key, values in table.get(controller, {}).items():
+                    if key in file_options:
+                        values = values.values if isinstance(values, Distribution) else values
+                        named += [(f"{where}.{controller}.{key}", key, v) for v in values]
+            search = self.optimise.search if self.optimise is not None else {}
+            named += [(f"optimise.search.{k}", k, v) for k, d in search.items() if k in file_options for v in d.values]
+            for where, key, path in named:
+                if path is not None and path not in checked:
+                    _check_option_file(where, key, path, geometry)
+                    checked.add(path)
+
+    def _checked_optimise(self, optimise: OptimiseSettings) -> OptimiseSettings:
+        """The [optimise] settings checked against the study (one controller, its options fixed or searched), with
+        the search distributions typed."""
+        if len(self.controllers) != 1:
+            raise WorkbenchInputError(
+                f"an optimise study tunes one controller; study.controllers has {list(self.controllers)}"
+            )
+        controller = self.controllers[0]
+        allowed = controller_parameters(controller)
+        if self.controller_random.get(controller):
+            raise WorkbenchInputError(
+                f"[random.{controller}] is not allowed in an optimise study: the best options would depend on the "
+                f"draw; fix them in [grid.{controller}] or search them in [optimise.search]"
+            )
+        for key, values in self.controller_grid.get(controller, {}).items():
+            if len(values) != 1:
+                raise WorkbenchInputError(
+                    f"grid.{controller}.{key} lists {len(values)} values; an optimise study fixes a controller option "
+                    f"(one value) or searches it (optimise.search)"
+                )
+        search = {}
+        for key, dist in optimise.search.items():
+            if key not in allowed:
+                raise WorkbenchInputError(
+                    f"unknown parameter optimise.search.{key} for {controller}; allowed: {', '.join(allowed)}"
+                )
+            if key in self.controller_grid.get(controller, {}):
+                raise WorkbenchInputError(f"{key} is both fixed in [grid.{controller}] and in [optimise.search]")
+            search[key] = _check_distribution(f"optimise.search.{key}", dist, allowed[key], self.base_dir)
+        return dataclasses.replace(optimise, search=search)
+
+    # ------------------------------------------------------------------------------------------- planning
+    def plan(self, options: Mapping[str, Any] | None = None) -> list[PlannedRun]:
+        """Every run of the study, in order: per scenario, vehicle and controller, the product of the run-parameter
+        axes (first listed outermost), the controller's axes, and the random samples. `options` adds controller
+        parameters to every run (an optimiser's trial; the study must have one controller)."""
+        digests: dict[Path, str | None] = {}
+        extra = {}
+        if options:
+            if len(self.controllers) != 1:
+                raise WorkbenchInputError("extra options need a study of one controller")
+            allowed = controller_parameters(self.controllers[0])
+            for key, value in options.items():
+                if key not in allowed:
+                    raise WorkbenchInputError(f"unknown option {key!r} for {self.controllers[0]}")
+                extra[key] = typed_value(key, value, allowed[key], self.base_dir)
+        samples = self.samples or 1
+        run_draws = {k: d.draw(key_rng(self.seed, k), samples) for k, d in self.random.items()}
+        runs: list[PlannedRun] = []
+        for scenario, vehicle, controller in itertools.product(self.scenarios, self.vehicles, self.controllers):
+            axes = self.controller_grid.get(controller, {})
+            draws = {
+                k: d.draw(key_rng(self.seed, f"{controller}.{k}"), samples)
+                for k, d in self.controller_random.get(controller, {}).items()
+            }
+            for run_values in itertools.product(*self.grid.values()):
+                for option_values in itertools.product(*axes.values()):
+                    for i in range(samples):
+                        values = dict(zip(self.grid, run_values, strict=True))
+                        values |= {k: v[i] for k, v in run_draws.items()}
+                        opts = dict(zip(axes, option_values, strict=True)) | {k: v[i] for k, v in draws.items()}
+                        opts |= extra
+                        sample = i if self.samples is not None else None
+                        runs.append(self._run(len(runs), scenario, vehicle, controller, values, opts, sample, digests))
+        return runs
+
+    def _canonical(self, value: Any, digests: dict[Path, str | None]) -> Any:
+        if isinstance(value, Path):
+            return {
+                "file": Path(os.path.relpath(value, self.base_dir)).as_posix(),
+                "sha256": _file_digest(value, digests),
+            }
+        return value
+
+    def _run(
+        self,
+        index: int,
+        scenario: str,
+        vehicle: str,
+        controller: str,
+        values: dict[str, Any],
+        options: dict[str, Any],
+        sample: int | None,
+        digests: dict[Path, str | None],
+    ) -> PlannedRun:
+        def canon_name(name: str, known: Mapping[str, Any]) -> Any:
+            return name if name in known else self._canonical(Path(name), digests)
+
+        track = self.track_file if scenario == "zandvoort" else None
+        document = {
+            "format": RUN_FORMAT,
+            "scenario": canon_name(scenario, SCENARIOS),
+            "vehicle": canon_name(vehicle, VEHICLES),
+            "controller": controller,
+            "controller_config": self._canonical(self.controller_config, digests),
+            "track_file": self._canonical(track, digests),
+            "parameters": {k: self._canonical(v, digests) for k, v in sorted(values.items())},
+            "options": {k: self._canonical(v, digests) for k, v in sorted(options.items())},
+            "sample": sample,
+        }
+        text = json.dumps(document, sort_keys=True, separators=(",", ":"), allow_nan=False)
+        return PlannedRun(
+            run_id=hashlib.sha256(text.encode()).hexdigest()[:16],
+            index=index,
+            scenario=scenario,
+            controller=controller,
+            vehicle=vehicle,
+            values=tuple(values.items()),
+            options=tuple(options.items()),
+            sample=sample,
+            controller_config=self.controller_config,
+            track_file=track,
+        )
+
+
+def _has_payload(vehicle: Any) -> bool:
+    """Whether a vehicle (a model, or a preset name) carries a payload."""
+    from workbench.vehicles.presets import carries_payload
+
+    return carries_payload(vehicle if isinstance(vehicle, str) else vehicle.name)
+
+
+def _vehicle_models(vehicles: Sequence[str]) -> dict[str, Any]:
+    """Each vehicle (preset name or file) built from its preset or file: a file a run cannot use is refused now,
+    naming it."""
+    from workbench.vehicles.presets import load_vehicle
+
+    models = {}
+    for vehicle in vehicles:
+        try:
+            models[vehicle] = load_vehicle(vehicle)
+        except WorkbenchInputError as exc:
+            raise WorkbenchInputError(f"study.vehicles: {exc}") from None
+    return models
+
+
+def _check_option_file(where: str, key: str, path: Path, geometry: Any) -> None:
+    """Read a file a controller option names, as the controller will (lead filters, curvature limits, steering
+    lags, vehicle files); any other file must at least be readable."""
+    from controllers.config_file import FILE_OPTIONS
+
+    label = f"{where}: {path}"
+    check_input_file(path, label)
+    if path.suffix.lower() == ".json":
+        read_json(path, label)  # deep nesting, bad JSON: refused here, whatever reads it next
+    if key in FILE_OPTIONS:
+        try:
+            FILE_OPTIONS[key].read(path, geometry)
+        except WorkbenchInputError as exc:
+            raise WorkbenchInputError(f"{where}: {exc}") from None
+
+
+def load_spec(path: str | Path, kind: str = "sweep", max_runs: int | None = None) -> StudySpec:
+    """Read a study spec from a TOML file. kind: "sweep" (no [optimise] table) or "optimise" (one required);
+    max_runs: the limit on the study's runs, over the spec's study.max_runs (None: the spec's, else
+    DEFAULT_MAX_RUNS). WorkbenchInputError naming the file, the key and what is allowed for anything it cannot
+    use."""
+    if kind not in ("sweep", "optimise"):
+        raise WorkbenchInputError(f"kind must be sweep or optimise; got {kind!r}")
+    path = Path(path)
+    document = read_toml(path, f"spec file {str(path)!r}")
+    try:
+        return _from_document(document, kind, path.resolve().parent, max_runs)
+    except WorkbenchInputError as exc:
+        raise WorkbenchInputError(f"spec {path}: {exc}") from None
+
+
+def _from_document(document: Mapping[str, Any], kind: str, base_dir: Path, max_runs: int | None = None) -> StudySpec:
+    tables = ("study", "grid", "random") + (("optimise",) if kind == "optimise" else ())
+    unknown = [k for k in document if k not in tables]
+    if unknown:
+        hint = " ([optimise] belongs to `workbench optimise`)" if "optimise" in unknown else ""
+        raise WorkbenchInputError(f"unknown table(s) {', '.join(unknown)}; allowed: {', '.join(tables)}{hint}")
+    study = document.get("study")
+    if not isinstance(study, Mapping):
+        raise WorkbenchInputError(f"the spec needs a [study] table with {', '.join(STUDY_KEYS[:3])}")
+    unknown = [k for k in study if k not in STUDY_KEYS]
+    if unknown:
+        raise WorkbenchInputError(f"unknown key(s) study.{', study.'.join(unknown)}; allowed: {', '.join(STUDY_KEYS)}")
+    missing = [k for k in STUDY_KEYS[:3] if k not in study]
+    if missing:
+        raise WorkbenchInputError(f"[study] needs {', '.join(missing)}")
+    controllers = _names("controllers", study["controllers"])
+    grid, controller_grid = _split("grid", document.get("grid", {}), controllers)
+    random, controller_random = _split("random", document.get("random", {}), controllers)
+    optimise = None
+    if kind == "optimise":
+        if "optimise" not in document:
+            raise WorkbenchInputError(f"an optimise spec needs an [optimise] table with {', '.join(OPTIMISE_KEYS)}")
+        optimise = OptimiseSettings.from_table(document["optimise"])
+    return StudySpec(
+        scenarios=study["scenarios"],
+        controllers=controllers,
+        vehicles=study["vehicles"],
+        grid=grid,
+        controller_grid=controller_grid,
+        random=random,
+        controller_random=controller_random,
+        seed=study.get("seed", 0),
+        samples=study.get("samples"),
+        controller_config=study.get("controller_config"),
+        track_file=study.get("track_file"),
+        description=study.get("description", ""),
+        base_dir=base_dir,
+        optimise=optimise,
+        max_runs=max_runs if max_runs is not None else study.get("max_runs", DEFAULT_MAX_RUNS),
+    )
+
+
+__all__ = [
+    "DEFAULT_MAX_RUNS",
+    "LEAD_FILTER_SCALES",
+    "OBJECTIVE_METRICS",
+    "RUN_PARAMETERS",
+    "OptimiseSettings",
+    "PlannedRun",
+    "StudySpec",
+    "controller_parameters",
+    "load_spec",
+]

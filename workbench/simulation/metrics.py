@@ -1,0 +1,145 @@
+"""Run metrics: the numbers in metrics.json. Other tools read these keys, so they are stable.
+
+CTE is measured at the reference point (the tractor's rear-axle centre), signed, left of the path positive, at
+every logged (controller) step. Vehicle fields (max_ltr, max_offtracking_m) are null for vehicles that do not
+output them.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+from workbench.base.path import ReferencePath
+from workbench.simulation.limit_cycle import detect_limit_cycle, oscillation
+from workbench.simulation.speed_profile import G_MPS2
+
+#: The keys of metrics.json, in order.
+METRIC_KEYS: tuple[str, ...] = (
+    "scenario",
+    "controller",
+    "vehicle",
+    "completed",
+    "distance_m",
+    "path_length_m",
+    "max_abs_cte_m",
+    "rms_cte_m",
+    "max_abs_heading_error_deg",
+    "max_abs_steer_wheel_deg",
+    "max_abs_steer_rate_deg_s",
+    "rms_steer_rate_deg_s",
+    "steer_oscillation_deg",
+    "limit_cycle",
+    "limit_cycle_hz",
+    "limit_cycle_amplitude_deg",
+    "max_abs_lat_accel_g",
+    "max_ltr",
+    "max_offtracking_m",
+    "step_time_median_us",
+    "step_time_p99_us",
+)
+
+
+@dataclass(frozen=True)
+class Metrics:
+    """Summary of one run; None where a quantity does not apply (no samples, no trailer, no roll model).
+
+    distance_m: distance travelled by the reference point; path_length_m: the length the run was asked to cover
+    (the path, times the laps of a closed path); max_abs_steer_rate_deg_s, rms_steer_rate_deg_s: the largest and the
+    RMS steering-wheel rate (the steering effort), from the measured steering-wheel angle differenced at the
+    controller rate; steer_oscillation_deg: the RMS of the measured steering-wheel angle about its centred 1 s moving
+    average, away from the trace's ends (`limit_cycle.oscillation`; None for a trace under about 2 s);
+    limit_cycle, limit_cycle_hz, limit_cycle_amplitude_deg: whether the steering wheel limit-cycles, at what
+    frequency and steering-wheel amplitude (`limit_cycle.detect_limit_cycle`; None when it does not);
+    max_offtracking_m: the largest lateral distance of the trailer's rear-axle centre from the path.
+    """
+
+    scenario: str
+    controller: str
+    vehicle: str
+    completed: bool
+    distance_m: float
+    path_length_m: float
+    max_abs_cte_m: float | None
+    rms_cte_m: float | None
+    max_abs_heading_error_deg: float | None
+    max_abs_steer_wheel_deg: float | None
+    max_abs_steer_rate_deg_s: float | None
+    rms_steer_rate_deg_s: float | None
+    steer_oscillation_deg: float | None
+    limit_cycle: bool
+    limit_cycle_hz: float | None
+    limit_cycle_amplitude_deg: float | None
+    max_abs_lat_accel_g: float | None
+    max_ltr: float | None
+    max_offtracking_m: float | None
+    step_time_median_us: float | None
+    step_time_p99_us: float | None
+
+    def to_dict(self) -> dict[str, object]:
+        return asdict(self)
+
+
+def _max_abs(values: np.ndarray | None, scale: float = 1.0) -> float | None:
+    if values is None or values.size == 0:
+        return None
+    return float(np.max(np.abs(values)) * scale)
+
+
+def offtracking(path: ReferencePath, x_m: np.ndarray, y_m: np.ndarray) -> np.ndarray:
+    """Signed lateral distance (m) of a trailer point from the path, projected with progress tracking.
+
+    Sideways only (`Projection.cte_m`): a trailer starts behind an open path's start, where the distance to the
+    start point would count its length as offtracking."""
+    tracker = path.tracker(None)
+    return np.array([tracker.update(float(x), float(y)).cte_m for x, y in zip(x_m, y_m, strict=True)])
+
+
+def compute_metrics(
+    trace: dict[str, np.ndarray],
+    path: ReferencePath,
+    *,
+    scenario: str,
+    controller: str,
+    vehicle: str,
+    completed: bool,
+    path_length_m: float,
+) -> Metrics:
+    """Metrics of a trace (columns as the simulator logs them)."""
+    t = trace["t_s"]
+    n = t.size
+    cte = trace["cte_m"]
+    steer = trace["steer_wheel_rad"]
+    step_us = trace["step_time_s"] * 1e6
+    distance = float(np.trapezoid(trace["speed_mps"], t)) if n > 1 else 0.0
+    steer_rate = np.diff(steer) / np.diff(t) if n > 1 else None
+    deviation = oscillation(t, steer)
+    cycle = detect_limit_cycle(t, steer)
+    off = None
+    if "trailer_x_m" in trace and n:
+        off = offtracking(path, trace["trailer_x_m"], trace["trailer_y_m"])
+    return Metrics(
+        scenario=scenario,
+        controller=controller,
+        vehicle=vehicle,
+        completed=completed,
+        distance_m=distance,
+        path_length_m=float(path_length_m),
+        max_abs_cte_m=_max_abs(cte),
+        rms_cte_m=float(math.sqrt(np.mean(cte**2))) if n else None,
+        max_abs_heading_error_deg=_max_abs(trace["heading_error_rad"], 180.0 / math.pi),
+        max_abs_steer_wheel_deg=_max_abs(steer, 180.0 / math.pi),
+        max_abs_steer_rate_deg_s=_max_abs(steer_rate, 180.0 / math.pi),
+        rms_steer_rate_deg_s=float(math.degrees(math.sqrt(np.mean(steer_rate**2)))) if steer_rate is not None else None,
+        steer_oscillation_deg=math.degrees(math.sqrt(np.mean(deviation[1] ** 2))) if deviation is not None else None,
+        limit_cycle=cycle.detected,
+        limit_cycle_hz=cycle.frequency_hz,
+        limit_cycle_amplitude_deg=cycle.amplitude_deg,
+        max_abs_lat_accel_g=_max_abs(trace["lat_accel_mps2"], 1.0 / G_MPS2),
+        max_ltr=_max_abs(trace.get("ltr")),
+        max_offtracking_m=_max_abs(off),
+        step_time_median_us=float(np.median(step_us)) if n else None,
+        step_time_p99_us=float(np.percentile(step_us, 99)) if n else None,
+    )

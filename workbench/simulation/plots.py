@@ -1,0 +1,158 @@
+"""Plots of one run (trajectory over the reference with cones, CTE vs distance, steering vs time, speed), and of
+several runs on shared axes (the paper's Figures 17 and 18: `trajectories`, `cte_comparison`, `speed_comparison`,
+`steering_comparison`).
+
+matplotlib.pyplot is imported where a figure is drawn, not with this module (issue 17): `workbench.simulation.result`
+and the CLI's startup need none of it."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+
+    from workbench.simulation.result import SimulationResult
+
+
+def _axes(ax: Axes | None) -> Axes:
+    if ax is None:
+        import matplotlib.pyplot as plt
+
+        _, ax = plt.subplots(figsize=(8, 4.5), layout="constrained")
+    return ax
+
+
+def _label(result: SimulationResult) -> str:
+    return f"{result.controller} on {result.vehicle}"
+
+
+def _distance(result: SimulationResult) -> np.ndarray:
+    return result.trace["progress_m"]
+
+
+def trajectory(result: SimulationResult, ax: Axes | None = None) -> Axes:
+    ax = _axes(ax)
+    _draw_reference(result, ax)
+    ax.plot(result.trace["x_m"], result.trace["y_m"], lw=1.5, label=f"{_label(result)} (rear axle)")
+    if "trailer_x_m" in result.trace:
+        ax.plot(
+            result.trace["trailer_x_m"],
+            result.trace["trailer_y_m"],
+            lw=1.0,
+            color="tab:green",
+            label="trailer rear axle",
+        )
+    ax.set(xlabel="x (m)", ylabel="y (m)", title=f"{result.scenario.name}: tracked trajectory")
+    ax.legend(loc="best", fontsize="small")
+    return ax
+
+
+def cte_vs_distance(result: SimulationResult, ax: Axes | None = None) -> Axes:
+    ax = _axes(ax)
+    ax.plot(_distance(result), result.trace["cte_m"], label=_label(result))
+    ax.axhline(0.0, color="k", lw=0.5)
+    ax.set(xlabel="distance along path (m)", ylabel="cross-track error (m)", title="CTE at the rear-axle centre")
+    ax.legend(loc="best", fontsize="small")
+    return ax
+
+
+def steering_vs_time(result: SimulationResult, ax: Axes | None = None) -> Axes:
+    ax = _axes(ax)
+    t = result.trace["t_s"]
+    ax.plot(t, np.degrees(result.trace["steer_wheel_cmd_rad"]), lw=1.0, label="command")
+    ax.plot(t, np.degrees(result.trace["steer_wheel_rad"]), lw=1.5, label="measured")
+    ax.set(xlabel="time (s)", ylabel="steering-wheel angle (deg)", title=f"Steering: {_label(result)}")
+    ax.legend(loc="best", fontsize="small")
+    return ax
+
+
+def speed_vs_distance(result: SimulationResult, ax: Axes | None = None) -> Axes:
+    ax = _axes(ax)
+    d = _distance(result)
+    ax.plot(d, result.trace["speed_ref_mps"] * 3.6, "k--", lw=1.0, label="planned")
+    ax.plot(d, result.trace["speed_mps"] * 3.6, lw=1.5, label="actual")
+    ax.set(xlabel="distance along path (m)", ylabel="speed (km/h)", title="Speed")
+    ax.legend(loc="best", fontsize="small")
+    return ax
+
+
+RUN_PLOTS = {
+    "trajectory.png": trajectory,
+    "cte_vs_distance.png": cte_vs_distance,
+    "steering_vs_time.png": steering_vs_time,
+    "speed_vs_distance.png": speed_vs_distance,
+}
+
+
+def save_run_plots(result: SimulationResult, out_dir: Path) -> list[Path]:
+    """Write the four standard plots of a run as PNG files in out_dir."""
+    import matplotlib.pyplot as plt
+
+    written = []
+    for filename, draw in RUN_PLOTS.items():
+        ax = draw(result, None)
+        path = out_dir / filename
+        ax.figure.savefig(path, dpi=120)
+        plt.close(ax.figure)
+        written.append(path)
+    return written
+
+
+# ---------------------------------------------------------------------------------------------- several runs
+def _draw_reference(result: SimulationResult, ax: Axes) -> None:
+    path = result.path
+    ax.plot(path.x_m, path.y_m, "k--", lw=1.0, label="reference")
+    cones = result.scenario.cones_xy
+    if cones is not None:
+        ax.plot(cones[:, 0], cones[:, 1], "^", color="tab:red", ms=5, label="cones")
+    width, height = np.ptp(path.x_m), np.ptp(path.y_m)
+    if min(width, height) > 0.25 * max(width, height):  # true shape unless the path is long and thin (a DLC)
+        ax.set_aspect("equal", adjustable="datalim")
+
+
+def trajectories(results: Sequence[SimulationResult], labels: Sequence[str], ax: Axes | None = None) -> Axes:
+    """Figure 17a: each run's rear-axle path over the reference."""
+    ax = _axes(ax)
+    _draw_reference(results[0], ax)
+    for result, label in zip(results, labels, strict=True):
+        ax.plot(result.trace["x_m"], result.trace["y_m"], lw=1.3, label=label)
+    ax.set(xlabel="x (m)", ylabel="y (m)", title=f"{results[0].scenario.name}: tracked trajectories (rear axle)")
+    ax.legend(loc="best", fontsize="small")
+    return ax
+
+
+def cte_comparison(results: Sequence[SimulationResult], labels: Sequence[str], ax: Axes | None = None) -> Axes:
+    """Figure 17b: CTE against distance along the path, every run on one axis."""
+    ax = _axes(ax)
+    for result, label in zip(results, labels, strict=True):
+        ax.plot(_distance(result), result.trace["cte_m"], lw=1.3, label=label)
+    ax.axhline(0.0, color="k", lw=0.5)
+    ax.set(xlabel="distance along path (m)", ylabel="cross-track error (m)", title="CTE at the rear-axle centre")
+    ax.legend(loc="best", fontsize="small")
+    return ax
+
+
+def speed_comparison(results: Sequence[SimulationResult], labels: Sequence[str], ax: Axes | None = None) -> Axes:
+    """Figure 18a: speed against distance along the path (and the planned profile of the first run)."""
+    ax = _axes(ax)
+    ax.plot(_distance(results[0]), results[0].trace["speed_ref_mps"] * 3.6, "k--", lw=1.0, label="planned")
+    for result, label in zip(results, labels, strict=True):
+        ax.plot(_distance(result), result.trace["speed_mps"] * 3.6, lw=1.3, label=label)
+    ax.set(xlabel="distance along path (m)", ylabel="speed (km/h)", title="Speed")
+    ax.legend(loc="best", fontsize="small")
+    return ax
+
+
+def steering_comparison(results: Sequence[SimulationResult], labels: Sequence[str], ax: Axes | None = None) -> Axes:
+    """Figure 18b: measured steering-wheel angle against time."""
+    ax = _axes(ax)
+    for result, label in zip(results, labels, strict=True):
+        ax.plot(result.trace["t_s"], np.degrees(result.trace["steer_wheel_rad"]), lw=1.3, label=label)
+    ax.set(xlabel="time (s)", ylabel="steering-wheel angle (deg)", title="Steering-wheel angle")
+    ax.legend(loc="best", fontsize="small")
+    return ax

@@ -1,0 +1,112 @@
+"""The result of one closed-loop run: the trace, how the run ended, its metrics; converts and plots itself."""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field
+from enum import StrEnum
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from workbench.base.path import ReferencePath
+from workbench.simulation.metrics import Metrics, compute_metrics
+from workbench.simulation.scenarios import Scenario
+
+if TYPE_CHECKING:
+    import pandas as pd
+    from matplotlib.axes import Axes
+
+    from workbench.simulation.simulator import SimulationConfig
+
+
+class Status(StrEnum):
+    """How a run ended."""
+
+    COMPLETED = "completed"
+    TIMEOUT = "timeout"
+    LEFT_PATH = "left_path"
+    DIVERGED = "diverged"
+    CONTROLLER_FAILED = "controller_failed"
+
+
+@dataclass(frozen=True, eq=False)
+class SimulationResult:
+    """trace: one array per logged signal (SI units, units in the names), one row per controller step."""
+
+    trace: dict[str, np.ndarray]
+    status: Status
+    message: str
+    scenario: Scenario
+    path: ReferencePath
+    controller: str
+    vehicle: str
+    config: SimulationConfig
+    _metrics: list[Metrics] = field(default_factory=list, repr=False)
+
+    @property
+    def completed(self) -> bool:
+        return self.status is Status.COMPLETED
+
+    @property
+    def metrics(self) -> Metrics:
+        if not self._metrics:  # computed once, on first use
+            laps = self.config.laps if self.path.closed else 1
+            self._metrics.append(
+                compute_metrics(
+                    self.trace,
+                    self.path,
+                    scenario=self.scenario.name,
+                    controller=self.controller,
+                    vehicle=self.vehicle,
+                    completed=self.completed,
+                    path_length_m=self.path.length_m * laps,
+                )
+            )
+        return self._metrics[0]
+
+    def to_pandas(self) -> pd.DataFrame:
+        """The trace as a DataFrame, one row per controller step."""
+        import pandas as pd
+
+        return pd.DataFrame(self.trace)
+
+    # Plots: each draws on the given axes (or a new figure) and returns the axes.
+    def plot_trajectory(self, ax: Axes | None = None) -> Axes:
+        from workbench.simulation import plots
+
+        return plots.trajectory(self, ax)
+
+    def plot_cte(self, ax: Axes | None = None) -> Axes:
+        from workbench.simulation import plots
+
+        return plots.cte_vs_distance(self, ax)
+
+    def plot_steering(self, ax: Axes | None = None) -> Axes:
+        from workbench.simulation import plots
+
+        return plots.steering_vs_time(self, ax)
+
+    def plot_speed(self, ax: Axes | None = None) -> Axes:
+        from workbench.simulation import plots
+
+        return plots.speed_vs_distance(self, ax)
+
+    def save(self, out_dir: str | Path, with_plots: bool = True) -> list[Path]:
+        """Write trace.parquet, metrics.json (plus status and message) and the PNG plots; return the paths. The
+        files a run writes that are already in out_dir (an earlier run's, the plots included when with_plots is
+        False) are removed first, so the folder never holds files of two runs."""
+        from workbench.simulation import plots  # matplotlib itself only when the plots are drawn
+
+        out = Path(out_dir)
+        out.mkdir(parents=True, exist_ok=True)
+        for name in ("trace.parquet", "metrics.json", *plots.RUN_PLOTS):
+            (out / name).unlink(missing_ok=True)
+        written = [out / "trace.parquet", out / "metrics.json"]
+        self.to_pandas().to_parquet(written[0], index=False)
+        document = self.metrics.to_dict() | {"status": self.status.value, "message": self.message}
+        written[1].write_text(json.dumps(document, indent=2) + "\n")
+        if with_plots:
+            written += plots.save_run_plots(self, out)
+        return written

@@ -1,0 +1,318 @@
+"""Named test scenarios: a reference path, where the vehicle starts, and what to draw around it.
+
+`make_scenario(name)` builds one by name (`figure8`, `dlc`, `fig17`, `zandvoort`) or from a waypoint file path
+(CSV with x,y[,v] columns, a TUMFTM racetrack-database CSV, or a GPS CSV with lat/lon columns).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import os
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from workbench.base.errors import WorkbenchInputError, require_in_range
+
+if TYPE_CHECKING:
+    from workbench.base.path import ReferencePath
+
+#: Environment variable naming the TUMFTM Zandvoort centre-line CSV when --track is not given.
+ZANDVOORT_ENV = "WORKBENCH_ZANDVOORT_CSV"
+#: Bounds of a run's initial error: lateral offset (m, either side) and heading error (rad, either way).
+MAX_INITIAL_OFFSET_M = 50.0
+MAX_INITIAL_HEADING_ERROR_RAD = math.pi / 2
+ZANDVOORT_SOURCE = (
+    "the TUMFTM racetrack-database file tracks/Zandvoort.csv "
+    "(https://github.com/TUMFTM/racetrack-database/blob/master/tracks/Zandvoort.csv, LGPL-3.0)"
+)
+
+
+@dataclass(frozen=True)
+class ScenarioOptions:
+    """What a scenario factory may depend on.
+
+    vehicle_width_m: overall width b of the vehicle (m), which sizes the ISO 3888-1 lanes; track_file: a track CSV
+    for scenarios that read one (zandvoort).
+    """
+
+    vehicle_width_m: float = 2.59
+    track_file: Path | None = None
+
+    def __post_init__(self) -> None:
+        require_in_range("vehicle_width_m", self.vehicle_width_m, 0.5, 4.0, "m")
+
+
+@dataclass(frozen=True, eq=False)
+class Scenario:
+    """A reference path and the initial condition of a run.
+
+    initial_offset_m: lateral offset of the vehicle's reference point (rear-axle centre) from the path at s = 0,
+    left positive (m, within +-MAX_INITIAL_OFFSET_M); initial_heading_error_rad: vehicle heading minus path heading
+    at the start (rad, within +-pi/2); cones_xy: (n, 2) cone positions (m) to draw, or None; description: one line
+    for `workbench scenarios`.
+    """
+
+    name: str
+    path: ReferencePath
+    description: str
+    initial_offset_m: float = 0.0
+    initial_heading_error_rad: float = 0.0
+    cones_xy: np.ndarray | None = None
+
+    def __post_init__(self) -> None:
+        require_in_range("initial_offset_m", self.initial_offset_m, -MAX_INITIAL_OFFSET_M, MAX_INITIAL_OFFSET_M, "m")
+        bound = MAX_INITIAL_HEADING_ERROR_RAD
+        require_in_range("initial_heading_error_rad", self.initial_heading_error_rad, -bound, bound, "rad")
+
+    def with_initial_error(self, offset_m: float | None = None, heading_error_rad: float | None = None) -> Scenario:
+        """The same scenario started with this lateral offset (m, left positive) and heading error (rad); None keeps
+        the scenario's own (e.g. fig17 starts 1.0 m left of the path)."""
+        offset = self.initial_offset_m if offset_m is None else offset_m
+        heading = self.initial_heading_error_rad if heading_error_rad is None else heading_error_rad
+        return dataclasses.replace(self, initial_offset_m=offset, initial_heading_error_rad=heading)
+
+    def initial_pose(self) -> tuple[float, float, float]:
+        """(x, y, heading) of the vehicle's rear-axle centre at the start."""
+        heading = float(self.path.heading_rad[0])
+        x = self.path.x_m[0] - self.initial_offset_m * math.sin(heading)
+        y = self.path.y_m[0] + self.initial_offset_m * math.cos(heading)
+        return float(x), float(y), heading + self.initial_heading_error_rad
+
+
+# ---------------------------------------------------------------------------------------------- figure-8
+def figure8(options: ScenarioOptions, radius_m: float = 22.0, transition_m: float = 15.0) -> Scenario:
+    """Two lobes through a self-crossing at the origin, with clothoid transitions between straights and arcs.
+
+    The crossing straights lie at +-45 degrees; each lobe turns 270 degrees (clothoid to 1/R, arc, clothoid back
+    to zero). The straight's length is solved so that each lobe is symmetric about the x axis, which closes the
+    loop exactly. Minimum radius `radius_m` (default 22 m).
+    """
+    from workbench.base.clothoid_chain import ClothoidChain
+
+    kappa = 1.0 / radius_m
+    lobe_turn = 1.5 * math.pi
+    arc_length = lobe_turn / kappa - transition_m  # kappa * Lc / 2 * 2 + kappa * La = lobe turn
+    if arc_length <= 0:
+        raise WorkbenchInputError(f"figure8: transition_m={transition_m} is too long for radius_m={radius_m}")
+    start_heading = math.pi / 4
+    # Half of the right lobe (clockwise) from the crossing; its y at the lobe's apex is linear in the straight.
+    half = ClothoidChain(0.0, 0.0, start_heading).clothoid_to(-kappa, transition_m).arc(arc_length / 2)
+    straight = -half.end_pose()[1] / math.sin(start_heading)
+    chain = (
+        ClothoidChain(0.0, 0.0, start_heading)
+        .straight(straight)
+        .clothoid_to(-kappa, transition_m)
+        .arc(arc_length)
+        .clothoid_to(0.0, transition_m)
+        .straight(2 * straight)
+        .clothoid_to(kappa, transition_m)
+        .arc(arc_length)
+        .clothoid_to(0.0, transition_m)
+        .straight(straight)
+    )
+    return Scenario(
+        "figure8",
+        chain.to_path("figure8", closed=True, closure_tol_m=1e-6),
+        _figure8_description(radius_m),
+    )
+
+
+def _figure8_description(radius_m: float = 22.0) -> str:
+    return f"figure-8, two 270-degree lobes of radius {radius_m:g} m through a self-crossing, clothoid transitions"
+
+
+# ---------------------------------------------------------------------------------------------- ISO 3888-1
+@dataclass(frozen=True)
+class DoubleLaneChangeLayout:
+    """ISO 3888-1 double lane change for a vehicle of width b (m), as Project Chrono's `ISO3888_Helper` and
+    MathWorks' `sm_car_trajectory_double_lane_change_iso3888.m` lay it out.
+
+    Lane widths 1.1 b + 0.25, 1.2 b + 0.25 and 1.3 b + 0.25 m; sections 15, 30, 25, 25 and 15 m. The 3.5 m lateral
+    offset is taken between the right-hand cone lines of sections 1 and 3 (the datum varies between sources);
+    the exit lane is centred on the entry lane's centre line.
+    """
+
+    vehicle_width_m: float
+    run_in_m: float = 40.0
+    run_out_m: float = 40.0
+    lateral_offset_m: float = 3.5
+
+    @property
+    def lane_widths_m(self) -> tuple[float, float, float]:
+        b = self.vehicle_width_m
+        return 1.1 * b + 0.25, 1.2 * b + 0.25, 1.3 * b + 0.25
+
+    @property
+    def section_starts_m(self) -> np.ndarray:
+        """x of the start of sections 1-5 and of the end of section 5."""
+        return self.run_in_m + np.cumsum([0.0, 15.0, 30.0, 25.0, 25.0, 15.0])
+
+    @property
+    def offset_lane_centre_m(self) -> float:
+        w1, w3, _ = self.lane_widths_m
+        return -w1 / 2 + self.lateral_offset_m + w3 / 2
+
+    def centre_line(self, x_m: np.ndarray) -> np.ndarray:
+        """y of the smooth centre line: straight in each lane, quintic smoothsteps (curvature-continuous) between."""
+        _, x1, x2, x3, x4, _ = self.section_starts_m
+        h = self.offset_lane_centre_m
+
+        def smoothstep(u: np.ndarray) -> np.ndarray:
+            u = np.clip(u, 0.0, 1.0)
+            return u**3 * (10 - 15 * u + 6 * u**2)  # zero slope and curvature at both ends
+
+        return h * (smoothstep((x_m - x1) / (x2 - x1)) - smoothstep((x_m - x3) / (x4 - x3)))
+
+    def cones(self) -> np.ndarray:
+        """(n, 2) cone positions: both edges of lanes 1, 3 and 5 at their start, middle and end."""
+        x0, x1, x2, x3, x4, x5 = self.section_starts_m
+        w1, w3, w5 = self.lane_widths_m
+        h = self.offset_lane_centre_m
+        rows = []
+        for start, end, centre, width in ((x0, x1, 0.0, w1), (x2, x3, h, w3), (x4, x5, 0.0, w5)):
+            for x in np.linspace(start, end, 3):
+                rows += [(x, centre - width / 2), (x, centre + width / 2)]
+        return np.array(rows)
+
+
+def double_lane_change(options: ScenarioOptions) -> Scenario:
+    """ISO 3888-1 double lane change laid out for the vehicle's width, with run-in and run-out straights."""
+    from workbench.base.path import ReferencePath
+    from workbench.base.waypoints import Waypoints
+
+    layout = DoubleLaneChangeLayout(options.vehicle_width_m)
+    x = np.arange(0.0, layout.section_starts_m[-1] + layout.run_out_m + 1e-9, 0.5)
+    path = ReferencePath.from_waypoints(Waypoints(x, layout.centre_line(x), source="dlc"), name="dlc")
+    return Scenario("dlc", path, _dlc_description(options), cones_xy=layout.cones())
+
+
+def _dlc_description(options: ScenarioOptions) -> str:
+    layout = DoubleLaneChangeLayout(options.vehicle_width_m)
+    w1, w3, w5 = layout.lane_widths_m
+    return (
+        f"ISO 3888-1 double lane change for a {options.vehicle_width_m:g} m wide vehicle "
+        f"(lanes {w1:.2f}/{w3:.2f}/{w5:.2f} m, centre-line offset {layout.offset_lane_centre_m:.2f} m)"
+    )
+
+
+# ---------------------------------------------------------------------------------------------- Figure 17
+FIG17_DESCRIPTION = "Figure 17 comparison path: S-bend of radius 30 m between straights, start 1.0 m left of the path"
+
+
+def fig17(options: ScenarioOptions) -> Scenario:
+    """The controller-comparison path of the paper's Figure 17, built from clothoids (curvature-continuous).
+
+    40 m straight; 20 m clothoid to 1/30 1/m (left); 30 m arc; 40 m clothoid to -1/30 1/m; 30 m arc; 20 m clothoid
+    to 0; 60 m straight. The vehicle starts 1.0 m left of the path, heading along it.
+    """
+    from workbench.base.clothoid_chain import ClothoidChain
+
+    kappa = 1.0 / 30.0
+    chain = (
+        ClothoidChain()
+        .straight(40.0)
+        .clothoid_to(kappa, 20.0)
+        .arc(30.0)
+        .clothoid_to(-kappa, 40.0)
+        .arc(30.0)
+        .clothoid_to(0.0, 20.0)
+        .straight(60.0)
+    )
+    return Scenario(
+        "fig17",
+        chain.to_path("fig17"),
+        FIG17_DESCRIPTION,
+        initial_offset_m=1.0,
+    )
+
+
+# ---------------------------------------------------------------------------------------------- Zandvoort
+def zandvoort(options: ScenarioOptions) -> Scenario:
+    """The Zandvoort centre line from the TUMFTM racetrack database (closed loop, 4316.5 m).
+
+    The file is third-party data (LGPL-3.0) and is not shipped: pass it with --track FILE or set the environment
+    variable WORKBENCH_ZANDVOORT_CSV.
+    """
+    scenario = from_file(_zandvoort_track(options), options)
+    return Scenario("zandvoort", scenario.path, _zandvoort_description(options))
+
+
+def _zandvoort_track(options: ScenarioOptions) -> Path:
+    """The track file: --track, else $WORKBENCH_ZANDVOORT_CSV; WorkbenchInputError when neither names a file."""
+    track = options.track_file or (Path(os.environ[ZANDVOORT_ENV]) if os.environ.get(ZANDVOORT_ENV) else None)
+    if track is None:
+        raise WorkbenchInputError(
+            f"zandvoort needs {ZANDVOORT_SOURCE}; download it and pass --track FILE "
+            f"or set the environment variable {ZANDVOORT_ENV}"
+        )
+    if not Path(track).is_file():
+        raise WorkbenchInputError(f"zandvoort: track file {str(track)!r} does not exist; expected {ZANDVOORT_SOURCE}")
+    return Path(track)
+
+
+def _zandvoort_description(options: ScenarioOptions) -> str:
+    _zandvoort_track(options)
+    return "Zandvoort (TUMFTM racetrack-database centre line, closed loop)"
+
+
+# ---------------------------------------------------------------------------------------------- files
+def from_file(path: Path, options: ScenarioOptions) -> Scenario:
+    """A scenario from any waypoint file (CSV x,y[,v]; TUMFTM racetrack CSV; GPS CSV with lat/lon columns)."""
+    from workbench.base.path import ReferencePath
+    from workbench.base.waypoint_files import read_waypoints  # pandas and pyproj: only for a file (issue 17)
+
+    waypoints = read_waypoints(path)
+    ref = ReferencePath.from_waypoints(waypoints, name=path.stem)
+    kind = "closed loop" if waypoints.closed else "open path"
+    return Scenario(path.stem, ref, f"waypoints from {path.name} ({len(waypoints)} points, {kind})")
+
+
+ScenarioFactory = Callable[[ScenarioOptions], Scenario]
+
+#: The named scenarios, in the order `workbench scenarios` lists them.
+SCENARIOS: dict[str, ScenarioFactory] = {
+    "figure8": figure8,
+    "dlc": double_lane_change,
+    "fig17": fig17,
+    "zandvoort": zandvoort,
+}
+
+
+def make_scenario(name_or_file: str, options: ScenarioOptions | None = None) -> Scenario:
+    """Build a named scenario, or one from a waypoint file when the argument is a path to a file."""
+    options = options or ScenarioOptions()
+    if name_or_file in SCENARIOS:
+        return SCENARIOS[name_or_file](options)
+    candidate = Path(name_or_file)
+    if candidate.suffix.lower() in {".csv", ".txt"} or candidate.is_file():
+        if not candidate.is_file():
+            raise WorkbenchInputError(f"waypoint file {name_or_file!r} does not exist")
+        return from_file(candidate, options)
+    raise WorkbenchInputError(
+        f"unknown scenario {name_or_file!r}; choose one of {', '.join(SCENARIOS)} or give a waypoint CSV file"
+    )
+
+
+#: Each named scenario's one-line description, without building its path (`workbench scenarios` starts fast).
+DESCRIPTIONS: dict[str, Callable[[ScenarioOptions], str]] = {
+    "figure8": lambda _options: _figure8_description(),
+    "dlc": _dlc_description,
+    "fig17": lambda _options: FIG17_DESCRIPTION,
+    "zandvoort": _zandvoort_description,
+}
+
+
+def describe_scenarios(options: ScenarioOptions | None = None) -> list[tuple[str, str]]:
+    """(name, one-line description) of every named scenario; a scenario that needs a missing file says so."""
+    rows = []
+    for name, factory in SCENARIOS.items():
+        try:
+            rows.append((name, DESCRIPTIONS[name](options or ScenarioOptions())))
+        except WorkbenchInputError as exc:
+            rows.append((name, f"{(factory.__doc__ or '').strip().splitlines()[0]} [unavailable: {exc}]"))
+    return rows

@@ -1,0 +1,379 @@
+"""Closed-loop simulation: a controller steering a plant along a scenario's path at a planned speed.
+
+Fixed steps: the controller (and the speed controller) run at `controller_rate_hz`; between two controller
+steps the plant integrates `plant_rate_hz / controller_rate_hz` RK4 steps with the commands held (zero-order
+hold). One row of the trace is logged per controller step. The run ends when the vehicle reaches the end of an
+open path or completes the requested laps of a closed one; it stops early, keeping its partial trace and saying
+why, on a time-out, when the vehicle leaves the path (further than `max_abs_cte_m` from it, or beyond either end
+of an open path by more than `max_past_end_m`), when the plant state stops being finite, or when the controller
+fails. The logged CTE is the signed distance from the path, so beyond an open path's ends it is the distance to
+the end point, never the sideways offset from the end's tangent alone.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+from tqdm import tqdm
+
+from controllers.base import COMMAND_REJECTED, MEASUREMENT_REJECTED, Controller, Measurement
+from workbench.base.errors import WorkbenchInputError, require_in_range, require_positive
+from workbench.base.path import ReferencePath, wrap_angle
+from workbench.simulation.result import SimulationResult, Status
+from workbench.simulation.scenarios import Scenario
+from workbench.simulation.speed_control import PISpeedController, PISpeedGains
+from workbench.simulation.speed_profile import G_MPS2, SpeedLimits, plan_speed_profile
+from workbench.vehicles.base import VehicleModel
+
+#: Spacing (m) of the points the speed profile is planned on (the paper plans on its waypoints).
+SPEED_PLAN_SPACING_M = 1.0
+#: A run that may take more controller steps than this before its time-out is announced with a warning (at 50 Hz
+#: about 83 simulated minutes; a dlc at 30 km/h may take 5 700, a Zandvoort lap 79 000).
+LONG_RUN_STEPS = 250_000
+#: Trace columns besides the vehicle's outputs, estimated generously for the trace-size warning: the simulator's
+#: 11 signals and up to 29 controller diagnostics (`ctrl_*`).
+EXTRA_TRACE_COLUMNS = 40
+
+
+@dataclass(frozen=True)
+class SimulationConfig:
+    """How a run is simulated.
+
+    speed_kmh: the speed asked for (km/h), the maximum of the planned profile; max_lateral_accel_g: the profile's
+    lateral acceleration bound (the paper: 0.3 g); max_accel_mps2, max_decel_mps2: its longitudinal bounds;
+    controller_rate_hz, plant_rate_hz: step rates (the plant rate must be a whole multiple); laps: laps of a
+    closed path; max_time_s: time-out (None: three times the planned lap time plus 30 s); max_abs_cte_m: a run
+    whose |CTE| exceeds this has left the path and stops; max_past_end_m: so has a run whose reference point goes
+    this far beyond either end of an open path (along the end's tangent); speed_feedforward: the speed controller
+    feeds the planned speed's rate of change forward (speed x dv_ref/ds) besides its PI action (False: PI only).
+    """
+
+    speed_kmh: float = 30.0
+    max_lateral_accel_g: float = 0.3
+    max_accel_mps2: float = 1.0
+    max_decel_mps2: float = 2.0
+    controller_rate_hz: float = 50.0
+    plant_rate_hz: float = 1000.0
+    laps: int = 1
+    max_time_s: float | None = None
+    max_abs_cte_m: float = 30.0
+    max_past_end_m: float = 5.0
+    speed_feedforward: bool = True
+
+    def __post_init__(self) -> None:
+        require_in_range("speed_kmh", self.speed_kmh, 1e-3, 400.0, "km/h (must be > 0)")
+        require_in_range("max_lateral_accel_g", self.max_lateral_accel_g, 0.01, 2.0, "g")
+        require_positive("max_accel_mps2", self.max_accel_mps2)
+        require_positive("max_decel_mps2", self.max_decel_mps2)
+        require_in_range("controller_rate_hz", self.controller_rate_hz, 1.0, 10_000.0, "Hz")
+        require_in_range("plant_rate_hz", self.plant_rate_hz, 1.0, 100_000.0, "Hz")
+        ratio = self.plant_rate_hz / self.controller_rate_hz
+        if ratio < 1 or abs(ratio - round(ratio)) > 1e-9:
+            raise WorkbenchInputError(
+                f"plant_rate_hz ({self.plant_rate_hz}) must be a whole multiple of controller_rate_hz "
+                f"({self.controller_rate_hz}); the ratio is {ratio:g}"
+            )
+        if isinstance(self.laps, bool) or not isinstance(self.laps, int) or self.laps < 1:
+            raise WorkbenchInputError(f"laps must be a whole number >= 1; got {self.laps!r}")
+        if self.max_time_s is not None:
+            require_positive("max_time_s", self.max_time_s)
+        require_positive("max_abs_cte_m", self.max_abs_cte_m)
+        require_positive("max_past_end_m", self.max_past_end_m)
+        if not isinstance(self.speed_feedforward, bool):
+            raise WorkbenchInputError(f"speed_feedforward must be True or False; got {self.speed_feedforward!r}")
+
+    @property
+    def substeps(self) -> int:
+        return round(self.plant_rate_hz / self.controller_rate_hz)
+
+    @property
+    def speed_mps(self) -> float:
+        return self.speed_kmh / 3.6
+
+
+def plan_path_speed(path: ReferencePath, config: SimulationConfig) -> ReferencePath:
+    """The path carrying the planned speed: the paper's smart velocity waypoints (section 6), capped by any speed
+    the path's waypoints already carry."""
+    n = max(3, math.ceil(path.length_m / SPEED_PLAN_SPACING_M))
+    s_plan = np.linspace(0.0, path.length_m, n + 1)
+    if path.closed:
+        s_plan = s_plan[:-1]
+    x, y = path.position(s_plan)
+    limits = SpeedLimits(
+        max_speed_mps=config.speed_mps,
+        max_lateral_accel_mps2=config.max_lateral_accel_g * G_MPS2,
+        max_accel_mps2=config.max_accel_mps2,
+        max_decel_mps2=config.max_decel_mps2,
+        min_speed_mps=min(1.0, config.speed_mps),
+    )
+    profile = plan_speed_profile(x, y, limits, closed=path.closed)
+    planned = profile.speed_mps
+    if path.closed:  # close the loop for interpolation
+        s_plan, planned = np.append(s_plan, path.length_m), np.append(planned, planned[0])
+    speed = np.interp(path.s_m, s_plan, planned)
+    if path.speed_mps is not None:
+        stopped = np.flatnonzero(~(path.speed_mps > 0.0))
+        if stopped.size:
+            i = int(stopped[0])
+            raise WorkbenchInputError(
+                f"{path.name}: the path's speed must be > 0 m/s everywhere (a run follows it without stopping); "
+                f"it is {float(path.speed_mps[i]):g} m/s at s = {float(path.s_m[i]):.1f} m"
+            )
+        speed = np.minimum(speed, path.speed_mps)
+    return path.with_speed(speed)
+
+
+class Simulation:
+    """A scenario, a vehicle and a controller, wired once; `run()` simulates and returns a SimulationResult."""
+
+    def __init__(
+        self,
+        scenario: Scenario,
+        vehicle: VehicleModel,
+        controller: Controller,
+        config: SimulationConfig | None = None,
+    ) -> None:
+        self.scenario = scenario
+        self.vehicle = vehicle
+        self.controller = controller
+        self.config = config or SimulationConfig()
+        self.path = plan_path_speed(scenario.path, self.config)
+
+    def warnings(self, label: str = "the run") -> list[str]:
+        """What to tell a person before this run: `path_warnings` and `long_run_warning`."""
+        long_run = self.long_run_warning(label)
+        return self.path_warnings() + ([long_run] if long_run is not None else [])
+
+    def long_run_warning(self, label: str = "the run") -> str | None:
+        """A warning for a run that may take more than LONG_RUN_STEPS controller steps before its time-out (a very
+        low speed, many laps): the simulated time, the steps and the trace's size (rows x columns x 8 bytes, the
+        columns estimated generously), and what shortens it; None for a run of ordinary length."""
+        steps = self.max_steps
+        if steps <= LONG_RUN_STEPS:
+            return None
+        columns = len(self.vehicle.output_names) + EXTRA_TRACE_COLUMNS
+        size = steps * columns * 8
+        size_text = f"{size / 1e9:,.1f} GB" if size >= 1e9 else f"{size / 1e6:,.0f} MB"
+        return (
+            f"{label} may simulate up to {_duration_text(self.max_time_s)} "
+            f"({steps:,} controller steps at {self.config.controller_rate_hz:g} Hz) before it times out, with a "
+            f"trace of up to {steps:,} rows x about {columns} columns (about {size_text} at 8 bytes a value); it may "
+            f"take a long time. A higher --speed (now {self.config.speed_kmh:g} km/h) or fewer --laps shortens it"
+        )
+
+    def path_warnings(self) -> list[str]:
+        """What about the path this vehicle cannot do, to say before the run: stretches curving tighter than its
+        steering lock turns it (Ackermann, tan(max road-wheel angle) / wheelbase)."""
+        geometry = self.vehicle.geometry
+        reach = math.tan(geometry.max_road_wheel_angle_rad) / geometry.wheelbase_m
+        path = self.path
+        beyond = np.abs(path.curvature_1pm) > reach
+        if not beyond.any():
+            return []
+        edges = np.flatnonzero(np.diff(np.concatenate(([0], beyond.astype(np.int8), [0])))).reshape(-1, 2)
+        places = [
+            f"s = {path.s_m[first]:.1f}-{path.s_m[stop - 1]:.1f} m "
+            f"(peak {np.max(np.abs(path.curvature_1pm[first:stop])):.3g} 1/m)"
+            for first, stop in edges[:3]
+        ]
+        more = f" and {len(edges) - 3} more" if len(edges) > 3 else ""
+        return [
+            f"{path.name} curves tighter than the {self.vehicle.name} can turn at full lock ({reach:.3g} 1/m, a "
+            f"radius of {1.0 / reach:.2f} m) at {', '.join(places)}{more}: expect it to run wide there"
+        ]
+
+    @property
+    def total_length_m(self) -> float:
+        """The distance the run is asked to cover: the path, times the laps of a closed one."""
+        return self.path.length_m * (self.config.laps if self.path.closed else 1)
+
+    @property
+    def max_time_s(self) -> float:
+        """Simulated time before the run times out: the config's, or three times the planned time plus 30 s."""
+        mean_speed = float(np.mean(self.path.speed_mps))
+        return self.config.max_time_s or 3.0 * self.total_length_m / mean_speed + 30.0
+
+    @property
+    def max_steps(self) -> int:
+        """Controller steps the run may take before its time-out: the trace's row capacity."""
+        return math.ceil(self.max_time_s * self.config.controller_rate_hz) + 1
+
+    def run(self, progress: bool = False) -> SimulationResult:
+        cfg, path, vehicle, controller = self.config, self.path, self.vehicle, self.controller
+        dt = 1.0 / cfg.controller_rate_hz
+        total_length = self.total_length_m
+        max_time, max_steps = self.max_time_s, self.max_steps
+
+        x0, y0, yaw0 = self.scenario.initial_pose()
+        state = vehicle.initial_state(x0, y0, yaw0, float(path.speed_mps[0]))
+        tracker = path.tracker(0.0)
+        controller.reset(path, dt)
+        speed_controller = PISpeedController(PISpeedGains())
+
+        log = _TraceLog(vehicle.output_names, max_steps)
+        status, message = Status.TIMEOUT, f"did not finish within {max_time:.1f} s"
+        steer_cmd = accel_cmd = 0.0
+        held, first_held = 0, ""  # steps whose measurement the controller's screen rejected (it held its command)
+        bar = tqdm(total=round(total_length), unit="m", delay=2.0, disable=not progress, leave=False)
+        t = 0.0
+        for _ in range(max_steps):
+            out = vehicle.outputs(state, steer_cmd, accel_cmd)
+            x, y, yaw, vx, vy, yaw_rate, steer_wheel = out[:7]
+            foot = tracker.update(x, y)
+            if foot.past_end_m > cfg.max_past_end_m:
+                end = "end" if foot.at_end else "start"
+                status = Status.LEFT_PATH
+                message = (
+                    f"went {foot.past_end_m:.1f} m past the {end} of the path (max_past_end_m = "
+                    f"{cfg.max_past_end_m:g} m) at t = {t:.2f} s, {foot.distance_m:.1f} m from it"
+                )
+                break
+            if foot.distance_m > cfg.max_abs_cte_m:
+                status = Status.LEFT_PATH
+                message = (
+                    f"|CTE| = {foot.distance_m:.1f} m exceeds max_abs_cte_m = {cfg.max_abs_cte_m:g} m at t = {t:.2f} s"
+                )
+                break
+            if (foot.at_end and not path.closed) or foot.progress_m >= total_length:
+                status, message = Status.COMPLETED, "completed"
+                break
+            measurement = Measurement(t, x, y, vx, vy, yaw, yaw_rate, steer_wheel)
+            start = time.perf_counter()
+            try:
+                steer_cmd = controller.step(measurement, path)
+            except Exception as exc:  # reported in the result, never hidden
+                status, message = Status.CONTROLLER_FAILED, f"{controller.name} raised {type(exc).__name__}: {exc}"
+                break
+            step_time = time.perf_counter() - start
+            flags = controller.diagnostics
+            if flags.get(COMMAND_REJECTED) or not math.isfinite(steer_cmd):
+                status = Status.CONTROLLER_FAILED
+                message = f"{controller.name} computed a non-finite steering command at t = {t:.2f} s"
+                break
+            if flags.get(MEASUREMENT_REJECTED):
+                if not held:
+                    first_held = f"first at t = {t:.2f} s: {controller.rejection}"
+                held += 1
+            speed = math.hypot(vx, vy)
+            speed_ref = float(path.speed(foot.s_m))
+            # The reference changes at d(v_ref)/dt = dv_ref/ds * ds/dt, fed forward so braking for a corner is
+            # on time; without it a PI lags a braking ramp by ~0.76 x the deceleration in m/s.
+            speed_ref_rate = speed * path.speed_gradient(foot.s_m) if cfg.speed_feedforward else 0.0
+            accel_cmd = speed_controller.step(speed_ref, speed, dt, speed_ref_rate)
+            log.append(
+                t,
+                out,
+                steer_cmd,
+                accel_cmd,
+                speed,
+                speed_ref,
+                foot,
+                float(wrap_angle(yaw - foot.heading_rad)),
+                step_time,
+                controller.diagnostics,
+            )
+            state = vehicle.advance(state, steer_cmd, accel_cmd, dt, cfg.substeps)
+            t += dt
+            if not np.all(np.isfinite(state)):
+                bad = [n for n, v in zip(vehicle.state_names, state, strict=False) if not math.isfinite(v)]
+                status = Status.DIVERGED
+                message = f"the {vehicle.name} state diverged at t = {t:.2f} s (non-finite: {', '.join(bad)})"
+                break
+            bar.update(round(foot.progress_m) - bar.n)
+        bar.close()
+        if held:
+            message += (
+                f"; the controller rejected {held} measurements as implausible and held its command ({first_held})"
+            )
+        return SimulationResult(
+            trace=log.to_dict(),
+            status=status,
+            message=message,
+            scenario=self.scenario,
+            path=path,
+            controller=controller.name,
+            vehicle=vehicle.name,
+            config=cfg,
+        )
+
+
+def _duration_text(seconds: float) -> str:
+    if seconds < 120:
+        return f"{seconds:.0f} s"
+    if seconds < 2 * 3600:
+        return f"{seconds / 60:.0f} min"
+    if seconds < 2 * 86400:
+        return f"{seconds / 3600:.0f} h"
+    return f"{seconds / 86400:,.0f} days"
+
+
+class _TraceLog:
+    """Columns for the trace, one row per controller step; they double when full, so memory follows the steps
+    actually run, not the time-out's capacity."""
+
+    def __init__(self, output_names: tuple[str, ...], capacity: int) -> None:
+        self.output_names = output_names
+        self.capacity = min(capacity, 1 << 14)
+        self.outputs = np.empty((self.capacity, len(output_names)))
+        self.signals = np.empty((self.capacity, len(self.SIGNALS)))
+        self.diagnostics: dict[str, np.ndarray] = {}
+        self.n = 0
+
+    def _grow(self) -> None:
+        def doubled(column: np.ndarray) -> np.ndarray:
+            return np.concatenate((column, np.full((self.capacity, *column.shape[1:]), np.nan)))
+
+        self.outputs = doubled(self.outputs)
+        self.signals = doubled(self.signals)
+        self.diagnostics = {key: doubled(column) for key, column in self.diagnostics.items()}
+        self.capacity *= 2
+
+    SIGNALS = (
+        "t_s",
+        "steer_wheel_cmd_rad",
+        "accel_cmd_mps2",
+        "speed_mps",
+        "speed_ref_mps",
+        "path_s_m",
+        "progress_m",
+        "cte_m",
+        "heading_error_rad",
+        "path_curvature_1pm",
+        "step_time_s",
+    )
+
+    def append(self, t, out, steer_cmd, accel_cmd, speed, speed_ref, foot, heading_error, step_time, diagnostics):
+        i = self.n
+        if i == self.capacity:
+            self._grow()
+        self.outputs[i] = out
+        self.signals[i] = (
+            t,
+            steer_cmd,
+            accel_cmd,
+            speed,
+            speed_ref,
+            foot.s_m,
+            foot.progress_m,
+            foot.signed_distance_m,
+            heading_error,
+            foot.curvature_1pm,
+            step_time,
+        )
+        for key, value in diagnostics.items():
+            column = self.diagnostics.get(key)
+            if column is None:
+                column = self.diagnostics[key] = np.full(self.capacity, np.nan)
+            column[i] = value
+        self.n += 1
+
+    def to_dict(self) -> dict[str, np.ndarray]:
+        n = self.n
+        trace = {"t_s": self.signals[:n, 0].copy()}
+        trace.update({name: self.outputs[:n, k].copy() for k, name in enumerate(self.output_names)})
+        trace.update({name: self.signals[:n, k].copy() for k, name in enumerate(self.SIGNALS) if k > 0})
+        trace.update({f"ctrl_{key}": col[:n].copy() for key, col in self.diagnostics.items()})
+        return trace
