@@ -20,8 +20,9 @@ from pathlib import Path
 
 import numpy as np
 
-from controllers import CONTROLLERS, make_controller
-from controllers.config_file import build_config
+from controllers import CONTROLLERS
+from tuning.own_tuning import tuned_controller
+from workbench.apps.controller_config import build_config
 from workbench.simulation.scenarios import ZANDVOORT_ENV, ScenarioOptions, make_scenario
 from workbench.simulation.simulator import Simulation, SimulationConfig
 from workbench.vehicles import make_vehicle
@@ -97,7 +98,7 @@ def bench_run(scenario_name: str, controller_name: str, vehicle_name: str, optio
     vehicle = make_vehicle(vehicle_name)
     scenario = make_scenario(scenario_name, ScenarioOptions(vehicle.geometry.width_m, options.track_file))
     config = build_config(CONTROLLERS[controller_name].config_type, {}, overrides)
-    controller = make_controller(controller_name, vehicle.geometry, config, vehicle=vehicle)
+    controller = tuned_controller(controller_name, vehicle, config)
     sim = Simulation(scenario, vehicle, controller, SimulationConfig(speed_kmh=speed_kmh))
     sim.run()  # warm-up: compiles numba kernels, fills caches
     start = time.perf_counter()

@@ -21,7 +21,7 @@ from concurrent.futures import ProcessPoolExecutor
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
-from controllers import make_controller
+from tuning.own_tuning import tuned_controller
 from workbench.apps.comparison import converge_distance_m
 from workbench.simulation.scenarios import ZANDVOORT_ENV, ScenarioOptions, make_scenario
 from workbench.simulation.simulator import Simulation, SimulationConfig
@@ -61,7 +61,7 @@ def run_one(job: tuple[str, str, str, str | None]) -> Run:
     vehicle = make_vehicle(vehicle_name)
     options = ScenarioOptions(vehicle.geometry.width_m, Path(track) if track else None)
     scenario = make_scenario(scenario_name, options)
-    controller = make_controller(controller_name, vehicle.geometry, vehicle=vehicle)
+    controller = tuned_controller(controller_name, vehicle)
     start = time.perf_counter()
     result = Simulation(scenario, vehicle, controller, SimulationConfig(speed_kmh=30.0)).run()
     m, trace = result.metrics, result.trace

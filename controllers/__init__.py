@@ -21,7 +21,7 @@ if TYPE_CHECKING:
     from controllers.mpc import LMPCConfig, LMPCController, NMPCConfig, NMPCController
     from controllers.pure_pursuit import PurePursuit, PurePursuitConfig
     from controllers.stanley import Stanley, StanleyConfig
-    from workbench.vehicles.base import VehicleGeometry
+    from workbench.vehicles.geometry import VehicleGeometry
 
 #: Exported name -> the module that defines it (imported on first access, `__getattr__`).
 _EXPORTS = {

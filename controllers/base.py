@@ -36,13 +36,13 @@ import math
 import sys
 from abc import ABC, abstractmethod
 from collections.abc import Mapping
-from dataclasses import dataclass
 from types import MappingProxyType
 from typing import Any, ClassVar
 
 from workbench.base.errors import require_positive
 from workbench.base.path import ReferencePath, wrap_angle
-from workbench.vehicles.base import VehicleGeometry
+from workbench.simulation.control_interface import COMMAND_REJECTED, MEASUREMENT_REJECTED, Measurement
+from workbench.vehicles.geometry import VehicleGeometry
 
 _NO_DIAGNOSTICS: Mapping[str, float] = MappingProxyType({})
 
@@ -70,33 +70,7 @@ MAX_UNWRAPPED_YAW_RAD = 1e4
 #: controller restarts (as `reset`, on the same path) and takes the frame. Fewer are single bad frames, rejected;
 #: without the restart one frame stamped far ahead would lock the controller out until the next `reset`.
 CLOCK_RESET_FRAMES = 5
-#: The flags `diagnostics` adds to the controller's own signals.
-MEASUREMENT_REJECTED = "measurement_rejected"
-COMMAND_REJECTED = "command_rejected"
 _FIELDS = ("t_s", "x_m", "y_m", "vx_mps", "vy_mps", "yaw_rad", "yaw_rate_rad_s", "steer_wheel_rad")
-
-
-@dataclass(frozen=True, slots=True)
-class Measurement:
-    """What the sensors give at one controller step (SI units).
-
-    x_m, y_m: position of the reference point (the tractor's rear-axle centre, where the paper measures CTE);
-    vx_mps, vy_mps: its velocity in the vehicle frame; yaw_rad, yaw_rate_rad_s: heading and its rate;
-    steer_wheel_rad: measured steering-wheel angle; t_s: time.
-    """
-
-    t_s: float
-    x_m: float
-    y_m: float
-    vx_mps: float
-    vy_mps: float
-    yaw_rad: float
-    yaw_rate_rad_s: float
-    steer_wheel_rad: float
-
-    @property
-    def speed_mps(self) -> float:
-        return math.hypot(self.vx_mps, self.vy_mps)
 
 
 class Controller(ABC):

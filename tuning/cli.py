@@ -415,7 +415,7 @@ def _fit_lag(args: argparse.Namespace) -> int:
 
 
 def _design_lead(args: argparse.Namespace) -> int:
-    from controllers.clothoid.filter_file import write_filter_file
+    from tuning.filter_file import write_filter_file
     from tuning.lead_design import design_lead, validate
     from tuning.log_file import read_log
 
@@ -463,13 +463,14 @@ def _design_lead(args: argparse.Namespace) -> int:
 
 
 def _rollover_limits(args: argparse.Namespace) -> int:
+    from tuning.limits_file import write_limits_file
     from tuning.rollover import rollover_limits, table, to_curvature_limits
     from tuning.speeds import parse_speeds
 
     vehicle = _vehicle(args)
     speeds = parse_speeds(args.speeds)
     limits = rollover_limits(vehicle, speeds)
-    to_curvature_limits(limits, vehicle).write_csv(_prepare(args.out))
+    write_limits_file(to_curvature_limits(limits, vehicle), _prepare(args.out))
     print(table(limits))
     print(f"wrote {args.out}")
     if args.plot:
@@ -480,6 +481,7 @@ def _rollover_limits(args: argparse.Namespace) -> int:
 
 
 def _steering_limits(args: argparse.Namespace) -> int:
+    from tuning.limits_file import write_limits_file
     from tuning.speeds import parse_speeds
     from tuning.steering_limits import steering_limits
     from tuning.steering_limits import table as steering_table
@@ -487,21 +489,16 @@ def _steering_limits(args: argparse.Namespace) -> int:
 
     vehicle = _vehicle(args)
     limits = steering_limits(vehicle.geometry, parse_speeds(args.speeds), args.lat_accel_g)
-    steering_curvature_limits(limits, vehicle.name, args.lat_accel_g).write_csv(_prepare(args.out))
+    write_limits_file(steering_curvature_limits(limits, vehicle.name, args.lat_accel_g), _prepare(args.out))
     print(steering_table(limits))
     print(f"wrote {args.out}")
     return 0
 
 
 def _schedule(args: argparse.Namespace) -> int:
+    from tuning.filter_comparison import compare_closed_loop, fixed_and_scheduled_filters, scheduled_against_fixed
     from tuning.lag_fit import LagFitOptions
-    from tuning.schedule import (
-        PAPER_SPEED_KMH,
-        compare_closed_loop,
-        fixed_and_scheduled_filters,
-        identify_schedule,
-        scheduled_against_fixed,
-    )
+    from tuning.schedule import PAPER_SPEED_KMH, identify_schedule
     from tuning.speeds import parse_speeds
 
     out = _filter_path(args)
@@ -635,8 +632,8 @@ def _margin_lookaheads(text: str) -> tuple[float, ...]:
 
 
 def _margins(args: argparse.Namespace) -> int:
-    from controllers.clothoid.filter_file import read_filter_file
     from controllers.clothoid.loop_analysis import PlantLags
+    from tuning.filter_file import read_filter_file
     from tuning.margins import MarginStudy, run_margins
     from tuning.speeds import parse_speeds
     from workbench.base.errors import require_in_range
@@ -664,7 +661,7 @@ def _margins(args: argparse.Namespace) -> int:
                 "give --lag lag.json (and optionally --measured-lag, --lead), or --vehicle NAME / --vehicle-file F "
                 "for the lags and lead filter of the vehicle's own tuning"
             )
-        from controllers.clothoid.vehicle_tuning import tuning_for
+        from tuning.own_tuning import tuning_for
 
         tuning = tuning_for(vehicle)
         path_at, measured_at = tuning.lag_at, tuning.measured_lag_at

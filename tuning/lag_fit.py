@@ -1,41 +1,28 @@
 """Identification of the steering lag of Eq. 5 from vehicle logs (paper, section 5.1, Figure 8).
 
-Input: the kinematic (Ackermann) curvature of the steering wheel, tan(steer_wheel / steering_ratio) / wheelbase
-(the bicycle model's tan(phi) = L / R1), and the realised curvature of the rear-axle path: by default from the
-logged rear-axle positions x, y, as the paper computes it ("the actual curvature computed from the rear axle
-coordinates"), kappa = (x' y'' - y' x'') / (x'^2 + y'^2)^1.5 with the derivatives from a Savitzky-Golay filter
-(cubic, window smooth_s; zero phase, so it adds no lag); or, when the log has no positions or on request, from
-yaw rate / speed. (On the articulated truck the two differ in transients: the rear axle's side-slip builds up
-after the yaw rate, so yaw rate / speed leads the path curvature and gives a faster lag.)
+Input: the kinematic (Ackermann) curvature of the steering wheel, tan(steer_wheel / steering_ratio) / wheelbase,
+and the realised curvature of the rear-axle path: by default from the logged rear-axle x, y, as the paper computes
+it, kappa = (x' y'' - y' x'') / (x'^2 + y'^2)^1.5 with Savitzky-Golay derivatives (zero phase, so no added lag);
+or from yaw rate / speed (no positions, or on request; on the articulated truck it leads the path curvature).
 
-Model: measured = K x G_lag(s) e^(-s delay) kinematic, with G_lag of Eq. 5, simulated at the log's samples
-(exact first-order-hold discretisation, the linear interpolation scipy.signal.lsim uses, run by lfilter) from
-the steady state of the first sample. K, the steady-state gain, is fitted as a nuisance parameter by default:
-a vehicle that understeers reaches less than the kinematic curvature (K < 1, the understeer gradient), which
-Eq. 5 (unit DC gain) cannot express; without K the fit bends omega_n and zeta to mimic the missing gain. K goes
-into the steering-lag file as `steady_state_gain` (the MPC's lag model uses it; the lead filter of Eq. 6 keeps unit
-DC gain and does not); `unit_gain=True` fixes K = 1. The delay is fitted only with `fit_delay=True`.
+Model: measured = K x G_lag(s) e^(-s delay) kinematic, simulated at the log's samples (exact first-order hold)
+from the steady state of the first sample. K, the steady-state gain, is fitted by default: an understeering
+vehicle reaches less than the kinematic curvature, which Eq. 5 (unit DC gain) cannot express, and without K the
+fit bends omega_n and zeta to mimic it. K goes into the lag file (the MPC uses it; the lead filter of Eq. 6 keeps
+unit gain). `unit_gain=True` fixes K = 1; the delay is fitted only with `fit_delay=True`.
 
-A delay and the damping trade off: both add phase lag growing with frequency, and only the damping also bends
-the magnitude, so data with little energy above 1 Hz (steps, a dlc) cannot tell them apart. Two things separate
-them: a chirp in the
-logs (`tuning/maneuvers.py`; `tuning schedule` logs one), and with a delay an upper bound on zeta,
-DELAY_FIT_MAX_ZETA = 2, at which a fit is accepted rather than refused. Where a vehicle's response is a
-first-order lag behind a delay (the truck from 30 km/h, the cars' 0.05 s actuator), an overdamped Eq. 5 is that
-lag times a pole much faster than the data resolve, and that pole and the delay are interchangeable; at zeta = 2
-the second pole is 14 times the first, and the bound costs little against the vehicle's linearised response
-(tests/tuning/test_identification_against_linearisation.py; the README has the figures).
+Delay and damping trade off (both add phase lag growing with frequency), so steps and a dlc cannot tell them
+apart: a chirp in the logs separates them, and with a delay zeta is bounded at DELAY_FIT_MAX_ZETA = 2, where a fit
+is accepted rather than refused, since a first-order lag behind a delay is an overdamped Eq. 5 whose fast pole and
+the delay are interchangeable (checked in tests/tuning/test_identification_against_linearisation.py).
 
-Fit: scipy.optimize.least_squares over (omega_n, zeta[, K][, delay]) jointly over all logs, from each of the
-STARTS best points of a coarse grid of (omega_n, zeta[, delay]) (K solved linearly there), the lowest cost kept
-(with a delay the cost has more than one valley); each log's residuals are scaled by its measured curvature range
-and sample count, so that each log counts equally. NRMSE (reported, and written to the lag file) is the root mean
-square over the logs of RMS(error) / range(measured curvature). BLAS runs single-threaded during the fit.
-
-Refused, with a message saying why: a log shorter than min_duration_s or min_samples, steering that hardly
-varies (std under min_steer_std_deg: no excitation), speed under min_speed_mps, speed varying over all logs by
-more than max_speed_variation of its mean (the lag depends on speed: fit each speed separately), and a fit that
-runs to a parameter bound (but the zeta bound of a delay fit) or explains the data poorly (NRMSE over max_nrmse).
+Fit: scipy.optimize.least_squares over (omega_n, zeta[, K][, delay]) jointly over all logs, from each of the STARTS
+best points of a coarse grid, the lowest cost kept (with a delay the cost has several valleys); each log's
+residuals are scaled by its curvature range and sample count so that each log counts equally. NRMSE (reported and
+written to the lag file) is the RMS over the logs of RMS(error) / range(measured curvature). Refused, saying why:
+logs too short, too little steering (no excitation) or too slow, speed varying over the logs by more than
+max_speed_variation (the lag depends on speed: fit each speed separately), a fit at a parameter bound (but the
+zeta bound of a delay fit) or with NRMSE over max_nrmse.
 """
 
 from __future__ import annotations
@@ -52,7 +39,7 @@ from threadpoolctl import threadpool_limits
 from tuning.log_file import VehicleLog
 from tuning.savgol import savgol_matrix
 from workbench.base.errors import WorkbenchInputError, require_in_range, require_positive
-from workbench.vehicles.base import VehicleGeometry
+from workbench.vehicles.geometry import VehicleGeometry
 from workbench.vehicles.steering_lag import (
     DELAY_BOUNDS,
     GAIN_BOUNDS,

@@ -4,43 +4,25 @@
     G_lead(s) = wp^3 (s^2 + 2 psi wz s + wz^2) / (wz^2 (s + wp)^3)       (one complex zero pair, three real poles)
     T(s)      = G_lead(s) G_lag(s)                                      (the cascade; DC gain 1 by structure)
 
-Two bandwidths are used. The -3 dB bandwidth w_B(G): the first frequency where |G(jw)| falls 3 dB below its DC gain
-(python-control's `bandwidth`). The tracking bandwidth w_T(G): the first frequency where the error |G(jw) - 1|
-reaches 1 - 10^(-3/20) = 0.29, i.e. up to which the lagged curvature follows the kinematic curvature to within
-the error a 3 dB loss alone would give; it counts phase lag as well as lost magnitude, which is what the lead filter
-is for (the compensated curvature should be the kinematic one, Figure 9).
+`design_lead` cancels the lag's poles (wz = wn, psi = zeta; needs zeta <= 5, the range of psi, and a strongly damped
+lag may have no design under a tight bound), so that T = wp^3 / (s + wp)^3 (no overshoot, -3 dB bandwidth
+0.51 wp), and takes the largest wp, by bisection, within
 
-The bounds:
+    max_w |G_lead(jw)| <= max_lead_gain           (default 6: the most the filter may raise steering rate and noise)
+    max_w |T(jw)|      <= max_cascade_peak_db     (default 1 dB: no resonance, overshoot or ringing)
 
-    max_w |G_lead(jw)| <= max_lead_gain           (default 6, i.e. 15.6 dB; see below)
-    max_w |T(jw)|      <= max_cascade_peak_db     (default 1 dB over the DC gain of 1)
-    1 <= wp / wz <= 100, 0 < psi <= 5             (the ranges of LeadFilterParams)
+(Eq. 6 is strictly proper: its peak is its high-frequency gain.) A free search over (wz, psi, wp) was rejected:
+the bandwidths are first crossings of a threshold, so its optimum jumps with the frequency grid; cancellation is
+unique and smooth in the lag. 6 is the smallest round bound that at least doubles the loaded truck's bandwidth at
+30 km/h; in closed loop less lead tracks better, as a larger peak gain turns the controller's fast command changes
+into steering rates at the actuator's limit (README.md, tuning section). `design_lead_for_margins` instead picks
+Eq. 6 for the shortest lookahead floor of the clothoid loop: with a delay, cancelling leaves the delay untouched.
 
-The first bounds the high-frequency gain and so the steering-rate demand: the filter multiplies the amplitude, and
-so the rate, of every frequency component of the steering command by |G_lead(jw)|, so its peak gain is the most by
-which it can raise the steering rate (and the noise) the controller asks for. (Eq. 6 is strictly proper: |G_lead|
-rises from 1 to its peak near wp and then falls as wp^3 / (wz^2 w); its value at infinity is 0, so the peak is the
-meaningful "high-frequency gain".) The second keeps the cascade free of a resonance (overshoot and ringing).
-
-Why 6 by default: it is the smallest round bound whose design at least doubles the -3 dB bandwidth of the loaded
-tractor-semitrailer's lag at 30 km/h, with a margin for the scatter of an identified zeta. The closed loop, though,
-rewards less lead: the clothoid controller's command changes fast whenever its lookahead does, and a larger peak
-gain turns that into steering-wheel rates at the actuator's limit, where the lead's phase advance is lost (the
-README's tuning section has the measured trade-off).
-
-The design (classical loop shaping with pole-zero cancellation): the zeros cancel the lag's poles (wz = wn,
-psi = zeta), so the cascade is T = wp^3 / (s + wp)^3 (no overshoot, w_B = 0.51 wp), and wp is the largest meeting
-the bounds, found by bisection (both peaks grow with wp at every frequency, and so does w_B): the widest -3 dB and
-tracking bandwidth a cancelling Eq. 6 reaches under the bounds. It needs zeta <= 5 (LeadFilterParams' range of
-psi); a lightly damped lag's resonance widens its own -3 dB bandwidth, so it gains less, and under a tight bound a
-strongly damped lag may have no design (zeros that damped raise the gain past the bound even with wp = wz).
-(A free search over (wz, psi, wp) maximising either bandwidth was tried and rejected: both bandwidths are
-first crossings of a threshold, and their optima sit on a dip or an error hump just short of the threshold, so the
-"optimum" jumps with the frequency grid; cancellation is unique, smooth in the lag and gives no resonance.)
-
-Reported (and written to the filter file's `design` table): both bandwidths of plant and cascade, the peaks, and
-the phase of the plant and of the cascade at a stated frequency (by default the plant's -3 dB bandwidth),
-including any identified delay (which no filter of this form compensates).
+Reported (and written to the filter file's `design` table) for plant and cascade: the -3 dB bandwidth w_B (where
+|G(jw)| first falls 3 dB below its DC gain) and the tracking bandwidth w_T (where |G(jw) - 1| first reaches
+1 - 10^(-3/20): phase lag counts as well as lost magnitude, since the compensated curvature should be the
+kinematic one, Figure 9); the peaks; the phases at a stated frequency, with any identified delay (which no
+filter of this form compensates).
 """
 
 from __future__ import annotations
@@ -72,7 +54,7 @@ from tuning.lag_fit import (
 )
 from tuning.log_file import VehicleLog
 from workbench.base.errors import WorkbenchInputError, require_in_range
-from workbench.vehicles.base import VehicleGeometry
+from workbench.vehicles.geometry import VehicleGeometry
 from workbench.vehicles.steering_lag import SteeringLag
 
 METHOD = "cancel"

@@ -20,9 +20,10 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 import pandas as pd
+from scipy.constants import g as G_MPS2  # standard gravity, 9.80665 m/s^2
 
 from controllers.clothoid.curvature_limits import CurvatureLimits
-from controllers.clothoid.filter_file import FilterSchedule
+from controllers.clothoid.filter_schedule import FilterSchedule
 from controllers.clothoid.loop_analysis import (
     REQUIRED_GAIN_MARGIN_DB,
     REQUIRED_PHASE_MARGIN_DEG,
@@ -35,7 +36,7 @@ from controllers.clothoid.loop_analysis import (
     predicted_limit_cycle,
 )
 from workbench.base.errors import WorkbenchInputError, require_in_range
-from workbench.vehicles.base import VehicleGeometry
+from workbench.vehicles.geometry import VehicleGeometry
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -54,7 +55,6 @@ COLUMNS = (
     "limit_cycle_hz",
     "limit_cycle_steer_wheel_deg",
 )
-G_MPS2 = 9.80665
 #: Rows with |path curvature| x lookahead at or above this are left out (no target on the arc that far ahead; the
 #: floor search skips them too).
 MAX_CURVATURE_LOOKAHEAD = 1.8

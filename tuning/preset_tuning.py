@@ -10,9 +10,9 @@ For each preset (workbench/presets/<name>.toml) it runs, in a fresh directory,
 
 and writes manifest.json (the commands, the options, the hash of the preset's parameters, the package version,
 the date, the speeds dropped and why), then moves the directory to workbench/presets/tuning/<name>/, where
-`controllers.clothoid.vehicle_tuning.tuning_for` reads it. `--check` changes nothing and exits 1 listing the
+`tuning.own_tuning.tuning_for` reads it. `--check` changes nothing and exits 1 listing the
 presets whose files are stale: made for other parameters or other options than the current ones (the test
-tests/controllers/clothoid/test_vehicle_tuning.py fails the same way).
+tests/tuning/test_tuning_dirs.py fails the same way).
 
 Every design option is in PRESET_TUNING_OPTIONS below: change it there and re-run the script. A user's own vehicle
 gets the same chain with the same options (`tuning_for` calls `write_tuning_files`, the functions these commands
@@ -36,18 +36,8 @@ from importlib import metadata
 from pathlib import Path
 from typing import Any
 
-from controllers.clothoid.vehicle_tuning import (
-    LEAD_FILE,
-    LIMITS_FILE,
-    MANIFEST_FILE,
-    MANIFEST_FORMAT,
-    options_dict,
-    params_sha256,
-    read_manifest,
-    read_vehicle_tuning,
-    shipped_tuning_root,
-)
 from tuning.lag_fit import LagFitOptions
+from tuning.limits_file import write_limits_file
 from tuning.rollover import LTR_OUTPUT, rollover_limits
 from tuning.rollover import to_curvature_limits as rollover_curvature_limits
 from tuning.schedule import (
@@ -60,6 +50,16 @@ from tuning.schedule import (
 from tuning.speeds import check_speeds
 from tuning.steering_limits import steering_limits
 from tuning.steering_limits import to_curvature_limits as steering_curvature_limits
+from tuning.tuning_dirs import (
+    LEAD_FILE,
+    LIMITS_FILE,
+    MANIFEST_FILE,
+    MANIFEST_FORMAT,
+    params_sha256,
+    read_manifest,
+    read_vehicle_tuning,
+    shipped_tuning_root,
+)
 from workbench.base.errors import WorkbenchInputError, require_in_range
 from workbench.vehicles import list_presets, make_vehicle
 from workbench.vehicles.base import VehicleModel
@@ -180,6 +180,12 @@ PRESET_TUNING_OPTIONS = PresetTuningOptions(
     controller_rate_hz=50.0,
     prediction_time_s=0.2,
 )
+
+
+def options_dict(options: PresetTuningOptions, model_type: str) -> dict[str, Any]:
+    """The options as resolved for one model type, as recorded in a manifest."""
+    return options.for_model(model_type).to_dict()
+
 
 #: Rough generation time per schedule speed (s), by model type, for the message of a first use (measured with the
 #: margins design and a delay: 46-52 s for the ten speeds of the kinematic and dynamic bicycles and the truck, 4-5 s
@@ -320,7 +326,7 @@ def write_tuning_files(
     else:
         table = steering_limits(vehicle.geometry, resolved.limits_speeds_kmh, resolved.limit_lat_accel_g)
         limits = steering_curvature_limits(table, vehicle.name, resolved.limit_lat_accel_g)
-    limits.write_csv(directory / LIMITS_FILE)
+    write_limits_file(limits, directory / LIMITS_FILE)
     seconds = {"schedule": middle - start, "limits": time.perf_counter() - middle}
     write_manifest(directory, vehicle, preset, options, commands, seconds)
     return directory

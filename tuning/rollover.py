@@ -20,6 +20,8 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
+from scipy.constants import g as G_MPS2  # standard gravity, 9.80665 m/s^2
+
 from controllers.clothoid.curvature_limits import CurvatureLimits
 from tuning.speeds import check_speeds
 from workbench.base.errors import WorkbenchInputError, require_in_range
@@ -47,7 +49,7 @@ class RolloverLimit:
     @property
     def lateral_accel_g(self) -> float:
         """Path curvature x speed^2 in g."""
-        return self.path_curvature_1pm * (self.speed_kmh / 3.6) ** 2 / 9.80665
+        return self.path_curvature_1pm * (self.speed_kmh / 3.6) ** 2 / G_MPS2
 
 
 def _output_index(vehicle: VehicleModel, name: str) -> int:

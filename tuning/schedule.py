@@ -1,47 +1,41 @@
 """A lead filter scheduled on speed: the paper's stated future work (section 7: the filter tuned at 30 km/h is
 suboptimal at higher speeds).
 
-At each speed the plant is driven open loop (`generate_open_loop_log`) with the double-lane-change, step-series and
-chirp steering profiles (SCHEDULE_MANEUVERS) sized for the same kinematic lateral acceleration (default 0.1 g,
-small enough to stay linear and far from rollover; the chirp sweeps 0.1-2 Hz), every profile's steering-wheel
-rate kept to half the vehicle's rate limit (the steps become ramps, the chirp's amplitude falls at high frequency)
-so that the actuator stays linear. Two lags of Eq. 5 are fitted to the logs jointly (`fit_lag`): to the path
-curvature (of the rear axle's x, y: what turns the course and moves the rear axle) and to the measured curvature
-(yaw rate / speed: what the clothoid controller measures; it leads the path curvature on the truck). The lead
-filter is designed for them (`design`): "cancel" (`design_lead`: zeros on the path lag's poles, the paper's
-loop shaping of the lag alone) or "margins" (`design_lead_for_margins`: the filter giving the clothoid loop, at
-the controller's rate and pose prediction, the shortest lookahead floor with 45 deg / 6 dB margins about a straight
-and about an arc of 0.4 g). The filters form a `FilterSchedule`, written in the lead-filter file format with a
-`schedule` list; the clothoid controller interpolates it at the current speed. The file's `design` table keeps,
-per speed, the identified lags (omega_n, zeta, the steady-state gain K and the delay, 0 unless fitted; the measured
-lag's prefixed measured_), the filter, and with "margins" the lookahead floor with and without the filter.
+At each speed the plant is driven open loop (`generate_open_loop_log`) with the dlc, step-series and chirp steering
+profiles (SCHEDULE_MANEUVERS), sized for a small kinematic lateral acceleration (default 0.1 g: linear, far from
+rollover) at no more than half the vehicle's steering-wheel rate limit (so that the actuator stays linear). Two lags
+of Eq. 5 are fitted to the logs jointly (`fit_lag`): to the path curvature (the rear axle's x, y: what moves the
+rear axle) and to the measured curvature (yaw rate / speed: what the clothoid controller measures). The lead filter
+is designed for them: "cancel" (`design_lead`: the paper's loop shaping of the lag alone) or "margins"
+(`design_lead_for_margins`: the shortest lookahead floor of the clothoid loop, at the controller's rate and pose
+prediction, with 45 deg / 6 dB margins about a straight and an arc of 0.4 g).
 
-With a fitted delay (`fit_options=LagFitOptions(fit_delay=True)`, `tuning schedule --delay`) Eq. 5 matches the
-plant's frequency response where it matters for the loop; fitted to dlc and steps alone the delay trades off with
-the damping, so the chirp is logged and zeta bounded with a delay (`tuning/lag_fit.py`; the README has the
-measured agreement). `drop_refused=True` (`--drop-refused`) leaves a refused speed out of the schedule and
-records it with the reason in the file's `design.dropped_speeds`, instead of refusing the whole schedule.
+The filters form a `FilterSchedule`, written in the lead-filter file format with a `schedule` list, which the
+clothoid controller interpolates at the current speed; the file's `design` table keeps, per speed, the identified
+lags (the measured lag's keys prefixed measured_), the filter, and with "margins" the floor with and without it.
+With a fitted delay (`tuning schedule --delay`) Eq. 5 matches the plant's frequency response where it matters for
+the loop; the chirp is logged because on dlc and steps alone delay and damping trade off (`tuning/lag_fit.py`).
+`drop_refused=True` (`--drop-refused`) leaves a refused speed out, recorded with the reason in the file's
+`design.dropped_speeds`, instead of refusing the whole schedule.
 
-`compare_closed_loop` runs the clothoid controller on a scenario with a scheduled and with a fixed filter, to show
-which tracks better (the demonstration of issue 6, item 5), and `scheduled_against_fixed` reads the verdict off
-its rows (the README's tuning section has the measured comparison on the loaded truck).
+Whether the schedule tracks better than a fixed filter in closed loop (issue 6, item 5) is shown by
+`tuning/filter_comparison.py`.
 """
 
 from __future__ import annotations
 
 import dataclasses
 import math
-import tempfile
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
-import numpy as np
+from scipy.constants import g as G_MPS2  # standard gravity, 9.80665 m/s^2
 
-from controllers.clothoid import ClothoidConfig, ClothoidController
-from controllers.clothoid.filter_file import FilterSchedule, read_filter_file, write_filter_file
+from controllers.clothoid.filter_schedule import FilterSchedule
 from controllers.clothoid.loop_analysis import LoopSettings, PlantLags
 from tuning.data_generation import generate_open_loop_log
+from tuning.filter_file import write_filter_file
 from tuning.lag_fit import LagFit, LagFitOptions, fit_lag
 from tuning.lead_design import (
     DEFAULT_MAX_CASCADE_PEAK_DB,
@@ -55,12 +49,9 @@ from tuning.log_file import VehicleLog
 from tuning.maneuvers import Maneuver
 from tuning.speeds import check_speeds
 from workbench.base.errors import WorkbenchInputError, require_in_range
-from workbench.simulation.scenarios import ScenarioOptions, make_scenario
-from workbench.simulation.simulator import Simulation, SimulationConfig
 from workbench.vehicles.base import VehicleModel
 from workbench.vehicles.steering_lag import SteeringLag
 
-G_MPS2 = 9.80665
 DEFAULT_LAT_ACCEL_G = 0.1
 SCHEDULE_MANEUVERS = ("dlc", "step-series", "chirp")
 #: The identification maneuvers ask at most this fraction of the vehicle's steering-wheel rate limit (their steps
@@ -389,141 +380,3 @@ def identify_schedule(
 
 def _floor_text(floor_m: float) -> str:
     return f"{floor_m:g} m" if math.isfinite(floor_m) else f"none up to {MARGINS_LOOKAHEAD_M[1]:g} m"
-
-
-@dataclass(frozen=True)
-class ClosedLoopRow:
-    """One closed-loop run of the comparison: speed_kmh is the speed asked for (the profile's maximum);
-    min/max_speed_kmh the speeds actually driven."""
-
-    speed_kmh: float
-    filter: str
-    completed: bool
-    max_abs_cte_m: float
-    rms_cte_m: float
-    max_abs_steer_rate_deg_s: float
-    min_speed_kmh: float = math.nan
-    max_speed_kmh: float = math.nan
-
-
-@dataclass(frozen=True)
-class FilterVerdict:
-    """At one speed: max |CTE| (m) with the scheduled and with the fixed filter."""
-
-    speed_kmh: float
-    scheduled_max_abs_cte_m: float
-    fixed_max_abs_cte_m: float
-    fixed_label: str
-
-    def __post_init__(self) -> None:
-        for name in ("scheduled_max_abs_cte_m", "fixed_max_abs_cte_m"):
-            value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, int | float) or not value >= 0.0:
-                raise WorkbenchInputError(f"{name} must be a number >= 0 m (inf: the run failed); got {value!r}")
-
-    @property
-    def scheduled_better(self) -> bool:
-        return self.scheduled_max_abs_cte_m < self.fixed_max_abs_cte_m
-
-    @property
-    def change(self) -> float:
-        """Relative change of max |CTE| from the fixed filter to the schedule (negative: the schedule is better)."""
-        return self.scheduled_max_abs_cte_m / self.fixed_max_abs_cte_m - 1.0
-
-    def line(self) -> str:
-        if self.scheduled_max_abs_cte_m == self.fixed_max_abs_cte_m:
-            verdict = "the same (at the fixed filter's own speed the schedule is that filter)"
-        else:
-            verdict = "scheduled better" if self.scheduled_better else "scheduled NOT better"
-        return (
-            f"{self.speed_kmh:g} km/h: max |CTE| scheduled {self.scheduled_max_abs_cte_m:.3f} m, "
-            f"{self.fixed_label} {self.fixed_max_abs_cte_m:.3f} m ({100 * self.change:+.0f} %): {verdict}"
-        )
-
-
-def scheduled_against_fixed(
-    rows: Sequence[ClosedLoopRow], fixed_label: str, scheduled_label: str = "scheduled"
-) -> list[FilterVerdict]:
-    """The verdict at each speed of `compare_closed_loop` rows that ran both filters (a run that did not complete
-    counts as an infinite error)."""
-
-    def error(row: ClosedLoopRow) -> float:
-        return row.max_abs_cte_m if row.completed and math.isfinite(row.max_abs_cte_m) else math.inf
-
-    by_key = {(row.speed_kmh, row.filter): row for row in rows}
-    speeds = dict.fromkeys(row.speed_kmh for row in rows)
-    out = []
-    for speed in speeds:
-        scheduled, fixed = by_key.get((speed, scheduled_label)), by_key.get((speed, fixed_label))
-        if scheduled is not None and fixed is not None:
-            out.append(FilterVerdict(speed, error(scheduled), error(fixed), fixed_label))
-    return out
-
-
-def compare_closed_loop(
-    vehicle_factory: Callable[[], VehicleModel],
-    filters: dict[str, Path | None] | dict[str, Path],
-    speeds_kmh: Sequence[float] = (60.0, 80.0),
-    scenario: str = "dlc",
-    max_lateral_accel_g: float | None = None,
-) -> list[ClosedLoopRow]:
-    """Run the clothoid controller on `scenario` at each speed with each filter file (label -> path; None: the
-    lead filter switched off) and return the tracking metrics. vehicle_factory() builds a fresh vehicle per run.
-    max_lateral_accel_g: the speed profile's bound (default: the simulator's 0.3 g; raise it so that the dlc is
-    driven at the asked speed)."""
-    rows = []
-    for speed in speeds_kmh:
-        for label, path in filters.items():
-            vehicle = vehicle_factory()
-            config = (
-                ClothoidConfig(lead_filter=read_filter_file(path))
-                if path is not None
-                else ClothoidConfig(use_lead_filter=False)
-            )
-            controller = ClothoidController(vehicle.geometry, config, vehicle=vehicle)
-            scen = make_scenario(scenario, ScenarioOptions(vehicle_width_m=vehicle.geometry.width_m))
-            sim_config = (
-                SimulationConfig(speed_kmh=speed)
-                if max_lateral_accel_g is None
-                else SimulationConfig(speed_kmh=speed, max_lateral_accel_g=max_lateral_accel_g)
-            )
-            result = Simulation(scen, vehicle, controller, sim_config).run()
-            m = result.metrics
-            driven = np.asarray(result.trace["speed_mps"], dtype=float) * 3.6
-            rows.append(
-                ClosedLoopRow(
-                    float(speed),
-                    label,
-                    result.completed,
-                    float(m.max_abs_cte_m) if m.max_abs_cte_m is not None else math.nan,
-                    float(m.rms_cte_m) if m.rms_cte_m is not None else math.nan,
-                    float(m.max_abs_steer_rate_deg_s) if m.max_abs_steer_rate_deg_s is not None else math.nan,
-                    float(driven.min()) if driven.size else math.nan,
-                    float(driven.max()) if driven.size else math.nan,
-                )
-            )
-    return rows
-
-
-def fixed_and_scheduled_filters(
-    vehicle: VehicleModel, result: ScheduleResult, fixed_speed_kmh: float, directory: str | Path | None = None
-) -> dict[str, Path]:
-    """Write the schedule and the single filter of its entry at fixed_speed_kmh to `directory` (a temporary one by
-    default) and return {"scheduled": path, "fixed <speed> km/h": path} for `compare_closed_loop`."""
-    directory = Path(directory) if directory is not None else Path(tempfile.mkdtemp(prefix="tuning-"))
-    matches = [e for e in result.entries if e.speed_kmh == fixed_speed_kmh]
-    if not matches:
-        raise WorkbenchInputError(
-            f"fixed_speed_kmh {fixed_speed_kmh:g} is not a speed of the schedule {list(result.speeds_kmh)}"
-        )
-    entry = matches[0]
-    fixed = write_filter_file(
-        directory / f"lead_{fixed_speed_kmh:g}kmh.json",
-        entry.design.params,
-        source=f"design_lead at {fixed_speed_kmh:g} km/h ({vehicle.name})",
-        plant={"omega_n_rad_s": entry.fit.lag.omega_n_rad_s, "zeta": entry.fit.lag.zeta},
-        speed_kmh=fixed_speed_kmh,
-        extra=entry.design.metadata(),
-    )
-    scheduled = result.write(directory / "schedule.json", nominal_speed_kmh=fixed_speed_kmh)
-    return {"scheduled": scheduled, f"fixed {fixed_speed_kmh:g} km/h": fixed}

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 from controllers.clothoid.curvature_limits import DEFAULT_LIMIT_LATERAL_ACCEL_G, G_MPS2, CurvatureLimits
 from tuning.speeds import check_speeds
 from workbench.base.errors import require_in_range
-from workbench.vehicles.base import VehicleGeometry
+from workbench.vehicles.geometry import VehicleGeometry
 
 SPEED_RANGE_KMH = (1.0, 200.0)
 LIMITED_BY = ("steering lock", "lateral acceleration")

@@ -1,12 +1,13 @@
 """The clothoid-based lateral controller of Shaju, Southward & Ahmadian (2024): per-step hyper-clothoid
 (`clothoid_fit`), Fréchet-distance adaptive lookahead (`frechet`, `lookahead`), curvature limits
-(`curvature_limits`) and lead filter (`lead_filter`, `filter_file`), put together in `controller`.
+(`curvature_limits`) and lead filter (`lead_filter`; against speed, `filter_schedule`), put together in
+`controller`.
 """
 
 from controllers.clothoid.clothoid_fit import ClothoidFit, fit_hyper_clothoid
 from controllers.clothoid.controller import ClothoidConfig, ClothoidController
 from controllers.clothoid.curvature_limits import CurvatureLimits
-from controllers.clothoid.filter_file import DEFAULT_FILTER, FilterSchedule, read_filter_file, write_filter_file
+from controllers.clothoid.filter_schedule import DEFAULT_FILTER, FilterSchedule
 from controllers.clothoid.frechet import discrete_frechet
 from controllers.clothoid.lead_filter import DiscreteLeadFilter, LeadFilterParams
 
@@ -21,6 +22,4 @@ __all__ = [
     "LeadFilterParams",
     "discrete_frechet",
     "fit_hyper_clothoid",
-    "read_filter_file",
-    "write_filter_file",
 ]

@@ -2,30 +2,26 @@
 vehicle's rear-axle pose to a target point, solved by a compiled, damped Newton iteration.
 
 The curve: kappa(s) = kappa0 + kdot s, theta(s) = theta0 + kappa0 s + kdot s^2 / 2, points (x0, y0) + int_0^s
-(cos theta, sin theta). It starts at the rear axle with the vehicle's heading and current curvature (Eq. 3's x(0),
-y(0), psi(0), kappa(0)); its unknowns, the curvature rate kdot (1/m^2) and the length L (m), put its end on the
-target (x1, y1). kdot is saturated at +-kdot_max; a saturated clothoid cannot reach the target, so its length is
-the one that brings its end closest, and the residual is left to the controller to check against Eq. 3's
-tolerances (`ClothoidFit.end_error_m`).
+(cos theta, sin theta), from the rear axle with the vehicle's heading and curvature (Eq. 3's x(0), y(0), psi(0),
+kappa(0)); the unknowns kdot (1/m^2) and L (m) put its end on the target. kdot is saturated at +-kdot_max; a
+saturated clothoid ends as close as it can, and the controller checks the residual against Eq. 3's tolerances
+(`ClothoidFit.end_error_m`).
 
-The method, in the start frame: the end point F(kdot, L) and its Jacobian by Gauss-Legendre quadrature, the rule
-chosen by a bound on the heading turned so that end points are exact to rounding; Newton from a small-angle guess,
-damped (bounded heading change, L > 0, a cap on the turn, Armijo backtracking). It stops as failed after 30
-iterations, a line search that cannot descend, or 3 steps in a row that barely reduce the residual: a local minimum
-of |F - target| that is not zero, i.e. no clothoid through the target. A saturated kdot leaves a 1-D search for L.
+The method, in the start frame: the end point and its Jacobian by Gauss-Legendre quadrature (the rule chosen so
+that end points are exact to rounding); damped Newton from a small-angle guess (bounded heading change, L > 0,
+Armijo backtracking), failing after 30 iterations, a line search that cannot descend, or 3 steps in a row that
+barely reduce the residual (no clothoid through the target). A saturated kdot leaves a 1-D search for L.
 
 Status codes (the fifth value `fit_kernel` returns, and `ClothoidFit.status`):
     FIT_OK = 0          converged: the end point is on the target and |kdot| <= kdot_max.
     FIT_SATURATED = 1   kdot = +-kdot_max exactly; L > 0 a local minimiser of the end point's distance to the target.
-    FIT_UNREACHABLE = 2 the target is behind or beside the start (bearing |phi| > 100 deg in the start frame), at
-                        the start, or no clothoid reaches it, or the saturated search failed. The fallback is finite
-                        and bounded: kdot = sign(phi) kdot_max, L = distance, and that clothoid's end point.
-                        Non-finite inputs give kdot = L = 0 and the start point.
+    FIT_UNREACHABLE = 2 the target is behind or beside the start (bearing |phi| > 100 deg), at the start, or
+                        unreachable, or the saturated search failed: a finite fallback, kdot = sign(phi) kdot_max,
+                        L = distance. Non-finite inputs give kdot = L = 0 and the start point.
 
-Why not pyclothoids at run time: `pyclothoids.Clothoid.Forward` (Bertolazzi & Frego) solves the same boundary
-problem (without the rate limit) and is the tests' reference, but it cannot be called from the compiled lookahead
-search, costs several times more per call from Python, and returns degenerate answers for targets behind or beside
-the start and for targets no clothoid reaches (the README's clothoid section has the measured figures).
+Why not pyclothoids at run time: `pyclothoids.Clothoid.Forward` (Bertolazzi & Frego), the tests' reference for the
+same boundary problem without the rate limit, cannot be called from the compiled lookahead search, is slower from
+Python, and returns degenerate answers for targets behind or beside the start or that no clothoid reaches.
 """
 
 from __future__ import annotations

@@ -1,47 +1,27 @@
 """The clothoid-based lateral controller (Shaju, Southward & Ahmadian 2024, Figure 2).
 
-Each step:
-  1. the start pose: the rear-axle centre, heading along its course, and its curvature kappa(0) (Eq. 3), moved
-     ahead by an optional prediction time on that curvature (Figure 2, step 5);
-  2. the lookahead (adaptive by Fréchet distance, fixed, or proportional to speed; `lookahead.py`) and the
-     hyper-clothoid from the start pose to the target (Eq. 3; `clothoid_fit.py`);
-  3. kappa' x V integrated into the curvature command, under the speed-dependent curvature-rate and curvature
-     limits (section 4; `curvature_limits.py`);
-  4. road-wheel angle by Ackermann, tan(phi) = L kappa; steering-wheel angle by the steering ratio;
-  5. the lead filter (Eq. 6, discretised at the controller rate, scheduled on speed when its file holds a
-     schedule; `lead_filter.py`, `filter_file.py`) against the lag between steering wheel and path curvature
-     (Eq. 5), unless switched off.
+Each step (Figure 2): the start pose, the rear-axle centre along its course with the curvature kappa(0) of Eq. 3,
+moved ahead by an optional prediction time (step 5); the lookahead (adaptive by Fréchet distance, fixed or
+proportional to speed; `lookahead.py`) and the hyper-clothoid to the target (Eq. 3; `clothoid_fit.py`); kappa' x V
+integrated into the curvature command under the speed-dependent curvature and curvature-rate limits (section 4;
+`curvature_limits.py`); Ackermann, tan(phi) = L kappa, and the steering ratio; the lead filter of Eq. 6 against
+the steering-to-curvature lag of Eq. 5 (at the controller rate, scheduled on speed; `lead_filter.py`).
 
-Choices the paper leaves open, each an option (ClothoidConfig), with the reasons for the defaults (measurements
-in README.md):
-  - kappa(0) is the curvature the vehicle actually drives, yaw rate / speed ("yaw-rate"). The integrator's own
-    command ("command") or the kinematic curvature of the measured steering ("steering") differ from it by the
-    vehicle's understeer and lag, and the fit then settles on a circle through the target with the wrong
-    curvature: a steady offset in every bend.
-  - the clothoid starts along the rear axle's course (yaw plus its sideslip), the direction the vehicle moves in,
-    not its body yaw ("course"; a tandem axle slips sideways).
-  - the Fréchet threshold is the paper's, absolute ("absolute", 0.02 m): off the path no lookahead qualifies and
-    the search takes the candidate of least Fréchet distance, the shortest, which brings the vehicle back fastest.
-    Before the lookahead floor (below) that choice could drive a lagging plant into a limit cycle, so the
-    threshold applied to the distance in excess of |CTE| ("excess", still an option), which keeps long lookaheads
-    off the path and converges slowly.
+Choices the paper leaves open are options (ClothoidConfig); the defaults, and why (measurements in README.md):
+kappa(0) is the curvature actually driven, yaw rate / speed (the command or the steering's kinematic curvature
+differ from it by understeer and lag, and the fit then leaves a steady offset in every bend); the clothoid starts
+along the rear axle's course, yaw plus sideslip, the direction the vehicle moves in; the Fréchet threshold is the
+paper's absolute one (off the path the search falls back to the shortest candidate, which returns fastest).
 
-What this controller adds to the paper, so that its loop keeps its margins on the vehicle it steers (issue 15):
-  - lookahead floor: `loop_analysis.py` linearises the loop (Eq. 3 on the predicted pose, the integrator of
-    Figure 2, the lead filter, the vehicle's identified lags of Eq. 5, sampling) and finds, per speed, the
-    shortest lookahead from which every lookahead keeps min_phase_margin_deg and min_gain_margin_db (both ways)
-    about a straight and about an arc at the lateral-acceleration limit. The adaptive search never goes
-    below it. The loop's gain goes as L^-3 (about a straight kappa' = -(6 / L^3) (y + psi D + kappa D^2 / 2), D the
-    lookahead from the predicted pose), so each jump of the search's choice is a step change of the loop: the
-    choice is followed with hysteresis and at a limited rate both ways (`lookahead_filter.py`), slowly against
-    the loop's own time scale L / V, so that the frozen-lookahead margins hold.
-  - two degrees of freedom (`path_feedforward.py`): the feedback is Eq. 3's kappa' less that of the path's own
-    clothoid to the same target, and the path's curvature rate is fed forward, so tracking no longer needs the
-    short lookaheads where the loop has no margin.
-  - the lead filter, curvature limits and lags are the steered vehicle's own (`vehicle_tuning.py`), made by the
-    project's tuning chain (the lead chosen for the shortest floor, `tuning schedule --design margins`); without
-    a vehicle (geometry only) and without files, no lead filter and no floor.
-  - min_preview_time_s can still raise the lower end of the lookahead range to a preview time.
+Added to the paper so that the loop keeps its margins on the vehicle it steers (issue 15):
+  - a lookahead floor per speed: `loop_analysis.py` linearises the loop (Eq. 3 on the predicted pose, Figure 2's
+    integrator, the lead filter, the lags of Eq. 5, sampling) and finds the shortest lookahead from which the
+    phase and gain margins hold about a straight and an arc; the loop gain goes as L^-3, so the search's choice
+    is followed with hysteresis and at a limited rate, slowly against L / V (`lookahead_filter.py`);
+  - two degrees of freedom (`path_feedforward.py`): feedback on Eq. 3's kappa' less the path's own clothoid's,
+    and the path's curvature rate fed forward, so tracking needs no short lookaheads where the loop has no margin;
+  - the steered vehicle's own lead filter, curvature limits and lags (`vehicle_tuning.py`, made by `tuning
+    schedule --design margins`; the config holds them); without them, no lead filter and no floor.
 """
 
 from __future__ import annotations
@@ -52,17 +32,18 @@ from dataclasses import dataclass
 from typing import ClassVar
 
 import numpy as np
+from scipy.constants import g as G_MPS2  # standard gravity, 9.80665 m/s^2
 
 from controllers.base import Controller, Measurement
 from controllers.clothoid.curvature_limits import CurvatureLimits
-from controllers.clothoid.filter_file import FilterSchedule
+from controllers.clothoid.filter_schedule import FilterSchedule
 from controllers.clothoid.lead_filter import DiscreteLeadFilter, PassThroughFilter, SteeringFilter
 from controllers.clothoid.lookahead import MAX_CURVE_POINTS, adaptive_search, candidate_count, evaluate_candidate
 from controllers.clothoid.lookahead_filter import LookaheadFilter, LookaheadFilterSettings, require_rate
 from controllers.clothoid.loop_analysis import LoopSettings, PlantLags, lookahead_floor
 from controllers.clothoid.path_feedforward import FeedforwardTiming, two_degree_of_freedom_rate
 from controllers.clothoid.pose_prediction import along_arc
-from controllers.clothoid.vehicle_tuning import VehicleTuning, tuning_for
+from controllers.clothoid.vehicle_tuning import VehicleTuning
 from controllers.config_checks import (
     check_bool,
     check_choice,
@@ -72,7 +53,7 @@ from controllers.config_checks import (
 )
 from workbench.base.errors import WorkbenchInputError, value_text
 from workbench.base.path import PathTracker, ReferencePath
-from workbench.vehicles.base import VehicleGeometry, VehicleModel
+from workbench.vehicles.base import VehicleGeometry
 
 LOOKAHEAD_MODES = ("adaptive", "fixed", "speed")
 INITIAL_CURVATURE = ("yaw-rate", "command", "steering")
@@ -87,7 +68,6 @@ MAX_FLOOR_LOOKAHEAD_M = 40.0
 #: Lateral acceleration (g) of the arc about which the floor is checked besides the straight (the speed profile's
 #: 0.3 g bound, with margin), capped by the curvature limit.
 FLOOR_ARC_LATERAL_ACCEL_G = 0.4
-G_MPS2 = 9.80665
 #: The longest lookahead (m) the options allow.
 MAX_LOOKAHEAD_M = 200.0
 #: The controller's own diagnostics (`ctrl_*` columns), the same every step: zero until the first step.
@@ -127,12 +107,14 @@ class ClothoidConfig:
     of Eq. 3, "yaw-rate", "command" or "steering"; heading: "course" or "yaw"; prediction_time_s: pose prediction
     (s; 0: off); path_feedforward: the two-degree-of-freedom form (`path_feedforward.py`; False: Eq. 3 alone);
     feedforward_window_m: the window the path's curvature rate is averaged over (m); feedforward_time_s,
-    reference_lead_s: its timings (s; None: from the vehicle's identified lags); lead_filter: the lead filter's
-    schedule (None: the steered vehicle's own; in a config file or `--set`, `filter_file` names a file of the
-    `tuning design-lead` or `tuning schedule` format, read when the config is loaded); use_lead_filter: False
-    switches the filter off; curvature_limits: the curvature limits (None: the vehicle's own, else limits from its
-    geometry, `CurvatureLimits.default_for`; in a file, `limits_file` names a CSV of the `tuning rollover-limits`
-    format).
+    reference_lead_s: its timings (s; None: from the vehicle's identified lags); tuning: the steered vehicle's own
+    tuning (lead filter, curvature limits, identified lags; `tuning.own_tuning.tuning_for` finds it, and
+    `tuned_controller` fills it in; None: untuned, no lead filter and no lookahead floor unless given below; in a
+    config file, `tuning_dir` names a tuning directory); lead_filter: the lead filter's schedule (None: the
+    tuning's; in a config file or `--set`, `filter_file` names a file of the `tuning design-lead` or `tuning
+    schedule` format, read when the config is loaded); use_lead_filter: False switches the filter off;
+    curvature_limits: the curvature limits (None: the tuning's, else limits from the geometry,
+    `CurvatureLimits.default_for`; in a file, `limits_file` names a CSV of the `tuning rollover-limits` format).
     """
 
     lookahead_mode: str = "adaptive"
@@ -160,6 +142,7 @@ class ClothoidConfig:
     feedforward_window_m: float = 6.0
     feedforward_time_s: float | None = None
     reference_lead_s: float | None = None
+    tuning: VehicleTuning | None = None
     lead_filter: FilterSchedule | None = None
     use_lead_filter: bool = True
     curvature_limits: CurvatureLimits | None = None
@@ -191,6 +174,7 @@ class ClothoidConfig:
         check_number("feedforward_window_m", self.feedforward_window_m, 0.1, 100.0, "m")
         for name in ("feedforward_time_s", "reference_lead_s"):
             check_optional_number(name, getattr(self, name), 0.0, 5.0, "s", none_means="from the vehicle's lags")
+        check_optional_instance("tuning", self.tuning, VehicleTuning)
         check_optional_instance("lead_filter", self.lead_filter, FilterSchedule)
         check_bool("use_lead_filter", self.use_lead_filter)
         check_optional_instance("curvature_limits", self.curvature_limits, CurvatureLimits)
@@ -215,8 +199,10 @@ class ClothoidConfig:
 class ClothoidController(Controller):
     """The clothoid controller (Figure 2). Build once for a vehicle and a ClothoidConfig; `reset` for each path.
 
-    `vehicle` (the steered VehicleModel) selects its tuning (`vehicle_tuning.tuning_for`): the lead filter, the
-    curvature limits and the identified lags the lookahead floor and the feed-forward timing are computed from.
+    Its tuning (the lead filter, the curvature limits and the identified lags the lookahead floor and the
+    feed-forward timing are computed from) is the config's (`ClothoidConfig.tuning`); a `vehicle` given without one
+    is refused, so that a controller meant for a vehicle never runs untuned by mistake
+    (`tuning.own_tuning.tuned_controller` builds it with the vehicle's own).
     """
 
     name: ClassVar[str] = "clothoid"
@@ -227,7 +213,14 @@ class ClothoidController(Controller):
     ) -> None:
         super().__init__(geometry, config)
         cfg = self.config
-        self.tuning: VehicleTuning | None = tuning_for(vehicle) if isinstance(vehicle, VehicleModel) else None
+        if vehicle is not None and cfg.tuning is None:
+            raise WorkbenchInputError(
+                f"the clothoid controller for vehicle {getattr(vehicle, 'name', vehicle)!r} needs that vehicle's "
+                "tuning: build it with tuning.own_tuning.tuned_controller('clothoid', vehicle[, config]), or give "
+                "ClothoidConfig(tuning=tuning.own_tuning.tuning_for(vehicle)); for an untuned controller pass no "
+                "vehicle"
+            )
+        self.tuning: VehicleTuning | None = cfg.tuning
         if cfg.curvature_limits is not None:
             self.limits = cfg.curvature_limits
         elif self.tuning is not None:

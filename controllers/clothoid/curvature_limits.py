@@ -19,21 +19,18 @@ import bisect
 import itertools
 import math
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
-import pandas as pd
+from scipy.constants import g as G_MPS2  # standard gravity, 9.80665 m/s^2
 
 from workbench.base.errors import WorkbenchInputError, require_positive, value_text
-from workbench.base.input_files import check_input_file
-from workbench.vehicles.base import VehicleGeometry
+from workbench.vehicles.geometry import VehicleGeometry
 
 REQUIRED_COLUMNS = ("speed_kmh", "max_curvature_1pm")
 RATE_COLUMN = "max_curvature_rate_1pm_s"
 #: Lateral acceleration bound (g) of the default limits: above the paper's 0.3 g speed-planning bound and below
 #: the loaded truck preset's static rollover threshold (0.45 g) and dynamic thresholds ~25% lower (SAE 2003-01-3385).
 DEFAULT_LIMIT_LATERAL_ACCEL_G = 0.4
-G_MPS2 = 9.80665
 
 
 @dataclass(frozen=True)
@@ -94,47 +91,3 @@ class CurvatureLimits:
             tuple([rate] * speeds.size),
             source=f"default limits (steering lock, {max_lateral_accel_g:g} g, steering-rate limit)",
         )
-
-    @classmethod
-    def read_csv(cls, path: str | Path, geometry: VehicleGeometry | None = None) -> CurvatureLimits:
-        """Read a limits table; without a rate column, the rate comes from `default_for(geometry)`."""
-        path = check_input_file(path, f"curvature limits file {str(path)!r}")
-        try:
-            table = pd.read_csv(path, comment="#")
-        except (OSError, ValueError, UnicodeDecodeError) as exc:
-            raise WorkbenchInputError(f"{path.name}: not a readable CSV file ({exc})") from None
-        table.columns = [str(c).strip().lower() for c in table.columns]
-        missing = [c for c in REQUIRED_COLUMNS if c not in table.columns]
-        if missing:
-            raise WorkbenchInputError(
-                f"{path.name}: missing column(s) {', '.join(missing)}; found {', '.join(table.columns)}; "
-                f"expected {', '.join(REQUIRED_COLUMNS)}[, {RATE_COLUMN}]"
-            )
-        numeric = table.apply(pd.to_numeric, errors="coerce")
-        if numeric.isna().to_numpy().any():
-            row, col = np.argwhere(numeric.isna().to_numpy())[0]
-            raise WorkbenchInputError(
-                f"{path.name}: row {row + 1} column {table.columns[col]} is {value_text(table.iat[row, col])}, "
-                "not a number"
-            )
-        if RATE_COLUMN in numeric.columns:
-            rates = numeric[RATE_COLUMN].tolist()
-        else:
-            if geometry is None:
-                raise WorkbenchInputError(f"{path.name}: no {RATE_COLUMN} column and no vehicle to derive it from")
-            rates = [cls.default_for(geometry).max_curvature_rate_1pm_s[0]] * len(numeric)
-        return cls(
-            tuple(numeric["speed_kmh"].tolist()),
-            tuple(numeric["max_curvature_1pm"].tolist()),
-            tuple(rates),
-            source=path.name,
-        )
-
-    def write_csv(self, path: str | Path) -> None:
-        pd.DataFrame(
-            {
-                "speed_kmh": self.speeds_kmh,
-                "max_curvature_1pm": self.max_curvature_1pm,
-                RATE_COLUMN: self.max_curvature_rate_1pm_s,
-            }
-        ).to_csv(path, index=False, float_format="%.9g")

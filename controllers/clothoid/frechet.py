@@ -1,32 +1,23 @@
 """Discrete Fréchet distance between two polylines: the dissimilarity score of the adaptive lookahead (paper,
 section 3, Eq. 4 and Appendix A; Eiter & Mannila 1994).
 
-Definition. The Fréchet distance of Eq. 4 is FD(P, Q) = inf over monotone reparametrisations (gamma, delta) of
-max_t d(P(gamma(t)), Q(delta(t))): the shortest leash that lets a walker on P and one on Q go from start to end
-without ever stepping back. Its discrete form, the one Appendix A computes, restricts both walkers to the given
-vertices P_0..P_{n-1} and Q_0..Q_{m-1}: a coupling is a sequence of index pairs (0, 0) = (i_0, j_0), ...,
-(i_K, j_K) = (n-1, m-1) where each step advances i, j or both by one, and
+The Fréchet distance of Eq. 4 is the shortest leash that lets a walker on P and one on Q go from start to end
+without stepping back. Its discrete form, the one Appendix A computes, restricts the walkers to the vertices: a
+coupling is a sequence of index pairs from (0, 0) to (n-1, m-1), each step advancing i, j or both by one, and
 
-    d_F(P, Q) = min over couplings of max_k |P_{i_k} - Q_{j_k}|      (Euclidean norm).
+    d_F(P, Q) = min over couplings of max_k |P_{i_k} - Q_{j_k}|      (Euclidean norm),
 
-It obeys the recursion of Appendix A's matrix, filled row by row from the top-left corner:
+computed by Appendix A's matrix recursion, row by row from the top-left corner (absent neighbours count as +inf):
 
-    c(0, 0) = |P_0 - Q_0|,
-    c(i, j) = max(|P_i - Q_j|, min(c(i-1, j), c(i, j-1), c(i-1, j-1)))   (absent neighbours count as +inf),
+    c(0, 0) = |P_0 - Q_0|,   c(i, j) = max(|P_i - Q_j|, min(c(i-1, j), c(i, j-1), c(i-1, j-1))),   d_F = c(n-1, m-1).
 
-and d_F = c(n-1, m-1), the bottom-right corner.
+It depends on the sampling: it is >= the continuous distance of the polylines and exceeds it by at most the longest
+edge (Eiter & Mannila), so it converges as the sampling is refined. The controller samples clothoid and path at
+the same number of points, where the lock-step max_i |P_i - Q_i| bounds it from above.
 
-Sampling. This is the coupling distance over the vertices as given, so it depends on how the curves are sampled:
-it is always >= the continuous Fréchet distance of the two polylines (a discrete coupling is one of the
-continuous ones) and exceeds it by at most the longest edge of either curve (Eiter & Mannila), so it converges as
-the sampling is refined. It is also at least the distance between the start points and between the end points,
-and at most the largest vertex-to-vertex distance. The controller samples the clothoid and the reference path at
-the same number of points, where the lock-step coupling max_i |P_i - Q_i| bounds it from above.
-
-Cost. O(n m) time and O(min(n, m)) memory: one rolling row over the shorter curve, no recursion, no allocation
-but that row. The hot loop compares squared distances (one sqrt at the end; sqrt is monotone, so the min/max
-recursion picks the same cells); when the squared result leaves the range where squaring is exact to rounding
-(distances below 1e-140 or above 1e140 m, where squares underflow or overflow) it is recomputed with hypot.
+O(n m) time, O(min(n, m)) memory (one rolling row, no recursion). The hot loop compares squared distances (sqrt is
+monotone, so the same cells win) and takes one sqrt at the end, recomputing with hypot where squares would
+underflow or overflow (distances below 1e-140 or above 1e140 m).
 
 `discrete_frechet` is the checked public entry point; `frechet_kernel` and `frechet_with_early_exit` are the
 compiled kernels for callers inside numba code (the lookahead search), which must pass finite float64 arrays.

@@ -44,7 +44,7 @@ from controllers.mpc.solver import MPCSolver
 from controllers.mpc.status import SolveStatus
 from workbench.base.errors import WorkbenchInputError
 from workbench.base.path import PathTracker, Projection, ReferencePath, wrap_angle
-from workbench.vehicles.base import VehicleGeometry
+from workbench.vehicles.geometry import VehicleGeometry
 from workbench.vehicles.steering_lag import SteeringLag
 
 #: Below this speed (m/s) yaw rate / speed and the course angle are not used (the yaw and the previous plan are).

@@ -33,7 +33,7 @@ from controllers.mpc.ocp import TrackingOCP
 from controllers.mpc.sparse_qp import OsqpSettings
 from controllers.mpc.status import SolveResult
 from workbench.base.errors import WorkbenchInputError, value_text
-from workbench.vehicles.base import VehicleGeometry
+from workbench.vehicles.geometry import VehicleGeometry
 
 
 class LtvSolver:

@@ -26,7 +26,7 @@ from controllers.mpc.common import MPCConfig, MPCController
 from controllers.mpc.nlp_solver import IpoptSolver
 from controllers.mpc.rti import RtiSolver
 from controllers.mpc.sparse_qp import OsqpSettings
-from workbench.vehicles.base import VehicleGeometry
+from workbench.vehicles.geometry import VehicleGeometry
 
 SOLVERS = ("rti", "ipopt")
 

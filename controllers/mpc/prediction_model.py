@@ -1,44 +1,28 @@
 """The MPC prediction model: its ODE in path coordinates, from the vehicle's single-track equivalent.
 
-`PredictionParams` (`workbench/vehicles/single_track.py`) is the vehicle as the MPC sees it, and every vehicle
-model provides its own (`VehicleModel.single_track`); `prediction_params_for` takes it from a vehicle model, a
-preset's params dataclass, a preset name or a TOML file, or (when nothing else is known) from the
-`VehicleGeometry` a controller is given. `PredictionModel` turns it into CasADi expressions.
+`PredictionParams` (`VehicleModel.single_track`) is the vehicle as the MPC sees it; `prediction_params_for` takes
+it from a vehicle model, params dataclass, preset name or TOML file, or else from the controller's
+`VehicleGeometry`; `PredictionModel` turns it into CasADi expressions. Every kind is referenced at the rear-axle
+centre (where the paper measures CTE) in Frenet errors e_y (left positive) and e_psi, has the commanded road-wheel
+angle delta_c as a state and its rate as the input u (so steering limits are simple bounds), and takes the path
+curvature kappa and the speed v per shooting interval:
 
-Three model kinds, all referenced at the rear-axle centre (where the paper measures CTE) in Frenet errors with
-respect to the path: e_y (cross-track error, left positive) and e_psi (heading error). Every kind has the
-commanded road-wheel angle delta_c as a state and its rate as the input u, so steering angle and rate limits are
-simple bounds. Per shooting interval two parameters enter: the path curvature kappa and the speed v.
-
-  "dynamic"  nonlinear single track (dynamic bicycle): lateral velocity v_y at the CG and yaw rate r, axle
-             forces from the slip angles through the magic formula of the vehicle's tyres (saturating), the road
-             wheel angle delta following delta_c through the first-order steering actuator of the preset:
+  "dynamic"  nonlinear single track: v_y at the CG, yaw rate r, magic-formula axle forces, first-order actuator:
                  v_y' = (Fyf cos(delta) + Fyr) / m - v r,   r' = (a Fyf cos(delta) - b Fyr) / Iz,
-                 delta' = (delta_c - delta) / tau,          delta_c' = u.
-             Neglected against the workbench plants: tyre relaxation, load transfer, the actuator's rate clip.
-  "kinematic" kinematic bicycle with the first-order actuator: the rear axle moves along its heading with
-             curvature tan(delta) / L. Exact for the `kinematic-bicycle` plant; the model used when only the
-             geometry is known.
-  "kinematic-lag" the paper's "kinematic with lag" (section 5.1, Figures 8-9): the path curvature kappa_v
-             follows the kinematic curvature tan(delta_c) / L through the identified second-order lag of Eq. 5
-             and its steady-state gain K (1 in Eq. 5; the understeer that `tuning fit-lag` identifies),
-                 kappa_v'' = wn^2 (K kappa_kin - kappa_v) - 2 zeta wn kappa_v',
-             its pure delay (if any) as a first-order Pade approximant. (The states are L kappa_v and its rate:
-             dimensionless like the road-wheel angle, which keeps the QPs well scaled.) The lag identified by
-             `tuning fit-lag` is the whole steering-wheel-to-curvature response (actuator, tyres, inertia), so it
-             replaces the dynamic bicycle's lateral dynamics rather than being stacked on them (that would count
-             the tyre lag twice). This is how the MPC and the clothoid controller's lead filter use the same
-             identified data.
+                 delta' = (delta_c - delta) / tau,          delta_c' = u
+             (neglects tyre relaxation, load transfer and the actuator's rate clip).
+  "kinematic" the rear axle moves along its heading with curvature tan(delta) / L, same actuator; exact for the
+             `kinematic-bicycle` plant, and the model when only the geometry is known.
+  "kinematic-lag" the paper's "kinematic with lag" (section 5.1, Figures 8-9): the identified lag of Eq. 5 with
+             its steady-state gain K, kappa_v'' = wn^2 (K kappa_kin - kappa_v) - 2 zeta wn kappa_v', a delay as a
+             first-order Pade state (states L kappa_v and its rate: dimensionless, for well-scaled QPs). The lag is
+             the whole steering-to-curvature response, so it replaces the lateral dynamics (stacked on them it would
+             count the tyre lag twice); the clothoid controller's lead filter uses the same identified data.
 
-Path coordinates at the rear axle, with v_r the rear axle's lateral velocity (v_y - b r; zero in the kinematic
-kinds) and omega the yaw rate (r, or v kappa_v in the kinematic kinds):
-    s' = (v cos(e_psi) - v_r sin(e_psi)) / (1 - kappa e_y),  e_y' = v sin(e_psi) + v_r cos(e_psi),
-    e_psi' = omega - kappa s'.
-In the kinematic kinds e_psi is the error of the rear axle's course, which is its heading there.
-
-The tractor-semitrailer is predicted by its equivalent single track (`TractorSemitrailer.single_track`): the
-tractor carrying the kingpin's share of the trailer as a point mass at the fifth wheel; it neglects the trailer's
-yaw transient, which an identified lag file captures if one is given.
+Path coordinates, v_r the rear axle's lateral velocity (v_y - b r; 0 in the kinematic kinds), omega the yaw rate
+(r, or v kappa_v): s' = (v cos(e_psi) - v_r sin(e_psi)) / (1 - kappa e_y), e_y' = v sin(e_psi) + v_r cos(e_psi),
+e_psi' = omega - kappa s'. The tractor-semitrailer is predicted by its equivalent single track (the kingpin's share
+of the trailer as a point mass at the fifth wheel), which neglects the trailer's yaw transient.
 """
 
 from __future__ import annotations

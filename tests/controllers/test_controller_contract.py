@@ -11,6 +11,7 @@ import pytest
 
 from controllers import CONTROLLERS, make_controller
 from controllers.base import Measurement
+from tuning.own_tuning import tuned_controller
 from workbench.base.clothoid_chain import ClothoidChain
 from workbench.base.errors import WorkbenchInputError
 from workbench.simulation.scenarios import make_scenario
@@ -76,7 +77,7 @@ IMPLAUSIBLE = {
 @pytest.mark.parametrize("situation", sorted(SITUATIONS))
 def test_command_is_finite_and_within_the_steering_limit(name: str, situation: str) -> None:
     vehicle = KinematicBicycle()
-    controller = make_controller(name, vehicle.geometry, vehicle=vehicle)
+    controller = tuned_controller(name, vehicle)
     controller.reset(PATH, 0.02)
     command = controller.step(SITUATIONS[situation], PATH)
     assert math.isfinite(command)
@@ -90,7 +91,7 @@ def test_command_is_finite_and_within_the_steering_limit(name: str, situation: s
 @pytest.mark.parametrize("situation", sorted(IMPLAUSIBLE))
 def test_an_implausible_measurement_holds_the_last_command_and_says_so(name: str, situation: str) -> None:
     vehicle = KinematicBicycle()
-    controller = make_controller(name, vehicle.geometry, vehicle=vehicle)
+    controller = tuned_controller(name, vehicle)
     controller.reset(PATH, 0.02)
     last = controller.step(BEFORE, PATH)
     assert last != 0.0 and controller.diagnostics["measurement_rejected"] == 0.0
@@ -118,7 +119,7 @@ def test_an_implausible_measurement_holds_the_last_command_and_says_so(name: str
 @pytest.mark.parametrize("name", NAMES)
 def test_turns_toward_the_path(name: str) -> None:
     vehicle = KinematicBicycle()
-    controller = make_controller(name, vehicle.geometry, vehicle=vehicle)
+    controller = tuned_controller(name, vehicle)
     controller.reset(PATH, 0.02)
     left_of_path = controller.step(_measure(5.0, 1.0, 0.0, 8.0), PATH)
     controller.reset(PATH, 0.02)
@@ -130,9 +131,7 @@ def test_turns_toward_the_path(name: str) -> None:
 def test_completes_the_dlc_closely(name: str) -> None:
     vehicle = KinematicBicycle()
     scenario = make_scenario("dlc")
-    result = Simulation(
-        scenario, vehicle, make_controller(name, vehicle.geometry, vehicle=vehicle), SimulationConfig()
-    ).run()
+    result = Simulation(scenario, vehicle, tuned_controller(name, vehicle), SimulationConfig()).run()
     assert result.completed, result.message
     assert result.metrics.max_abs_cte_m < 0.3
     assert np.isfinite(result.to_pandas().select_dtypes("number").to_numpy()).all()

@@ -22,13 +22,14 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from test_controller_contract import PATH as CONTRACT_PATH
 
-from controllers import CONTROLLERS, make_controller
+from controllers import CONTROLLERS
 from controllers.base import MAX_SPEED_MPS, STEER_SENSOR_MARGIN, Measurement
+from tuning.own_tuning import tuned_controller
 from workbench.base.errors import WorkbenchInputError
 from workbench.base.path import ReferencePath
 from workbench.simulation.scenarios import make_scenario
 from workbench.vehicles import KinematicBicycle
-from workbench.vehicles.base import VehicleGeometry
+from workbench.vehicles.geometry import VehicleGeometry
 
 #: Controller steps per controller, over both paths.
 STEPS_PER_CONTROLLER = 100_000
@@ -211,7 +212,7 @@ _BUILT: dict[str, object] = {}
 def _controller(name: str):
     if name not in _BUILT:
         vehicle = KinematicBicycle()
-        _BUILT[name] = make_controller(name, vehicle.geometry, vehicle=vehicle)
+        _BUILT[name] = tuned_controller(name, vehicle)
     return _BUILT[name]
 
 

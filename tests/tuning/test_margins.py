@@ -15,12 +15,12 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from controllers.clothoid.filter_file import write_filter_file
 from controllers.clothoid.lead_filter import LeadFilterParams
 from controllers.clothoid.loop_analysis import LoopSettings, PlantLags, lookahead_floor, loop_margins, loop_transfer
-from controllers.clothoid.vehicle_tuning import tuning_for
 from tuning.cli import main
+from tuning.filter_file import write_filter_file
 from tuning.margins import COLUMNS, G_MPS2, MarginStudy, run_margins
+from tuning.own_tuning import tuning_for
 from workbench.vehicles import make_vehicle
 from workbench.vehicles.steering_lag import SteeringLag, write_lag_file
 

@@ -8,6 +8,7 @@ from pathlib import Path
 import pytest
 
 from controllers.clothoid.curvature_limits import CurvatureLimits
+from tuning.limits_file import read_limits_file, write_limits_file
 from tuning.rollover import rollover_limit, rollover_limits, step_steer, to_curvature_limits
 from workbench.base.errors import WorkbenchInputError
 from workbench.vehicles import make_vehicle
@@ -54,8 +55,8 @@ def test_at_low_speed_the_steering_lock_limits(limits) -> None:
 
 def test_the_limits_file_round_trips_for_the_controller(truck, limits, tmp_path: Path) -> None:
     table = to_curvature_limits(limits, truck)
-    table.write_csv(tmp_path / "limits.csv")
-    back = CurvatureLimits.read_csv(tmp_path / "limits.csv", truck.geometry)
+    write_limits_file(table, tmp_path / "limits.csv")
+    back = read_limits_file(tmp_path / "limits.csv", truck.geometry)
     assert back.speeds_kmh == (20.0, 40.0, 60.0, 80.0)
     assert back.max_curvature_1pm == pytest.approx([lim.path_curvature_1pm for lim in limits], rel=1e-8)
     rate = CurvatureLimits.default_for(truck.geometry).at_speed(0.0)[1]  # the steering-rate limit

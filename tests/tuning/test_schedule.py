@@ -6,18 +6,17 @@ from pathlib import Path
 
 import pytest
 
-from controllers.clothoid.filter_file import read_filter_file, write_filter_file
-from controllers.clothoid.vehicle_tuning import LEAD_FILE, shipped_tuning_root
-from tuning.lag_fit import DELAY_FIT_MAX_ZETA, LagFitOptions
-from tuning.schedule import (
+from tuning.filter_comparison import (
     ClosedLoopRow,
     FilterVerdict,
     compare_closed_loop,
     fixed_and_scheduled_filters,
-    identify_schedule,
     scheduled_against_fixed,
-    steer_amplitude_deg,
 )
+from tuning.filter_file import read_filter_file, write_filter_file
+from tuning.lag_fit import DELAY_FIT_MAX_ZETA, LagFitOptions
+from tuning.schedule import identify_schedule, steer_amplitude_deg
+from tuning.tuning_dirs import LEAD_FILE, shipped_tuning_root
 from workbench.base.errors import WorkbenchInputError
 from workbench.vehicles import make_vehicle
 

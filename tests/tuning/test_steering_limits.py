@@ -11,6 +11,7 @@ import pytest
 import tuning.schedule
 from controllers.clothoid.curvature_limits import CurvatureLimits
 from tuning.cli import main
+from tuning.limits_file import read_limits_file
 from tuning.steering_limits import steering_limits
 from workbench.base.errors import WorkbenchInputError
 from workbench.vehicles import make_vehicle
@@ -38,7 +39,7 @@ def test_the_cli_writes_the_limits_file(tmp_path: Path, capsys) -> None:
     out = tmp_path / "limits.csv"
     argv = ["steering-limits", "--vehicle", "kinematic-bicycle", "--speeds", "10,20,...,150", "--lat-accel-g", "0.3"]
     assert main([*argv, "--out", str(out)]) == 0
-    limits = CurvatureLimits.read_csv(out)
+    limits = read_limits_file(out)
     assert limits.speeds_kmh == tuple(float(s) for s in range(10, 151, 10))
     assert limits.max_curvature_1pm[2] == pytest.approx(0.3 * 9.80665 / (30 / 3.6) ** 2)
     assert "lateral acceleration" in capsys.readouterr().out

@@ -11,9 +11,9 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from controllers.clothoid.curvature_limits import CurvatureLimits
-from controllers.clothoid.filter_file import read_filter_file
 from tuning.cli import main
+from tuning.filter_file import read_filter_file
+from tuning.limits_file import read_limits_file
 from workbench.vehicles import make_vehicle
 from workbench.vehicles.steering_lag import read_lag_file
 
@@ -103,7 +103,7 @@ def test_rollover_limits_writes_the_limits_csv(tmp_path: Path, capsys) -> None:
         str(tmp_path / "f6.png"),
     ]
     assert main(argv) == 0
-    limits = CurvatureLimits.read_csv(out)
+    limits = read_limits_file(out)
     assert limits.speeds_kmh == (20.0, 40.0, 60.0, 80.0)
     assert list(limits.max_curvature_1pm) == sorted(limits.max_curvature_1pm, reverse=True)
     assert "steering lock" in capsys.readouterr().out

@@ -401,8 +401,9 @@ def _optimise(args: argparse.Namespace) -> int:
 
 def _run(args: argparse.Namespace) -> int:
     from controllers import make_controller
-    from controllers.config_file import read_controller_config
+    from tuning.own_tuning import tuned_controller
     from workbench.apps.comparison import warn_on_stderr
+    from workbench.apps.controller_config import read_controller_config
     from workbench.base.output_dir import OutputDir
     from workbench.simulation.limit_cycle import detect_limit_cycle
     from workbench.simulation.scenarios import ScenarioOptions, make_scenario
@@ -418,7 +419,7 @@ def _run(args: argparse.Namespace) -> int:
     options = read_controller_config(
         args.controller_config, args.controller, CONTROLLERS[args.controller].config_type, args.set, vehicle.geometry
     )
-    controller = make_controller(args.controller, vehicle.geometry, options, vehicle=vehicle)
+    controller = tuned_controller(args.controller, vehicle, options)
     scenario = make_scenario(
         args.scenario, ScenarioOptions(vehicle_width_m=vehicle.geometry.width_m, track_file=args.track)
     )
@@ -481,7 +482,7 @@ def _vehicles(args: argparse.Namespace) -> None:
 
 
 def _controllers(args: argparse.Namespace) -> None:
-    from controllers.config_file import config_template
+    from workbench.apps.controller_config import config_template
 
     if args.show:
         if args.show not in CONTROLLERS:

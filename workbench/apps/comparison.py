@@ -26,8 +26,9 @@ from typing import TYPE_CHECKING
 import numpy as np
 import pandas as pd
 
-from controllers import CONTROLLERS, make_controller
-from controllers.config_file import read_controller_config
+from controllers import CONTROLLERS
+from tuning.own_tuning import tuned_controller
+from workbench.apps.controller_config import read_controller_config
 from workbench.base.errors import WorkbenchInputError
 from workbench.simulation.limit_cycle import LimitCycle, detect_limit_cycle
 from workbench.simulation.metrics import METRIC_KEYS
@@ -249,7 +250,7 @@ def compare(
         options = read_controller_config(
             spec.config_file, spec.controller, config_type, spec.overrides, vehicle.geometry
         )
-        controller = make_controller(spec.controller, vehicle.geometry, options, vehicle=vehicle)
+        controller = tuned_controller(spec.controller, vehicle, options)
         simulations.append(Simulation(scen, vehicle, controller, config))
     messages: list[str] = []
     for spec, simulation in zip(runs, simulations, strict=True):

@@ -125,11 +125,11 @@ def _fig7(path: Path) -> Path:
 
 
 def _tracking(scenario: str, options: ScenarioOptions) -> SimulationResult:
-    from controllers import make_controller
+    from tuning.own_tuning import tuned_controller
 
     vehicle = make_vehicle(TRUCK)
     scen = make_scenario(scenario, ScenarioOptions(vehicle.geometry.width_m, options.track_file))
-    controller = make_controller("clothoid", vehicle.geometry, vehicle=vehicle)
+    controller = tuned_controller("clothoid", vehicle)
     return Simulation(scen, vehicle, controller, SimulationConfig(speed_kmh=SPEED_KMH)).run()
 
 

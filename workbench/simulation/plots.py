@@ -2,21 +2,34 @@
 several runs on shared axes (the paper's Figures 17 and 18: `trajectories`, `cte_comparison`, `speed_comparison`,
 `steering_comparison`).
 
-matplotlib.pyplot is imported where a figure is drawn, not with this module (issue 17): `workbench.simulation.result`
-and the CLI's startup need none of it."""
+matplotlib.pyplot is imported where a figure is drawn, not with this module (issue 17): `result.py` and the CLI's
+startup need none of it. A plotted run is anything with a `SimulationResult`'s fields (`PlottedRun`), so this module
+does not import the result that draws itself with it."""
 
 from __future__ import annotations
 
 from collections.abc import Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Protocol
 
 import numpy as np
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
 
-    from workbench.simulation.result import SimulationResult
+    from workbench.base.path import ReferencePath
+    from workbench.simulation.scenarios import Scenario
+
+
+class PlottedRun(Protocol):
+    """What a plot reads of a run (a `SimulationResult` is one): its trace, the path and scenario it ran on, and
+    which controller and vehicle ran it."""
+
+    trace: dict[str, np.ndarray]
+    path: ReferencePath
+    scenario: Scenario
+    controller: str
+    vehicle: str
 
 
 def _axes(ax: Axes | None) -> Axes:
@@ -27,15 +40,15 @@ def _axes(ax: Axes | None) -> Axes:
     return ax
 
 
-def _label(result: SimulationResult) -> str:
+def _label(result: PlottedRun) -> str:
     return f"{result.controller} on {result.vehicle}"
 
 
-def _distance(result: SimulationResult) -> np.ndarray:
+def _distance(result: PlottedRun) -> np.ndarray:
     return result.trace["progress_m"]
 
 
-def trajectory(result: SimulationResult, ax: Axes | None = None) -> Axes:
+def trajectory(result: PlottedRun, ax: Axes | None = None) -> Axes:
     ax = _axes(ax)
     _draw_reference(result, ax)
     ax.plot(result.trace["x_m"], result.trace["y_m"], lw=1.5, label=f"{_label(result)} (rear axle)")
@@ -52,7 +65,7 @@ def trajectory(result: SimulationResult, ax: Axes | None = None) -> Axes:
     return ax
 
 
-def cte_vs_distance(result: SimulationResult, ax: Axes | None = None) -> Axes:
+def cte_vs_distance(result: PlottedRun, ax: Axes | None = None) -> Axes:
     ax = _axes(ax)
     ax.plot(_distance(result), result.trace["cte_m"], label=_label(result))
     ax.axhline(0.0, color="k", lw=0.5)
@@ -61,7 +74,7 @@ def cte_vs_distance(result: SimulationResult, ax: Axes | None = None) -> Axes:
     return ax
 
 
-def steering_vs_time(result: SimulationResult, ax: Axes | None = None) -> Axes:
+def steering_vs_time(result: PlottedRun, ax: Axes | None = None) -> Axes:
     ax = _axes(ax)
     t = result.trace["t_s"]
     ax.plot(t, np.degrees(result.trace["steer_wheel_cmd_rad"]), lw=1.0, label="command")
@@ -71,7 +84,7 @@ def steering_vs_time(result: SimulationResult, ax: Axes | None = None) -> Axes:
     return ax
 
 
-def speed_vs_distance(result: SimulationResult, ax: Axes | None = None) -> Axes:
+def speed_vs_distance(result: PlottedRun, ax: Axes | None = None) -> Axes:
     ax = _axes(ax)
     d = _distance(result)
     ax.plot(d, result.trace["speed_ref_mps"] * 3.6, "k--", lw=1.0, label="planned")
@@ -89,7 +102,7 @@ RUN_PLOTS = {
 }
 
 
-def save_run_plots(result: SimulationResult, out_dir: Path) -> list[Path]:
+def save_run_plots(result: PlottedRun, out_dir: Path) -> list[Path]:
     """Write the four standard plots of a run as PNG files in out_dir."""
     import matplotlib.pyplot as plt
 
@@ -104,7 +117,7 @@ def save_run_plots(result: SimulationResult, out_dir: Path) -> list[Path]:
 
 
 # ---------------------------------------------------------------------------------------------- several runs
-def _draw_reference(result: SimulationResult, ax: Axes) -> None:
+def _draw_reference(result: PlottedRun, ax: Axes) -> None:
     path = result.path
     ax.plot(path.x_m, path.y_m, "k--", lw=1.0, label="reference")
     cones = result.scenario.cones_xy
@@ -115,7 +128,7 @@ def _draw_reference(result: SimulationResult, ax: Axes) -> None:
         ax.set_aspect("equal", adjustable="datalim")
 
 
-def trajectories(results: Sequence[SimulationResult], labels: Sequence[str], ax: Axes | None = None) -> Axes:
+def trajectories(results: Sequence[PlottedRun], labels: Sequence[str], ax: Axes | None = None) -> Axes:
     """Figure 17a: each run's rear-axle path over the reference."""
     ax = _axes(ax)
     _draw_reference(results[0], ax)
@@ -126,7 +139,7 @@ def trajectories(results: Sequence[SimulationResult], labels: Sequence[str], ax:
     return ax
 
 
-def cte_comparison(results: Sequence[SimulationResult], labels: Sequence[str], ax: Axes | None = None) -> Axes:
+def cte_comparison(results: Sequence[PlottedRun], labels: Sequence[str], ax: Axes | None = None) -> Axes:
     """Figure 17b: CTE against distance along the path, every run on one axis."""
     ax = _axes(ax)
     for result, label in zip(results, labels, strict=True):
@@ -137,7 +150,7 @@ def cte_comparison(results: Sequence[SimulationResult], labels: Sequence[str], a
     return ax
 
 
-def speed_comparison(results: Sequence[SimulationResult], labels: Sequence[str], ax: Axes | None = None) -> Axes:
+def speed_comparison(results: Sequence[PlottedRun], labels: Sequence[str], ax: Axes | None = None) -> Axes:
     """Figure 18a: speed against distance along the path (and the planned profile of the first run)."""
     ax = _axes(ax)
     ax.plot(_distance(results[0]), results[0].trace["speed_ref_mps"] * 3.6, "k--", lw=1.0, label="planned")
@@ -148,7 +161,7 @@ def speed_comparison(results: Sequence[SimulationResult], labels: Sequence[str],
     return ax
 
 
-def steering_comparison(results: Sequence[SimulationResult], labels: Sequence[str], ax: Axes | None = None) -> Axes:
+def steering_comparison(results: Sequence[PlottedRun], labels: Sequence[str], ax: Axes | None = None) -> Axes:
     """Figure 18b: measured steering-wheel angle against time."""
     ax = _axes(ax)
     for result, label in zip(results, labels, strict=True):

@@ -18,7 +18,7 @@ if TYPE_CHECKING:
     import pandas as pd
     from matplotlib.axes import Axes
 
-    from workbench.simulation.simulator import SimulationConfig
+    from workbench.simulation.run_config import SimulationConfig
 
 
 class Status(StrEnum):

@@ -17,11 +17,9 @@ from typing import ClassVar
 
 import numpy as np
 import pandas as pd
+from scipy.constants import g as G_MPS2  # standard gravity, 9.80665 m/s^2
 
 from workbench.base.errors import WorkbenchInputError, require_finite, require_in_range, require_positive
-
-#: Standard gravity (m/s^2).
-G_MPS2 = 9.80665
 
 
 @dataclass(frozen=True)

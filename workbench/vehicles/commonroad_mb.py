@@ -22,7 +22,7 @@ from workbench.vehicles.base import VehicleGeometry, VehicleModel
 from workbench.vehicles.integration import rk4_python
 from workbench.vehicles.reference_point import reference_point_python
 from workbench.vehicles.single_track import PredictionParams, SingleTrackParams
-from workbench.vehicles.tyres import G_MPS2
+from workbench.vehicles.tyres import COMMONROAD_G_MPS2
 
 #: CommonRoad's names of the MB states, in order (x/y are the CG; vx/vy of the sprung mass, body frame).
 _MB_STATES: tuple[str, ...] = (
@@ -112,7 +112,7 @@ class CommonRoadMB(VehicleModel):
         """CommonRoad's car parameters as a single track with CommonRoad's tyre coefficients."""
         p, cr = self.params, self._cr
         a, b, m = float(cr.a), float(cr.b), float(cr.m)
-        fzf, fzr = m * G_MPS2 * b / (a + b), m * G_MPS2 * a / (a + b)
+        fzf, fzr = m * COMMONROAD_G_MPS2 * b / (a + b), m * COMMONROAD_G_MPS2 * a / (a + b)
         tyre = cr.tire
         track = SingleTrackParams(
             mass_kg=m,

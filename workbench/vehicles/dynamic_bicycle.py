@@ -27,7 +27,7 @@ from workbench.vehicles.blend import blend, blend_weight, check_blend_speeds, pu
 from workbench.vehicles.integration import rk4
 from workbench.vehicles.reference_point import reference_point, world_velocity
 from workbench.vehicles.single_track import PredictionParams, SingleTrackParams
-from workbench.vehicles.tyres import G_MPS2, magic_formula, relaxation_rate, slip_angle, steered_slip_angle
+from workbench.vehicles.tyres import COMMONROAD_G_MPS2, magic_formula, relaxation_rate, slip_angle, steered_slip_angle
 
 
 @dataclass(frozen=True)
@@ -69,7 +69,7 @@ class DynamicBicycleParams:
     @property
     def understeer_gradient_rad_per_mps2(self) -> float:
         """Linear K in delta = L kappa + K a_y: (m / L)(b / Cf - a / Cr) with C = coefficient x static load."""
-        return (1.0 / self.front_cornering_coeff_per_rad - 1.0 / self.rear_cornering_coeff_per_rad) / G_MPS2
+        return (1.0 / self.front_cornering_coeff_per_rad - 1.0 / self.rear_cornering_coeff_per_rad) / COMMONROAD_G_MPS2
 
 
 _RANGES: tuple[tuple[str, float, float, str], ...] = (
@@ -106,8 +106,8 @@ def _rhs(s, p, delta_cmd, accel, out):  # pragma: no cover - compiled
     ax = realised_accel(u, accel)
     ddelta = road_wheel_rate(delta_cmd, delta, p[P_TAU], p[P_RATE])
     sd, cd = math.sin(delta), math.cos(delta)
-    fzf = m * (G_MPS2 * b - ax * p[P_H]) / wb
-    fzr = m * (G_MPS2 * a + ax * p[P_H]) / wb
+    fzf = m * (COMMONROAD_G_MPS2 * b - ax * p[P_H]) / wb
+    fzr = m * (COMMONROAD_G_MPS2 * a + ax * p[P_H]) / wb
     alpha_f = steered_slip_angle(v + a * r, u, sd, cd)
     alpha_r = slip_angle(v - b * r, u)
     relax = relaxation_rate(u, p[P_VLO], p[P_SIGMA])
@@ -188,7 +188,7 @@ class DynamicBicycle(CompiledVehicleModel):
         load, peak = friction x load) and actuator."""
         p = self.params
         a, b = p.cg_to_front_axle_m, p.cg_to_rear_axle_m
-        fzf, fzr = p.mass_kg * G_MPS2 * b / (a + b), p.mass_kg * G_MPS2 * a / (a + b)
+        fzf, fzr = p.mass_kg * COMMONROAD_G_MPS2 * b / (a + b), p.mass_kg * COMMONROAD_G_MPS2 * a / (a + b)
         track = SingleTrackParams(
             mass_kg=p.mass_kg,
             yaw_inertia_kgm2=p.yaw_inertia_kgm2,

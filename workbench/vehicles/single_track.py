@@ -10,15 +10,12 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
 
 import numpy as np
 
 from workbench.base.errors import WorkbenchInputError, require_in_range, require_positive
+from workbench.vehicles.geometry import VehicleGeometry
 from workbench.vehicles.steering_lag import SteeringLag
-
-if TYPE_CHECKING:
-    from workbench.vehicles.base import VehicleGeometry
 
 #: Steering-actuator time constant (s) assumed when only the geometry is known: an electric or hydraulic power
 #: steering position loop (the workbench presets use 0.05 s for the car and 0.1 s for the truck).

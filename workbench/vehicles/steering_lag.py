@@ -2,33 +2,21 @@
 
     G_lag(s) = K wn^2 / (s^2 + 2 zeta wn s + wn^2) x exp(-s delay)
 
-(Eq. 5 has K = 1. A real vehicle understeers or oversteers, so the realised curvature settles at K times the
-kinematic (Ackermann) one, K depending on speed; `tuning fit-lag` fits K too unless told not to.)
+Eq. 5 has K = 1; a real vehicle understeers or oversteers, so the realised curvature settles at K times the
+kinematic (Ackermann) one. `tuning fit-lag` writes the lag; the clothoid controller's lead filter is designed from
+it and the MPC's prediction model takes it as its steering dynamics, so both controllers use the same data.
 
-`tuning fit-lag` writes it; the clothoid controller's lead filter is designed from it and the MPC's prediction
-model takes it as its steering dynamics, so both controllers use the same identified data.
+This module is the lag's one home: `SteeringLag` holds it, within the bounds the fit also searches, in every form
+its users need: `transfer_function` (python-control, the delay left out or as a Pade approximant),
+`frequency_response` (the lead design's search), `companion_matrices` (the clothoid loop analysis's plant),
+`simulate` / `simulate_lag` (first-order hold, the delay a shift of the input; the fit calls it thousands of
+times), and `state_derivatives` (written with + - * / only, so that floats, numpy arrays and CasADi symbols all
+work; the MPC's kinematic-lag model, the delay a first-order Pade state).
 
-This module is the lag's one home: `SteeringLag` holds it, within the bounds below (the fit searches the same
-ones), and gives every form its users need:
-- `transfer_function`: python-control's K G_lag(s), the delay left out (the lead design adds its phase) or as a
-  Pade approximant;
-- `frequency_response`: G_lag(j omega) on a grid, evaluated directly (the lead design's search);
-- `companion_matrices`: (A, B) of the realisation [y, y'] with unit gain, which the clothoid loop analysis
-  embeds in its plant (the gain and the delay, in whole periods, enter there);
-- `simulate` (and `simulate_lag`, the same on bare numbers, which the fit calls thousands of times): the response
-  to a sampled input, first-order hold, the delay as a shift of the input;
-- `state_derivatives`: the ODE right-hand side, written with + - * / only, so that floats, numpy arrays and
-  CasADi symbols all work (the MPC's kinematic-lag prediction model), the delay as a first-order Pade state;
-  `fastest_rate_per_s` is its fastest decay rate, which the MPC sizes its integration step with.
-
-The file is JSON:
-
-    {"format": "steering-lag/1", "omega_n_rad_s": 4.44, "zeta": 0.80, "delay_s": 0.0,
-     "steady_state_gain": 0.94, "nrmse": 0.03, "speed_range_mps": [8.2, 8.4], "source": "free text"}
-
-Required: format, omega_n_rad_s, zeta. Optional: delay_s (default 0), steady_state_gain (K, default 1), nrmse (fit
-quality: RMS error over the range of the measured curvature), speed_range_mps (the speeds the data covered),
-source. Any other key is an error, so that a misspelt key is not silently ignored.
+The file is JSON, {"format": "steering-lag/1", "omega_n_rad_s": ..., "zeta": ...}, optional delay_s (default 0),
+steady_state_gain (K, default 1), nrmse (fit quality: RMS error over the range of the measured curvature),
+speed_range_mps (the speeds the data covered) and source (free text). Any other key is an error, so that a
+misspelt key is not silently ignored.
 """
 
 from __future__ import annotations

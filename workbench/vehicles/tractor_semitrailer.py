@@ -39,14 +39,14 @@ from workbench.vehicles.blend import blend, blend_weight, check_blend_speeds, pu
 from workbench.vehicles.integration import rk4
 from workbench.vehicles.reference_point import reference_point, world_velocity
 from workbench.vehicles.single_track import PredictionParams, SingleTrackParams
-from workbench.vehicles.tyres import G_MPS2, magic_formula, relaxation_rate, slip_angle, steered_slip_angle
+from workbench.vehicles.tyres import COMMONROAD_G_MPS2, magic_formula, relaxation_rate, slip_angle, steered_slip_angle
 
 
 @dataclass(frozen=True)
 class TractorSemitrailerParams:
-    """A loaded 5-axle US tractor-semitrailer. Sources (see /work/shared/reference/vehicle-and-test-facts.md):
-    A = Auburn GAVLAB vehParams.m (5-axle rig, config 2 'loaded'); B = GOPS 7-DoF yaw-roll semitruck;
-    C = OpenPBS TractorSemitrailer6x2; D = CommonRoad vehicle 4. Distances along the unit's axis.
+    """A loaded 5-axle US tractor-semitrailer. Sources: A = Auburn GAVLAB vehParams.m (5-axle rig, config 2
+    'loaded'); B = GOPS 7-DoF yaw-roll semitruck (Semitruck7DoFParam); C = OpenPBS TractorSemitrailer6x2.mo;
+    D = CommonRoad vehicle 4 (parameters_vehicle4.yaml). Distances along the unit's axis.
     """
 
     # tractor
@@ -239,17 +239,18 @@ def derive(p: TractorSemitrailerParams) -> Derived:
         + sum(m * (x - e) ** 2 for m, x in parts2)
     )
     a, b = p.cg_to_front_axle_m - x1, p.cg_to_drive_axle_m + x1
-    king = m2 * G_MPS2 * (lt - e) / lt
+    king = m2 * COMMONROAD_G_MPS2 * (lt - e) / lt
     loads = (
-        m1 * G_MPS2 * b / l1 + king * hoff / l1,
-        m1 * G_MPS2 * a / l1 + king * (l1 - hoff) / l1,
-        m2 * G_MPS2 * e / lt,
+        m1 * COMMONROAD_G_MPS2 * b / l1 + king * hoff / l1,
+        m1 * COMMONROAD_G_MPS2 * a / l1 + king * (l1 - hoff) / l1,
+        m2 * COMMONROAD_G_MPS2 * e / lt,
     )
     for group, load in zip(("front", "drive", "trailer"), loads, strict=True):
-        if load < 0.05 * (m1 + m2) * G_MPS2:
+        if load < 0.05 * (m1 + m2) * COMMONROAD_G_MPS2:
             raise WorkbenchInputError(
-                f"the {group} axle group would carry {load / G_MPS2:.0f} kg, under 5% of the vehicle mass; check "
-                "cg_to_front_axle_m, cg_to_drive_axle_m, hitch_ahead_of_drive_m, hitch_to_trailer_cg_m, payload_*"
+                f"the {group} axle group would carry {load / COMMONROAD_G_MPS2:.0f} kg, under 5% of the vehicle "
+                "mass; check cg_to_front_axle_m, cg_to_drive_axle_m, hitch_ahead_of_drive_m, hitch_to_trailer_cg_m, "
+                "payload_*"
             )
     # quasi-static roll: sprung masses, their CG heights and roll-compliance lift per unit
     ms1, ms2 = p.tractor_sprung_mass_kg, p.trailer_sprung_mass_kg + p.payload_kg
@@ -263,12 +264,12 @@ def derive(p: TractorSemitrailerParams) -> Derived:
         ("trailer_roll_stiffness_nm_per_rad", ms2, hs2, k2),
     ):
         arm = max(hs - p.roll_axis_height_m, 0.0)
-        if k <= 1.2 * ms * G_MPS2 * arm:
+        if k <= 1.2 * ms * COMMONROAD_G_MPS2 * arm:
             raise WorkbenchInputError(
                 f"{name} too low for the sprung mass: the roll stiffness must exceed 1.2 x m g h = "
-                f"{1.2 * ms * G_MPS2 * arm:.4g} N m/rad (the unit would fall over standing still)"
+                f"{1.2 * ms * COMMONROAD_G_MPS2 * arm:.4g} N m/rad (the unit would fall over standing still)"
             )
-        heff.append(hs + arm * ms * G_MPS2 * arm / (k - ms * G_MPS2 * arm))
+        heff.append(hs + arm * ms * COMMONROAD_G_MPS2 * arm / (k - ms * COMMONROAD_G_MPS2 * arm))
     s1f = ms1 * p.cg_to_drive_axle_m / l1
     s2k = ms2 * (lt - xs2) / lt
     hu = p.unsprung_cg_height_m
@@ -279,7 +280,7 @@ def derive(p: TractorSemitrailerParams) -> Derived:
     )
     tracks = (p.front_track_m, p.dual_track_m, p.dual_track_m)
     coef = tuple((2 * mt / (t * w), 2 * ml / (t * w)) for (mt, ml), t, w in zip(moments, tracks, loads, strict=True))
-    threshold = 1.0 / max((c1 + c2) * G_MPS2 for c1, c2 in coef)
+    threshold = 1.0 / max((c1 + c2) * COMMONROAD_G_MPS2 for c1, c2 in coef)
     return Derived(m1, m2, a, b, e, i1, i2, loads, coef, threshold)
 
 

@@ -21,8 +21,12 @@ import math
 
 from numba import njit
 
-#: Gravitational acceleration (m/s^2) the models' axle loads are computed with.
-G_MPS2 = 9.81
+#: Gravitational acceleration (m/s^2) the vehicle models' axle loads are computed with: CommonRoad's rounded
+#: g = 9.81 (commonroad-vehicle-models, `vehicle_dynamics_st.py` and `vehicle_dynamics_mb.py`; Althoff &
+#: Wuersching, "CommonRoad: Vehicle Models", 2020), not standard gravity (9.80665, `scipy.constants.g`, which the
+#: speed profile, limits and tuning use): the cars take CommonRoad's parameters and match its models, and every
+#: plant computes its loads with the same g.
+COMMONROAD_G_MPS2 = 9.81
 
 
 @njit(cache=True)

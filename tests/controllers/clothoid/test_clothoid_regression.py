@@ -1,7 +1,7 @@
 """Regression of the clothoid controller on every vehicle model (issue 15): a tight corner (radius 15 m) followed by a
 150 m straight, and the ISO double lane change, each at 30 km/h asked.
 
-On each run the controller, with the vehicle's own tuning (`make_controller(..., vehicle=vehicle)`):
+On each run the controller, with the vehicle's own tuning (`tuned_controller(name, vehicle, config)`):
   - completes the run and tracks (max |CTE| under MAX_ABS_CTE_M, a generous bound: the reference controllers stay
     well under 0.1 m on both courses);
   - does not limit-cycle (`workbench.simulation.limit_cycle.detect_limit_cycle` on the steering wheel, the metric
@@ -23,8 +23,8 @@ import math
 
 import pytest
 
-from controllers import make_controller
 from controllers.mpc import NMPCConfig
+from tuning.own_tuning import tuned_controller
 from workbench.base.clothoid_chain import ClothoidChain
 from workbench.simulation.metrics import Metrics
 from workbench.simulation.scenarios import Scenario, ScenarioOptions, make_scenario
@@ -74,7 +74,7 @@ def _run(vehicle_name: str, scenario_name: str, controller_name: str) -> Metrics
     """The metrics of one run (each run once per session: the clothoid's and the reference's serve several tests)."""
     vehicle = make_vehicle(vehicle_name)
     config = REFERENCE_CONFIG.get(controller_name)
-    controller = make_controller(controller_name, vehicle.geometry, config, vehicle=vehicle)
+    controller = tuned_controller(controller_name, vehicle, config)
     result = Simulation(
         _scenario(scenario_name, vehicle_name), vehicle, controller, SimulationConfig(speed_kmh=SPEED_KMH)
     ).run()

@@ -16,9 +16,11 @@ from controllers.clothoid import (
     CurvatureLimits,
     FilterSchedule,
     LeadFilterParams,
-    write_filter_file,
 )
-from controllers.config_file import build_config
+from tuning.filter_file import write_filter_file
+from tuning.own_tuning import tuned_controller, tuning_for
+from tuning.tuning_dirs import shipped_tuning_root
+from workbench.apps.controller_config import build_config
 from workbench.base.clothoid_chain import ClothoidChain
 from workbench.base.errors import WorkbenchInputError
 from workbench.base.path import ReferencePath
@@ -26,6 +28,7 @@ from workbench.vehicles import KinematicBicycle, make_vehicle
 
 TRUCK = make_vehicle("tractor-semitrailer")
 GEOMETRY = TRUCK.geometry
+TRUCK_TUNING = tuning_for(TRUCK)
 BEND = ClothoidChain().straight(30.0).clothoid_to(1 / 30, 20.0).arc(60.0).to_path("bend")
 STRAIGHT = ReferencePath.from_xy(np.linspace(0.0, 100.0, 11), np.zeros(11), name="straight")
 
@@ -130,7 +133,9 @@ def test_lead_filter_leads_and_can_be_switched_off() -> None:
     Eq. 6 (DC gain 1, phase lead) it runs ahead of the ramp once the filter has settled."""
     commands = {}
     for use in (False, True):
-        config = ClothoidConfig(use_lead_filter=use, lookahead_mode="fixed", path_feedforward=False)
+        config = ClothoidConfig(
+            use_lead_filter=use, lookahead_mode="fixed", path_feedforward=False, tuning=TRUCK_TUNING
+        )
         controller = ClothoidController(GEOMETRY, config, vehicle=TRUCK)
         controller.reset(STRAIGHT, 0.02)
         commands[use] = [controller.step(_m(10.0, 1.0, 0.0, 8.0), STRAIGHT) for _ in range(25)]
@@ -148,13 +153,26 @@ def test_filter_file_is_read_and_a_schedule_follows_speed(tmp_path: Path) -> Non
     controller.reset(STRAIGHT, 0.02)
     controller.step(_m(10.0, 0.0, 0.0, 50.0 / 3.6), STRAIGHT)
     assert controller._filter.params == schedule.at_speed(50.0)
-    # Without a file: the steered vehicle's own (the truck's shipped schedule), none without a vehicle, and never
-    # DEFAULT_FILTER, the truck's old filter, for another vehicle.
-    own = ClothoidController(GEOMETRY, vehicle=TRUCK).filter_schedule
+    # Without a file: the tuning's (the truck's shipped schedule), none without a tuning, and never DEFAULT_FILTER,
+    # the truck's old filter, for another vehicle.
+    own = tuned_controller("clothoid", TRUCK).filter_schedule
     assert own is not None and len(own.speeds_kmh) > 1 and own.params != (DEFAULT_FILTER,)
+    assert own == TRUCK_TUNING.filter_schedule
     assert ClothoidController(GEOMETRY).filter_schedule is None
     car = make_vehicle("dynamic-bicycle")
-    assert ClothoidController(car.geometry, vehicle=car).filter_schedule.params != own.params
+    assert tuned_controller("clothoid", car).filter_schedule.params != own.params
+
+
+def test_a_vehicle_without_its_tuning_is_refused_and_a_tuning_directory_is_read() -> None:
+    """A controller built for a vehicle never runs untuned by mistake: the error names how to build it tuned. A
+    config file's `tuning_dir` is read at the boundary into the config's tuning."""
+    with pytest.raises(WorkbenchInputError, match=r"tractor-semitrailer.*tuned_controller"):
+        ClothoidController(GEOMETRY, ClothoidConfig(), vehicle=TRUCK)
+    assert tuned_controller("clothoid", TRUCK).tuning == TRUCK_TUNING
+    explicit = ClothoidConfig(tuning=tuning_for(make_vehicle("kinematic-bicycle")))
+    assert tuned_controller("clothoid", TRUCK, explicit).tuning == explicit.tuning  # a given tuning is kept
+    config = build_config(ClothoidConfig, {"tuning_dir": str(shipped_tuning_root() / "tractor-semitrailer")})
+    assert config.tuning == TRUCK_TUNING
 
 
 @pytest.mark.parametrize(
@@ -209,7 +227,7 @@ def test_the_analysis_floor_keeps_the_margins_at_every_lookahead_the_controller_
     at that floor the loop keeps 45 deg and 6 dB; with the margins set to 0 there is no floor."""
     from controllers.clothoid.loop_analysis import loop_margins
 
-    controller = ClothoidController(GEOMETRY, vehicle=TRUCK)
+    controller = ClothoidController(GEOMETRY, ClothoidConfig(tuning=TRUCK_TUNING))
     controller.reset(BEND, 0.02)
     controller.step(_m(40.0, 0.0, 0.0, 8.0), BEND)
     floor = controller.diagnostics["lookahead_floor_m"]
@@ -219,7 +237,9 @@ def test_the_analysis_floor_keeps_the_margins_at_every_lookahead_the_controller_
     lags, settings = controller.plant_lags(speed_kmh), controller.loop_settings(speed_kmh)
     for lookahead in np.arange(floor, 20.0 + 1e-9, 1.0):
         assert loop_margins(lags, settings, speed_kmh / 3.6, float(lookahead)).meets(45.0, 6.0)
-    free = ClothoidController(GEOMETRY, ClothoidConfig(min_phase_margin_deg=0.0, min_gain_margin_db=0.0), vehicle=TRUCK)
+    free = ClothoidController(
+        GEOMETRY, ClothoidConfig(min_phase_margin_deg=0.0, min_gain_margin_db=0.0, tuning=TRUCK_TUNING)
+    )
     free.reset(BEND, 0.02)
     free.step(_m(40.0, 0.0, 0.0, 8.0), BEND)
     assert free.diagnostics["lookahead_floor_m"] == 5.0

@@ -12,8 +12,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from controllers.base import Measurement
-from controllers.config_file import build_config
 from controllers.mpc import LMPCConfig, LMPCController, NMPCConfig, NMPCController, SolveStatus
+from workbench.apps.controller_config import build_config
 from workbench.base.clothoid_chain import ClothoidChain
 from workbench.base.errors import WorkbenchInputError
 from workbench.simulation.scenarios import Scenario, ScenarioOptions, make_scenario

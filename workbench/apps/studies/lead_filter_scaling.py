@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import dataclasses
 
-from controllers.clothoid.filter_file import DEFAULT_FILTER, FilterSchedule
+from controllers.clothoid.filter_schedule import DEFAULT_FILTER, FilterSchedule
 from controllers.clothoid.lead_filter import LeadFilterParams
 from workbench.base.errors import WorkbenchInputError, require_positive, value_text
 

@@ -30,6 +30,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import pandas as pd
 
+from tuning.limits_file import write_limits_file
 from workbench.apps.studies.backends import Backend, LocalBackend
 from workbench.apps.studies.results import SweepResult
 from workbench.apps.studies.runner import build_controller_config
@@ -93,7 +94,8 @@ def _write_object(folder: Path, value: Any) -> str | None:
     """Write an object a file option was read into beside the config (its file's name), or None when it has no
     file form (a vehicle's single-track equivalent)."""
     from controllers.clothoid.curvature_limits import CurvatureLimits
-    from controllers.clothoid.filter_file import FilterSchedule, write_filter_file
+    from controllers.clothoid.filter_schedule import FilterSchedule
+    from tuning.filter_file import write_filter_file
     from workbench.vehicles.steering_lag import SteeringLag, write_lag_file
 
     if isinstance(value, FilterSchedule):
@@ -102,7 +104,7 @@ def _write_object(folder: Path, value: Any) -> str | None:
         )
         return BEST_FILTER
     if isinstance(value, CurvatureLimits):
-        value.write_csv(folder / BEST_LIMITS)
+        write_limits_file(value, folder / BEST_LIMITS)
         return BEST_LIMITS
     if isinstance(value, SteeringLag):
         write_lag_file(value, folder / BEST_LAG)
@@ -114,7 +116,7 @@ def write_controller_config(path: Path, controller: str, config: Any, header: st
     """Write every field of a controller config as a controller-config TOML file (one [controller] table; None
     as "none"; paths inside the file's folder relative to it, others absolute); an object a file option was read
     into (`FILE_OPTIONS`) is written to a file beside it and named by that option; return the path."""
-    from controllers.config_file import FILE_OPTIONS
+    from workbench.apps.controller_config import FILE_OPTIONS
 
     file_keys = {option.field: name for name, option in FILE_OPTIONS.items()}
     lines = [f"# {line}" for line in header.splitlines()] + ["", f"[{controller}]"]

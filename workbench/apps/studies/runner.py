@@ -3,7 +3,7 @@ status, message).
 
 The run is built as `workbench run` builds one: the vehicle (with its payload), the scenario sized for it (with
 the initial offset and heading error), the controller's options from the controller-config file and the run's
-options on top (`controllers.config_file.read_controller_config`, the `--set KEY=VALUE` path), the lead filter
+options on top (`workbench.apps.controller_config.read_controller_config`, the `--set KEY=VALUE` path), the lead filter
 scaled when asked (`lead_filter_scaling.py`), then `Simulation(...).run()`. Nothing in it
 is random, so the same PlannedRun gives the same row, bit for bit, on any worker, except the wall-clock fields
 (TIMING_COLUMNS). One exception: the MPCs drop a solve that overruns its wall-clock budget (`max_solve_time_s`,
@@ -24,8 +24,8 @@ import traceback
 from typing import Any
 
 from controllers import CONTROLLERS, make_controller
-from controllers.clothoid.vehicle_tuning import tuning_for
-from controllers.config_file import read_controller_config
+from tuning.own_tuning import with_vehicle_tuning
+from workbench.apps.controller_config import read_controller_config
 from workbench.apps.studies.lead_filter_scaling import scaled_filter
 from workbench.apps.studies.spec import EXTRA_RUN_PARAMETERS, LEAD_FILTER_SCALES, PlannedRun
 from workbench.simulation.metrics import METRIC_KEYS
@@ -66,9 +66,12 @@ def build_controller_config(run: PlannedRun, vehicle: VehicleModel | None = None
     overrides = [f"{key}={option_text(value)}" for key, value in options.items()]
     geometry = vehicle.geometry if vehicle is not None else None
     config = read_controller_config(run.controller_config, run.controller, config_type, overrides, geometry)
+    if vehicle is not None:
+        config = with_vehicle_tuning(config, vehicle)
     zero, pole = (scales.get(k, 1.0) for k in LEAD_FILTER_SCALES)
     if zero != 1.0 or pole != 1.0:
-        own = tuning_for(vehicle).filter_schedule if vehicle is not None and config.lead_filter is None else None
+        tuning = getattr(config, "tuning", None)
+        own = tuning.filter_schedule if tuning is not None and config.lead_filter is None else None
         config = dataclasses.replace(config, lead_filter=scaled_filter(config.lead_filter, zero, pole, own))
     return config
 

@@ -1,49 +1,23 @@
 """A study spec (TOML) and the runs it plans: which scenarios, controllers and vehicles, over which parameter grids
 and seeded random draws; for `workbench optimise` also the objective and the search space.
 
-    [study]
-    scenarios = ["dlc"]                     # names (`workbench scenarios`) or waypoint files
-    controllers = ["clothoid"]              # registered names (`workbench controllers`)
-    vehicles = ["tractor-semitrailer"]      # preset names (`workbench vehicles`) or vehicle TOML files
-    # controller_config = "options.toml"    # as `workbench run --controller-config`; the spec's options go on top
-    # track_file = "Zandvoort.csv"          # for the zandvoort scenario
-    # seed = 0                              # of the random draws
-    # samples = 20                          # random draws; required with [random], not allowed without
-    # max_runs = 100000                     # refuse a larger study (default DEFAULT_MAX_RUNS; `--max-runs N`)
-
-    [grid]                                  # run parameters: a list is an axis, a single value is fixed
-    speed_kmh = [20, 30, 40]
-    initial_offset_m = [0.0, 0.5]
-
-    [grid.clothoid]                         # options of one controller (its config fields), on its runs only
-    frechet_threshold_m = [0.01, 0.02, 0.05]
-
-    [random]                                # run parameters drawn `samples` times (`distributions.py`)
-    payload_kg = { uniform = [0, 17000] }
-
-    [random.clothoid]
-    lead_filter_pole_scale = { uniform = [0.8, 1.25] }
-
-Run parameters (RUN_PARAMETERS) are the fields of `SimulationConfig` (speed_kmh, max_lateral_accel_g,
-controller_rate_hz, plant_rate_hz, laps, max_time_s, ...), payload_kg (vehicles with a payload),
-initial_offset_m (m, left of the path positive) and initial_heading_error_deg (deg): omitted, the scenario's own
-(fig17 starts 1.0 m left of the path). Controller parameters are the controller's options (`workbench controllers
---show NAME`) and, for a controller that reads a lead filter (`filter_file`), lead_filter_zero_scale and
-lead_filter_pole_scale: factors on the filter's zero and pole frequencies (`lead_filter_scaling.py`).
+The format, tables [study], [grid], [grid.NAME], [random], [random.NAME] and [optimise] (with its objective and
+search), is described with an example in README.md ("Studies: sweeps and optimisation"). Run parameters
+(RUN_PARAMETERS) are the fields of `SimulationConfig`, payload_kg, initial_offset_m and initial_heading_error_deg
+(omitted: the scenario's own). Controller parameters are the controller's options and, for a controller that
+reads a lead filter, lead_filter_zero_scale and lead_filter_pole_scale (`lead_filter_scaling.py`).
 
 Planned runs are the product, per scenario, vehicle and controller, of the run-parameter axes, that controller's
 axes and the random samples (draw i of every key together). Each run's id is a hash of its canonical parameters
 (files by their path relative to the spec and a hash of their content), so the same run always has the same id
 and a restarted or extended study finds the runs it already has.
 
-The spec is checked before any run starts: unknown tables and keys, unknown names, missing files, empty lists,
-NaN, wrong types and misplaced keys are WorkbenchInputError naming the key and what is allowed. Every file the
-spec names is read as the runs will read it (`_check_files`): the controller-config file (its keys and values, for
-each controller), vehicle files, waypoint files, the track file, and the files the controllers' options name
-(lead filters, limits, lags, vehicle files, from the config file or the grid). A study planning more runs than
-max_runs (counted from the axes' sizes, `run_count`, before anything is planned; an optimisation: trials x runs)
-is refused saying how many. A value that a run's vehicle, scenario, simulation or controller refuses only in
-combination (out of range, inconsistent) is that run's error.
+The spec is checked before any run starts, so that a mistake costs no runs: unknown tables, keys and names,
+missing files, empty lists, NaN and wrong types are WorkbenchInputError naming the key and what is allowed; every
+file the spec names is read as the runs will read it (`_check_files`); a study planning more than max_runs runs
+(`run_count`, from the axes' sizes, before anything is planned; an optimisation: trials x runs) is refused saying
+how many. A value refused only in combination (by the run's vehicle, scenario, simulation or controller) is that
+run's error.
 """
 
 from __future__ import annotations
@@ -117,7 +91,7 @@ def controller_parameters(controller: str) -> dict[str, Any]:
     """The parameters of a controller's runs and their types: its config options (`option_types`: a file option
     such as filter_file in place of the object it is read into), and the lead-filter scales when it reads a lead
     filter."""
-    from controllers.config_file import option_types
+    from workbench.apps.controller_config import option_types
 
     params = option_types(CONTROLLERS[controller].config_type)
     if "filter_file" in params:
@@ -496,7 +470,7 @@ class StudySpec:
         """Read every file the runs will read, as they will: the controller-config file for each controller
         (its keys and values), waypoint and track files, and each file a controller option names (in the config
         file, the grid or a choice). A WorkbenchInputError names the key and the file."""
-        from controllers.config_file import read_controller_config
+        from workbench.apps.controller_config import read_controller_config
         from workbench.simulation.scenarios import make_scenario
 
         for scenario in self.scenarios:
@@ -670,7 +644,7 @@ def _vehicle_models(vehicles: Sequence[str]) -> dict[str, Any]:
 def _check_option_file(where: str, key: str, path: Path, geometry: Any) -> None:
     """Read a file a controller option names, as the controller will (lead filters, curvature limits, steering
     lags, vehicle files); any other file must at least be readable."""
-    from controllers.config_file import FILE_OPTIONS
+    from workbench.apps.controller_config import FILE_OPTIONS
 
     label = f"{where}: {path}"
     check_input_file(path, label)

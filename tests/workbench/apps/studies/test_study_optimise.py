@@ -12,10 +12,11 @@ import pytest
 from study_helpers import SerialBackend, write_spec
 
 from controllers import CONTROLLERS
-from controllers.clothoid.filter_file import DEFAULT_FILTER, FilterSchedule, read_filter_file
-from controllers.clothoid.vehicle_tuning import tuning_for
-from controllers.config_file import read_controller_config
+from controllers.clothoid.filter_schedule import DEFAULT_FILTER, FilterSchedule
+from tuning.filter_file import read_filter_file
+from tuning.own_tuning import tuning_for
 from workbench.apps.cli import main
+from workbench.apps.controller_config import read_controller_config
 from workbench.apps.studies import LocalBackend, load_spec, run_optimisation
 from workbench.apps.studies.optimise import trial_value, write_controller_config
 from workbench.vehicles import make_vehicle

@@ -10,8 +10,8 @@ import pytest
 from study_helpers import write_spec
 
 from controllers import CONTROLLERS, make_controller
-from controllers.clothoid.filter_file import DEFAULT_FILTER
-from controllers.config_file import read_controller_config
+from controllers.clothoid.filter_schedule import DEFAULT_FILTER
+from workbench.apps.controller_config import read_controller_config
 from workbench.apps.studies import PlannedRun, execute_run, load_spec
 from workbench.apps.studies.runner import ROW_METRICS, build_controller_config, option_text, simulate
 from workbench.simulation.scenarios import ScenarioOptions, make_scenario

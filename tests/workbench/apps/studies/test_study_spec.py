@@ -8,7 +8,8 @@ from pathlib import Path
 import pytest
 from study_helpers import write_spec
 
-from controllers.clothoid.filter_file import DEFAULT_FILTER, write_filter_file
+from controllers.clothoid.filter_schedule import DEFAULT_FILTER
+from tuning.filter_file import write_filter_file
 from workbench.apps.studies import load_spec
 from workbench.apps.studies.distributions import Distribution, key_rng
 from workbench.base.errors import WorkbenchInputError

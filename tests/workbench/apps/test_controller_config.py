@@ -9,8 +9,9 @@ import pytest
 
 from controllers import CONTROLLERS
 from controllers.clothoid import ClothoidConfig
-from controllers.clothoid.filter_file import DEFAULT_FILTER, read_filter_file, write_filter_file
-from controllers.config_file import build_config, config_template, read_controller_config
+from controllers.clothoid.filter_schedule import DEFAULT_FILTER
+from tuning.filter_file import read_filter_file, write_filter_file
+from workbench.apps.controller_config import build_config, config_template, read_controller_config
 from workbench.base.errors import WorkbenchInputError
 
 

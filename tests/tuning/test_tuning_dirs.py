@@ -14,27 +14,26 @@ import pytest
 
 import tuning.preset_tuning as preset_tuning
 from controllers.clothoid.curvature_limits import CurvatureLimits
-from controllers.clothoid.filter_file import DEFAULT_FILTER, FilterSchedule, read_filter_file
+from controllers.clothoid.filter_schedule import DEFAULT_FILTER, FilterSchedule
 from controllers.clothoid.lead_filter import LeadFilterParams
-from controllers.clothoid.vehicle_tuning import (
+from controllers.clothoid.vehicle_tuning import VehicleTuning
+from tuning.cli import _parser as tuning_parser
+from tuning.filter_file import read_filter_file
+from tuning.lag_fit import DELAY_FIT_MAX_ZETA
+from tuning.own_tuning import cache_key, generate_vehicle_tuning, tuning_for
+from tuning.preset_tuning import PRESET_TUNING_OPTIONS, PresetTuningOptions, regenerate_command
+from tuning.tuning_dirs import (
     CACHE_ENV,
     LEAD_FILE,
     LIMITS_FILE,
     MANIFEST_FILE,
     VEHICLE_FILE,
-    VehicleTuning,
-    cache_key,
     canonical_vehicle_toml,
-    generate_vehicle_tuning,
     params_sha256,
     read_manifest,
     read_vehicle_tuning,
     shipped_tuning_root,
-    tuning_for,
 )
-from tuning.cli import _parser as tuning_parser
-from tuning.lag_fit import DELAY_FIT_MAX_ZETA
-from tuning.preset_tuning import PRESET_TUNING_OPTIONS, PresetTuningOptions, regenerate_command
 from workbench.base.errors import WorkbenchInputError
 from workbench.vehicles import list_presets, make_vehicle, preset_text
 from workbench.vehicles.presets import params_from_toml

@@ -28,7 +28,7 @@ from workbench.base.input_files import read_toml
 from workbench.base.typed_tables import field_types, typed_value
 
 if TYPE_CHECKING:
-    from workbench.vehicles.base import VehicleGeometry
+    from workbench.vehicles.geometry import VehicleGeometry
 
 
 @dataclass(frozen=True)
@@ -43,15 +43,21 @@ class FileOption:
 
 
 def _lead_filter(path: Path, _geometry: VehicleGeometry | None) -> Any:
-    from controllers.clothoid.filter_file import read_filter_file
+    from tuning.filter_file import read_filter_file
 
     return read_filter_file(path)
 
 
 def _curvature_limits(path: Path, geometry: VehicleGeometry | None) -> Any:
-    from controllers.clothoid.curvature_limits import CurvatureLimits
+    from tuning.limits_file import read_limits_file
 
-    return CurvatureLimits.read_csv(path, geometry)
+    return read_limits_file(path, geometry)
+
+
+def _tuning(path: Path, _geometry: VehicleGeometry | None) -> Any:
+    from tuning.tuning_dirs import read_vehicle_tuning
+
+    return read_vehicle_tuning(path)
 
 
 def _lag(path: Path, _geometry: VehicleGeometry | None) -> Any:
@@ -68,6 +74,7 @@ def _prediction_vehicle(path: Path, _geometry: VehicleGeometry | None) -> Any:
 
 #: The file options, by the name a config file or `--set` uses.
 FILE_OPTIONS: dict[str, FileOption] = {
+    "tuning_dir": FileOption("tuning", _tuning),
     "filter_file": FileOption("lead_filter", _lead_filter),
     "limits_file": FileOption("curvature_limits", _curvature_limits),
     "lag_file": FileOption("lag", _lag),

@@ -14,14 +14,9 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from controllers.clothoid.filter_file import (
-    DEFAULT_FILTER,
-    FORMAT_TAG,
-    FilterSchedule,
-    read_filter_file,
-    write_filter_file,
-)
+from controllers.clothoid.filter_schedule import DEFAULT_FILTER, FilterSchedule
 from controllers.clothoid.lead_filter import LeadFilterParams
+from tuning.filter_file import FORMAT_TAG, read_filter_file, write_filter_file
 from workbench.base.errors import WorkbenchInputError
 
 SLOW, FAST = LeadFilterParams(5.0, 0.7, 15.0), LeadFilterParams(3.0, 0.9, 12.0)

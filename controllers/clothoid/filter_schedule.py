@@ -1,0 +1,74 @@
+"""Lead filters against speed (`FilterSchedule`): what the clothoid controller's lead filter (Eq. 6) is at each
+speed, interpolated between the speeds it was designed for. Its file format is `tuning/filter_file.py`."""
+
+from __future__ import annotations
+
+import bisect
+import itertools
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from types import MappingProxyType
+from typing import Any
+
+from controllers.clothoid.lead_filter import LeadFilterParams
+from workbench.base.errors import WorkbenchInputError, require_in_range
+
+PARAM_KEYS = ("omega_z_rad_s", "psi", "omega_p_rad_s")
+SPEED_RANGE_KMH = (0.0, 300.0)
+
+#: The default filter until `tuning` has identified the user's vehicle: Eq. 6 designed by `from_lag` (zeros on the
+#: lag's poles, triple pole at 3 wn = 13.32 rad/s) for the lag of this repository's loaded tractor-semitrailer preset
+#: at 30 km/h, which a fit of Eq. 5 gave as omega_n = 4.44 rad/s, zeta = 0.80.
+DEFAULT_FILTER = LeadFilterParams.from_lag(4.44, 0.80)
+
+
+@dataclass(frozen=True)
+class FilterSchedule:
+    """Lead filters against speed: speeds_kmh (km/h, strictly increasing; one entry: the same filter at every
+    speed) and one LeadFilterParams per speed. metadata holds the file's other content (source, plant, design...)."""
+
+    speeds_kmh: tuple[float, ...]
+    params: tuple[LeadFilterParams, ...]
+    source: str = ""
+    metadata: Mapping[str, Any] = field(default_factory=dict, compare=False, repr=False)
+
+    def __post_init__(self) -> None:
+        speeds, params = tuple(self.speeds_kmh), tuple(self.params)
+        if not speeds or len(speeds) != len(params):
+            raise WorkbenchInputError(
+                f"a filter schedule needs one filter per speed and at least one; got {len(speeds)} speeds and "
+                f"{len(params)} filters"
+            )
+        for i, (speed, p) in enumerate(zip(speeds, params, strict=True)):
+            require_in_range(f"schedule[{i}].speed_kmh", speed, *SPEED_RANGE_KMH, "km/h")
+            if not isinstance(p, LeadFilterParams):
+                raise WorkbenchInputError(f"schedule[{i}] must be LeadFilterParams; got {p!r}")
+        if any(b <= a for a, b in itertools.pairwise(speeds)):
+            raise WorkbenchInputError(f"schedule speeds_kmh must be strictly increasing; got {list(speeds)}")
+        object.__setattr__(self, "speeds_kmh", tuple(float(s) for s in speeds))
+        object.__setattr__(self, "params", params)
+        object.__setattr__(self, "metadata", MappingProxyType(dict(self.metadata)))
+
+    @classmethod
+    def single(cls, params: LeadFilterParams, speed_kmh: float = 0.0, source: str = "") -> FilterSchedule:
+        """One filter for every speed (speed_kmh, km/h, is only its label)."""
+        return cls((speed_kmh,), (params,), source)
+
+    def at_speed(self, speed_kmh: float) -> LeadFilterParams:
+        """The filter at speed_kmh (km/h): each parameter interpolated linearly in speed, clamped at the ends.
+        (The parameter ranges and wp / wz bounds are convex, so interpolated filters are valid too.)"""
+        speeds = self.speeds_kmh
+        if not math.isfinite(speed_kmh):
+            raise WorkbenchInputError(f"speed_kmh must be a finite number; got {speed_kmh!r}")
+        i = bisect.bisect_left(speeds, speed_kmh)
+        if i < len(speeds) and speeds[i] == speed_kmh:
+            return self.params[i]
+        if i == 0:
+            return self.params[0]
+        if i == len(speeds):
+            return self.params[-1]
+        t = (speed_kmh - speeds[i - 1]) / (speeds[i] - speeds[i - 1])
+        lo, hi = self.params[i - 1], self.params[i]
+        values = ((getattr(lo, k), getattr(hi, k)) for k in PARAM_KEYS)
+        return LeadFilterParams(*(min(max(a + t * (b - a), min(a, b)), max(a, b)) for a, b in values))

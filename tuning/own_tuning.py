@@ -1,0 +1,193 @@
+"""A vehicle's own clothoid-controller tuning (lead filter, curvature limits, identified lags), found or made on
+first use, and the controller built with it.
+
+`tuning_for(vehicle)` gives the vehicle's own tuning, never another vehicle's: the shipped directory of the preset
+whose parameters it has (`workbench/presets/tuning/<preset>/`, made by `python -m tuning.preset_tuning`; the
+manifest records the parameters' hash), else its own in a user cache (`$WORKBENCH_TUNING_CACHE`, else
+`$XDG_CACHE_HOME/lateral-workbench/tuning`), one directory per vehicle and tuning options named by the sha256 of
+both. On first use the cache directory is made by the same chain the `tuning` commands run, in a temporary
+directory renamed into place when complete, so that concurrent sweep workers never see half a tuning; if that
+fails, the error names the `tuning` commands to run by hand.
+
+The payload is left out of a vehicle's identity (set to its preset's before comparing or hashing): the lag hardly
+depends on it, so a truck with another payload uses the preset's filter; its rollover limits are those at the
+preset's payload, conservative for a lighter truck and a little optimistic for a heavier one.
+
+`tuned_controller(name, vehicle)` is how the applications build a controller: the clothoid controller's config
+gets the vehicle's tuning (`ClothoidConfig.tuning`), so the controller itself reads no file.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import json
+import os
+import shlex
+import shutil
+import sys
+import tempfile
+import time
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from controllers.clothoid.controller import ClothoidConfig
+from controllers.clothoid.vehicle_tuning import VehicleTuning
+from tuning.preset_tuning import (
+    PRESET_TUNING_OPTIONS,
+    SECONDS_PER_SPEED,
+    PresetTuningOptions,
+    options_dict,
+    tuning_commands,
+    write_tuning_files,
+)
+from tuning.tuning_dirs import (
+    LEAD_FILE,
+    LIMITS_FILE,
+    MANIFEST_FILE,
+    VEHICLE_FILE,
+    cache_dir,
+    canonical_vehicle_toml,
+    params_sha256,
+    read_vehicle_tuning,
+    shipped_index,
+)
+from workbench.base.errors import WorkbenchInputError
+from workbench.vehicles.base import VehicleModel
+
+if TYPE_CHECKING:
+    from controllers.base import Controller
+
+
+def cache_key(vehicle: VehicleModel, options: PresetTuningOptions) -> str:
+    """Name of the vehicle's cache directory: sha256 of its canonical parameters and of the tuning options resolved
+    for it (so that changed options make a new tuning rather than reuse one made with the old)."""
+    text = canonical_vehicle_toml(vehicle) + json.dumps(options_dict(options, vehicle.name), sort_keys=True)
+    return hashlib.sha256(text.encode("utf-8")).hexdigest()
+
+
+def shipped_tuning_dir(vehicle: VehicleModel, options: PresetTuningOptions | None = None) -> Path | None:
+    """The shipped tuning made for exactly this vehicle (payload aside) and these options, or None."""
+    options = options or PRESET_TUNING_OPTIONS
+    key = (params_sha256(vehicle), json.dumps(options_dict(options, vehicle.name), sort_keys=True))
+    return shipped_index().get(key)
+
+
+def _stale_preset_hint(vehicle: VehicleModel) -> str:
+    """When a shipped tuning was made for this vehicle with other options: how to bring it up to date."""
+    digest = params_sha256(vehicle)
+    for (params_digest, _), directory in shipped_index().items():
+        if params_digest == digest:
+            return (
+                f" (the shipped tuning in {directory} was made for it with other options: "
+                f"`python -m tuning.preset_tuning --only {directory.name}` brings it up to date)"
+            )
+    return ""
+
+
+def manual_instructions(vehicle: VehicleModel, options: PresetTuningOptions, vehicle_file: str) -> str:
+    """The `tuning` commands that make this vehicle's files by hand, and the options that then use them."""
+
+    commands = tuning_commands(vehicle, ["--vehicle-file", vehicle_file], options.for_model(vehicle.name))
+    return (
+        "make them by hand: "
+        + " && ".join(f"`{shlex.join(c)}`" for c in commands)
+        + f", then pass the controller options filter_file = {LEAD_FILE!r} and limits_file = {LIMITS_FILE!r} "
+        f"(e.g. --set filter_file={LEAD_FILE} --set limits_file={LIMITS_FILE})"
+    )
+
+
+def generate_vehicle_tuning(vehicle: VehicleModel, directory: str | Path, options: PresetTuningOptions) -> Path:
+    """Make the vehicle's tuning in `directory` (which must not exist yet) by the tuning chain, atomically: in a
+    temporary sibling directory renamed to `directory` when complete. If another process completed it first, its
+    files are kept. Returns `directory`."""
+
+    target = Path(directory)
+    target.parent.mkdir(parents=True, exist_ok=True)
+    work = Path(tempfile.mkdtemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent))
+    try:
+        (work / VEHICLE_FILE).write_text(canonical_vehicle_toml(vehicle), encoding="utf-8")
+        write_tuning_files(vehicle, work, options, vehicle_args=["--vehicle-file", VEHICLE_FILE], preset=None)
+        try:
+            os.rename(work, target)
+        except OSError:
+            if not (target / MANIFEST_FILE).is_file():
+                raise
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+    return target
+
+
+def _estimate_s(vehicle: VehicleModel, options: PresetTuningOptions) -> float:
+
+    resolved = options.for_model(vehicle.name)
+    return SECONDS_PER_SPEED.get(vehicle.name, 60.0) * len(resolved.schedule_speeds_kmh)
+
+
+def _duration(seconds: float) -> str:
+    return f"{seconds:.0f} s" if seconds < 120 else f"{seconds / 60:.0f} min"
+
+
+def tuning_for(vehicle: VehicleModel, options: PresetTuningOptions | None = None) -> VehicleTuning:
+    """The tuning the clothoid controller uses for `vehicle` (module docstring): the shipped files of the preset it
+    equals (payload aside), else its own from the cache, generated there on first use. options: the tuning options
+    (default `tuning.preset_tuning.PRESET_TUNING_OPTIONS`, those the shipped files were made with)."""
+    options = options or PRESET_TUNING_OPTIONS
+    shipped = shipped_tuning_dir(vehicle, options)
+    if shipped is not None:
+        return read_vehicle_tuning(shipped)
+    base = cache_dir()
+    key = cache_key(vehicle, options)
+    directory = base / key
+    if (directory / MANIFEST_FILE).is_file():
+        return read_vehicle_tuning(directory)
+    estimate = _estimate_s(vehicle, options)
+    print(
+        f"lateral-workbench: no clothoid-controller tuning yet for this {vehicle.name} (params sha256 "
+        f"{params_sha256(vehicle)[:12]}): identifying its lag and designing its lead filter and limits by the "
+        f"tuning chain into {directory}, once (about {_duration(estimate)}){_stale_preset_hint(vehicle)}",
+        file=sys.stderr,
+        flush=True,
+    )
+    start = time.perf_counter()
+    try:
+        generate_vehicle_tuning(vehicle, directory, options)
+    except (WorkbenchInputError, OSError) as exc:
+        vehicle_file = base / f"{key}.{VEHICLE_FILE}"
+        try:
+            vehicle_file.parent.mkdir(parents=True, exist_ok=True)
+            vehicle_file.write_text(canonical_vehicle_toml(vehicle), encoding="utf-8")
+            named = str(vehicle_file)
+        except OSError:
+            named = "YOUR_VEHICLE.toml"
+        raise WorkbenchInputError(
+            f"no clothoid-controller tuning for this {vehicle.name}, and generating it in {directory} failed: "
+            f"{exc}; {manual_instructions(vehicle, options, named)}"
+        ) from None
+    print(
+        f"lateral-workbench: tuning of this {vehicle.name} done in {time.perf_counter() - start:.0f} s",
+        file=sys.stderr,
+        flush=True,
+    )
+    return read_vehicle_tuning(directory)
+
+
+# ---- the controller with its vehicle's tuning ------------------------------------------------------------------
+
+
+def with_vehicle_tuning(config: object, vehicle: VehicleModel) -> object:
+    """`config` with the vehicle's own tuning (`tuning_for`) when it is a ClothoidConfig without one; any other
+    config as it is."""
+    if isinstance(config, ClothoidConfig) and config.tuning is None:
+        return dataclasses.replace(config, tuning=tuning_for(vehicle))
+    return config
+
+
+def tuned_controller(name: str, vehicle: VehicleModel, config: object | None = None) -> Controller:
+    """The controller registered under `name` for `vehicle`, its config (the default when None) given the
+    vehicle's own tuning where it takes one (the clothoid controller): how the applications build controllers."""
+    from controllers import CONTROLLERS, make_controller
+
+    if config is None and name in CONTROLLERS:
+        config = CONTROLLERS[name].config_type()
+    return make_controller(name, vehicle.geometry, with_vehicle_tuning(config, vehicle), vehicle=vehicle)

@@ -1,0 +1,222 @@
+"""A vehicle's clothoid-controller tuning directory: its files (the README's "Tuning directories"), the vehicle's
+identity it is made for (its canonical parameters and their sha256, the payload set to its preset's: the lag
+hardly depends on it), where the shipped and the cached directories live, and reading one into a `VehicleTuning`.
+Which directory a vehicle gets, and making one, is `own_tuning.py`."""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+import hashlib
+import json
+import math
+from collections.abc import Mapping
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+from controllers.clothoid.filter_schedule import FilterSchedule
+from controllers.clothoid.vehicle_tuning import VehicleTuning
+from controllers.config_checks import shown_all
+from tuning.filter_file import read_filter_file
+from tuning.limits_file import read_limits_file
+from workbench.base.errors import WorkbenchInputError, value_text
+from workbench.base.input_files import read_json
+from workbench.base.user_cache import user_cache_dir
+from workbench.vehicles.base import VehicleModel
+from workbench.vehicles.presets import MODEL_TYPES, params_from_toml, preset_text
+from workbench.vehicles.steering_lag import SteeringLag
+
+#: Environment variable naming the directory generated tunings are cached in.
+CACHE_ENV = "WORKBENCH_TUNING_CACHE"
+MANIFEST_FORMAT = "vehicle-tuning/1"
+LEAD_FILE = "lead.json"
+LIMITS_FILE = "limits.csv"
+MANIFEST_FILE = "manifest.json"
+VEHICLE_FILE = "vehicle.toml"
+MANIFEST_KEYS = (
+    "format",
+    "vehicle",
+    "preset",
+    "params_sha256",
+    "options",
+    "commands",
+    "dropped_speeds",
+    "notes",
+    "package_version",
+    "date",
+    "generation_time_s",
+)
+PAYLOAD_FIELD = "payload_kg"
+LAG_KEYS = ("speed_kmh", "omega_n_rad_s", "zeta")
+#: The per_speed keys of the measured lag (prefix + the path lag's key); the first two are required for it.
+MEASURED_PREFIX = "measured_"
+MEASURED_LAG_KEYS = ("measured_omega_n_rad_s", "measured_zeta")
+
+
+# ---- the vehicle's identity -------------------------------------------------------------------------------------
+
+
+@functools.cache
+def _preset_payload_kg(model_type: str) -> float | None:
+    """The payload of the preset of this model type (None for a model without one)."""
+    _, params = params_from_toml(preset_text(model_type), f"preset {model_type!r}")
+    return getattr(params, PAYLOAD_FIELD, None)
+
+
+def reference_params(vehicle: VehicleModel) -> Any:
+    """The vehicle's parameters dataclass with the payload (of a vehicle that carries one) set to its preset's:
+    what its tuning is made for (module docstring)."""
+    params = getattr(vehicle, "params", None)
+    name = getattr(vehicle, "name", None)
+    if name not in MODEL_TYPES or not dataclasses.is_dataclass(params) or not isinstance(params, MODEL_TYPES[name][1]):
+        raise WorkbenchInputError(
+            f"cannot tell which tuning vehicle {vehicle!r} needs: vehicle-aware tuning needs a model of "
+            f"{', '.join(MODEL_TYPES)} with its params dataclass; pass filter_file and limits_file instead"
+        )
+    payload = _preset_payload_kg(name)
+    if payload is not None and getattr(params, PAYLOAD_FIELD) != payload:
+        params = dataclasses.replace(params, **{PAYLOAD_FIELD: payload})
+    return params
+
+
+def canonical_vehicle_toml(vehicle: VehicleModel) -> str:
+    """The vehicle's reference parameters as a vehicle file (every field, in declaration order, floats by repr):
+    one text per vehicle, hashed for its identity and written as the cache's vehicle.toml."""
+    params = reference_params(vehicle)
+    lines = ["# canonical parameters (payload set to the preset's) of a vehicle tuned by tuning_for", "[model]"]
+    lines += [f'type = "{vehicle.name}"', "", "[parameters]"]
+    for f in dataclasses.fields(params):
+        value = getattr(params, f.name)
+        lines.append(f"{f.name} = {value!r}")
+    text = "\n".join(lines) + "\n"
+    params_from_toml(text, "canonical vehicle file")  # it must read back as the same vehicle
+    return text
+
+
+def params_sha256(vehicle: VehicleModel) -> str:
+    """sha256 (hex) of the vehicle's canonical parameters."""
+    return hashlib.sha256(canonical_vehicle_toml(vehicle).encode("utf-8")).hexdigest()
+
+
+# ---- where the files are ----------------------------------------------------------------------------------------
+
+
+def shipped_tuning_root() -> Path:
+    """workbench/presets/tuning, where the presets' tunings are shipped."""
+    return Path(str(resources.files("workbench").joinpath("presets", "tuning")))
+
+
+def cache_dir() -> Path:
+    """$WORKBENCH_TUNING_CACHE, else $XDG_CACHE_HOME/lateral-workbench/tuning (~/.cache/...)."""
+    return user_cache_dir(CACHE_ENV, "tuning")
+
+
+def shipped_index() -> dict[tuple[str, str], Path]:
+    """(params_sha256, options as JSON) -> the shipped directory made for them."""
+    index = {}
+    root = shipped_tuning_root()
+    if root.is_dir():
+        for manifest_path in sorted(root.glob(f"*/{MANIFEST_FILE}")):
+            manifest = read_manifest(manifest_path.parent)
+            index[(manifest["params_sha256"], json.dumps(manifest["options"], sort_keys=True))] = manifest_path.parent
+    return index
+
+
+# ---- reading ----------------------------------------------------------------------------------------------------
+
+
+def read_manifest(directory: str | Path) -> dict[str, Any]:
+    """The manifest.json of a tuning directory, its keys checked."""
+    path = Path(directory) / MANIFEST_FILE
+    doc = read_json(path, f"tuning manifest {str(path)!r}")
+    if not isinstance(doc, dict) or doc.get("format") != MANIFEST_FORMAT:
+        raise WorkbenchInputError(f"tuning manifest {str(path)!r}: format must be {MANIFEST_FORMAT!r}")
+    missing = [k for k in MANIFEST_KEYS if k not in doc]
+    unknown = [k for k in doc if k not in MANIFEST_KEYS]
+    if missing or unknown:
+        raise WorkbenchInputError(
+            f"tuning manifest {str(path)!r}: missing keys {missing}, unknown keys {unknown}; "
+            f"keys: {list(MANIFEST_KEYS)}"
+        )
+    return doc
+
+
+def _lags(
+    path: Path, schedule: FilterSchedule
+) -> tuple[tuple[tuple[float, SteeringLag], ...], tuple[tuple[float, SteeringLag], ...]]:
+    """(the path lags, the measured lags) of design.per_speed; the measured ones empty when no row has them (files
+    made before they were recorded), refused when only some rows have them."""
+    design = schedule.metadata.get("design", {})
+    rows = design.get("per_speed") if isinstance(design, Mapping) else None
+    if not isinstance(rows, list) or not rows:
+        raise WorkbenchInputError(f"{path}: design.per_speed (the lag identified at each speed) is missing")
+    lags, measured = [], []
+    for i, row in enumerate(rows):
+        if not isinstance(row, Mapping) or any(k not in row for k in LAG_KEYS):
+            raise WorkbenchInputError(f"{path}: design.per_speed[{i}] must hold {list(LAG_KEYS)}; got {row!r}")
+        speed = row["speed_kmh"]
+        if isinstance(speed, bool) or not isinstance(speed, int | float):
+            raise WorkbenchInputError(
+                f"{path}: design.per_speed[{i}].speed_kmh must be a number; got {value_text(speed)}"
+            )
+        lags.append((float(speed), _row_lag(path, i, row, "", speed)))
+        if any(k in row for k in MEASURED_LAG_KEYS):
+            if any(k not in row for k in MEASURED_LAG_KEYS):
+                raise WorkbenchInputError(
+                    f"{path}: design.per_speed[{i}] must hold both of {list(MEASURED_LAG_KEYS)} or neither"
+                )
+            measured.append((float(speed), _row_lag(path, i, row, MEASURED_PREFIX, speed)))
+    if measured and len(measured) != len(lags):
+        raise WorkbenchInputError(
+            f"{path}: design.per_speed holds the measured lag ({list(MEASURED_LAG_KEYS)}) at {len(measured)} of "
+            f"{len(lags)} speeds; give it at every speed or at none"
+        )
+    speeds = tuple(speed for speed, _ in lags)
+    if speeds != schedule.speeds_kmh:
+        raise WorkbenchInputError(
+            f"{path}: the lags' speeds {shown_all(speeds)} differ from the schedule's {shown_all(schedule.speeds_kmh)}"
+        )
+    return tuple(lags), tuple(measured)
+
+
+def _row_lag(path: Path, i: int, row: Mapping[str, Any], prefix: str, speed: float) -> SteeringLag:
+    """The lag of one per_speed row: its keys with `prefix` ("" for the path lag, "measured_" for the other)."""
+    what = "measured lag" if prefix else "lag"
+    try:
+        return SteeringLag(
+            row[f"{prefix}omega_n_rad_s"],
+            row[f"{prefix}zeta"],
+            row.get(f"{prefix}delay_s", 0.0),
+            steady_state_gain=row.get(f"{prefix}steady_state_gain", 1.0),
+            nrmse=row.get(f"{prefix}nrmse", math.nan),
+            source=f"{what} identified at {speed:g} km/h ({path})",
+        )
+    except (WorkbenchInputError, TypeError) as exc:
+        raise WorkbenchInputError(f"{path}: design.per_speed[{i}] ({what}): {exc}") from None
+
+
+@functools.lru_cache(maxsize=64)
+def _read(directory: str, _stamp: tuple[int, ...]) -> VehicleTuning:
+    path = Path(directory)
+    manifest = read_manifest(path)
+    lead = path / LEAD_FILE
+    schedule = read_filter_file(lead)
+    limits = read_limits_file(path / LIMITS_FILE)
+    who = f"preset {manifest['preset']!r}" if manifest["preset"] else f"vehicle {manifest['vehicle']!r}"
+    source = f"{path} ({who}, params sha256 {str(manifest['params_sha256'])[:12]}, made {manifest['date']})"
+    lags, measured = _lags(lead, schedule)
+    return VehicleTuning(schedule, limits, lags, source, measured)
+
+
+def read_vehicle_tuning(directory: str | Path) -> VehicleTuning:
+    """Read a tuning directory (lead.json, limits.csv, manifest.json); WorkbenchInputError naming the file and the
+    problem for anything it cannot use. Reads are remembered while the files are unchanged."""
+    path = Path(directory)
+    stamp = []
+    for name in (MANIFEST_FILE, LEAD_FILE, LIMITS_FILE):
+        try:
+            stamp.append((path / name).stat().st_mtime_ns)
+        except OSError:
+            raise WorkbenchInputError(f"tuning directory {str(path)!r} has no {name}") from None
+    return _read(str(path.resolve()), tuple(stamp))

@@ -1,0 +1,66 @@
+"""What the simulator and a lateral controller exchange: the `Measurement` the sensors give at a controller step,
+and the `SteeringController` protocol the simulator drives (reset for a path, step to a steering-wheel command,
+diagnostics to log). `controllers.base.Controller` implements it; the simulator knows only this interface, so the
+simulation layer lies below the controllers."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Protocol
+
+if TYPE_CHECKING:
+    from workbench.base.path import ReferencePath
+
+#: The diagnostics flags (1.0 or 0.0) a controller adds to its own signals: its last measurement was implausible,
+#: or its last command was non-finite, and it held its previous command (controllers/base.py).
+MEASUREMENT_REJECTED = "measurement_rejected"
+COMMAND_REJECTED = "command_rejected"
+
+
+@dataclass(frozen=True, slots=True)
+class Measurement:
+    """What the sensors give at one controller step (SI units).
+
+    x_m, y_m: position of the reference point (the tractor's rear-axle centre, where the paper measures CTE);
+    vx_mps, vy_mps: its velocity in the vehicle frame; yaw_rad, yaw_rate_rad_s: heading and its rate;
+    steer_wheel_rad: measured steering-wheel angle; t_s: time.
+    """
+
+    t_s: float
+    x_m: float
+    y_m: float
+    vx_mps: float
+    vy_mps: float
+    yaw_rad: float
+    yaw_rate_rad_s: float
+    steer_wheel_rad: float
+
+    @property
+    def speed_mps(self) -> float:
+        return math.hypot(self.vx_mps, self.vy_mps)
+
+
+class SteeringController(Protocol):
+    """A lateral controller as the simulator drives it (`controllers.base.Controller` is the implementation)."""
+
+    name: str
+
+    def reset(self, path: ReferencePath, sample_time_s: float) -> None:
+        """Forget all state; steps on `path` come every `sample_time_s` seconds."""
+
+    def step(self, measurement: Measurement, path: ReferencePath) -> float:
+        """The steering-wheel angle command (rad) for this measurement: finite, within the vehicle's limit."""
+        ...
+
+    @property
+    def diagnostics(self) -> Mapping[str, float]:
+        """The last step's signals to log (`ctrl_<name>` columns), MEASUREMENT_REJECTED and COMMAND_REJECTED
+        among them."""
+        ...
+
+    @property
+    def rejection(self) -> str:
+        """Why the last rejected step was rejected, in words."""
+        ...

@@ -1,0 +1,63 @@
+"""How a closed-loop run is simulated: speeds, rates, laps and when a run stops early (`SimulationConfig`)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from workbench.base.errors import WorkbenchInputError, require_in_range, require_positive
+
+
+@dataclass(frozen=True)
+class SimulationConfig:
+    """How a run is simulated.
+
+    speed_kmh: the speed asked for (km/h), the maximum of the planned profile; max_lateral_accel_g: the profile's
+    lateral acceleration bound (the paper: 0.3 g); max_accel_mps2, max_decel_mps2: its longitudinal bounds;
+    controller_rate_hz, plant_rate_hz: step rates (the plant rate must be a whole multiple); laps: laps of a
+    closed path; max_time_s: time-out (None: three times the planned lap time plus 30 s); max_abs_cte_m: a run
+    whose |CTE| exceeds this has left the path and stops; max_past_end_m: so has a run whose reference point goes
+    this far beyond either end of an open path (along the end's tangent); speed_feedforward: the speed controller
+    feeds the planned speed's rate of change forward (speed x dv_ref/ds) besides its PI action (False: PI only).
+    """
+
+    speed_kmh: float = 30.0
+    max_lateral_accel_g: float = 0.3
+    max_accel_mps2: float = 1.0
+    max_decel_mps2: float = 2.0
+    controller_rate_hz: float = 50.0
+    plant_rate_hz: float = 1000.0
+    laps: int = 1
+    max_time_s: float | None = None
+    max_abs_cte_m: float = 30.0
+    max_past_end_m: float = 5.0
+    speed_feedforward: bool = True
+
+    def __post_init__(self) -> None:
+        require_in_range("speed_kmh", self.speed_kmh, 1e-3, 400.0, "km/h (must be > 0)")
+        require_in_range("max_lateral_accel_g", self.max_lateral_accel_g, 0.01, 2.0, "g")
+        require_positive("max_accel_mps2", self.max_accel_mps2)
+        require_positive("max_decel_mps2", self.max_decel_mps2)
+        require_in_range("controller_rate_hz", self.controller_rate_hz, 1.0, 10_000.0, "Hz")
+        require_in_range("plant_rate_hz", self.plant_rate_hz, 1.0, 100_000.0, "Hz")
+        ratio = self.plant_rate_hz / self.controller_rate_hz
+        if ratio < 1 or abs(ratio - round(ratio)) > 1e-9:
+            raise WorkbenchInputError(
+                f"plant_rate_hz ({self.plant_rate_hz}) must be a whole multiple of controller_rate_hz "
+                f"({self.controller_rate_hz}); the ratio is {ratio:g}"
+            )
+        if isinstance(self.laps, bool) or not isinstance(self.laps, int) or self.laps < 1:
+            raise WorkbenchInputError(f"laps must be a whole number >= 1; got {self.laps!r}")
+        if self.max_time_s is not None:
+            require_positive("max_time_s", self.max_time_s)
+        require_positive("max_abs_cte_m", self.max_abs_cte_m)
+        require_positive("max_past_end_m", self.max_past_end_m)
+        if not isinstance(self.speed_feedforward, bool):
+            raise WorkbenchInputError(f"speed_feedforward must be True or False; got {self.speed_feedforward!r}")
+
+    @property
+    def substeps(self) -> int:
+        return round(self.plant_rate_hz / self.controller_rate_hz)
+
+    @property
+    def speed_mps(self) -> float:
+        return self.speed_kmh / 3.6

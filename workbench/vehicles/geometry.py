@@ -1,0 +1,53 @@
+"""What a controller may know about the vehicle it steers: its geometry and steering limits (Ackermann
+tan(phi) = L kappa)."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+from workbench.base.errors import require_in_range, require_positive
+
+
+@dataclass(frozen=True)
+class VehicleGeometry:
+    """What a controller may know about the vehicle it steers.
+
+    wheelbase_m: front axle to rear axle (group centre) of the steered unit, for Ackermann tan(phi) = L kappa;
+    steering_ratio: steering-wheel angle / road-wheel angle; max_road_wheel_angle_rad and
+    max_steer_wheel_rate_rad_s: actuator limits; width_m: overall width (sizes the ISO 3888 lanes).
+    """
+
+    wheelbase_m: float
+    steering_ratio: float
+    max_road_wheel_angle_rad: float
+    max_steer_wheel_rate_rad_s: float
+    width_m: float
+
+    def __post_init__(self) -> None:
+        require_in_range("wheelbase_m", self.wheelbase_m, 0.5, 15.0, "m")
+        require_in_range("steering_ratio", self.steering_ratio, 1.0, 60.0)
+        require_in_range("max_road_wheel_angle_rad", self.max_road_wheel_angle_rad, 0.01, 1.5, "rad")
+        require_positive("max_steer_wheel_rate_rad_s", self.max_steer_wheel_rate_rad_s)
+        require_in_range("width_m", self.width_m, 0.5, 4.0, "m")
+
+    @property
+    def max_steer_wheel_angle_rad(self) -> float:
+        return self.max_road_wheel_angle_rad * self.steering_ratio
+
+    @classmethod
+    def from_params(cls, params: Any, wheelbase_m: float) -> VehicleGeometry:
+        """From a model's parameters with the usual fields (steering_ratio, max_road_wheel_angle_rad,
+        max_road_wheel_rate_rad_s, width_m); the steering-wheel rate limit is the road-wheel one x the ratio."""
+        return cls(
+            wheelbase_m=wheelbase_m,
+            steering_ratio=params.steering_ratio,
+            max_road_wheel_angle_rad=params.max_road_wheel_angle_rad,
+            max_steer_wheel_rate_rad_s=params.max_road_wheel_rate_rad_s * params.steering_ratio,
+            width_m=params.width_m,
+        )
+
+    def steer_wheel_for_curvature(self, curvature_1pm: float) -> float:
+        """Steering-wheel angle (rad) that gives this path curvature kinematically: tan(phi) = L kappa."""
+        return math.atan(self.wheelbase_m * curvature_1pm) * self.steering_ratio
