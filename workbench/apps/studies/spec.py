@@ -338,8 +338,26 @@ class StudySpec:
     max_runs: int = DEFAULT_MAX_RUNS
 
     def __post_init__(self) -> None:
-        base = Path(self.base_dir).resolve()
-        object.__setattr__(self, "base_dir", base)
+        """Check and type the study, in this order: the names (controllers, scenarios, vehicles), the files and
+        scalars of [study], the axes and draws, the samples, the optimisation, then its size and every file a run
+        will read."""
+        object.__setattr__(self, "base_dir", Path(self.base_dir).resolve())
+        self._resolve_names()
+        self._resolve_study_files()
+        self._check_scalars()
+        models = self._type_axes()
+        self._check_samples()
+        if self.optimise is not None:
+            object.__setattr__(self, "optimise", self._checked_optimise(self.optimise))
+        if isinstance(self.max_runs, bool) or not isinstance(self.max_runs, int) or self.max_runs < 1:
+            raise WorkbenchInputError(f"study.max_runs must be a whole number >= 1; got {value_text(self.max_runs)}")
+        self._check_size()
+        self._check_files(models)
+
+    # ------------------------------------------------------------------------------------------- typing
+    def _resolve_names(self) -> None:
+        """Controllers by their registered names; scenarios and vehicles by name or as files under base_dir."""
+        base = self.base_dir
         controllers = _names("controllers", self.controllers)
         for name in controllers:
             if name not in CONTROLLERS:
@@ -356,7 +374,11 @@ class StudySpec:
         object.__setattr__(self, "controllers", controllers)
         object.__setattr__(self, "scenarios", scenarios)
         object.__setattr__(self, "vehicles", vehicles)
-        if "zandvoort" in scenarios and self.track_file is None:
+
+    def _resolve_study_files(self) -> None:
+        """controller_config and track_file as absolute paths to readable files (track_file from the environment
+        when zandvoort is run without one)."""
+        if "zandvoort" in self.scenarios and self.track_file is None:
             if not os.environ.get(ZANDVOORT_ENV):
                 raise WorkbenchInputError(
                     f"study.scenarios has zandvoort, which needs {ZANDVOORT_SOURCE}: give study.track_file "
@@ -366,15 +388,22 @@ class StudySpec:
         for name in ("controller_config", "track_file"):
             value = getattr(self, name)
             if value is not None:
-                path = typed_value(f"study.{name}", value, Path, base)
+                path = typed_value(f"study.{name}", value, Path, self.base_dir)
                 if not os.path.lexists(path):
                     raise WorkbenchInputError(f"study.{name}: file {str(value)!r} does not exist (looked for {path})")
                 object.__setattr__(self, name, check_input_file(path, f"study.{name}: file {str(value)!r}"))
+
+    def _check_scalars(self) -> None:
         if not isinstance(self.description, str):
             raise WorkbenchInputError(f"study.description must be text; got {self.description!r}")
         if isinstance(self.seed, bool) or not isinstance(self.seed, int) or self.seed < 0:
             raise WorkbenchInputError(f"study.seed must be a whole number >= 0; got {value_text(self.seed)}")
 
+    def _type_axes(self) -> dict[str, Any]:
+        """The grid and random tables typed against the run parameters and each controller's options (a
+        parameter in one of them only); returns the vehicle models, read here so that a vehicle file a run cannot
+        use is refused now."""
+        base, controllers = self.base_dir, self.controllers
         grid = _axes("grid", self.grid, RUN_PARAMETERS, base)
         random = _draws("random", self.random, RUN_PARAMETERS, base)
         controller_grid, controller_random = {}, {}
@@ -397,9 +426,9 @@ class StudySpec:
                 raise WorkbenchInputError(
                     f"{', '.join(both)} is both in [grid{where}] and in [random{where}]; keep one"
                 )
-        models = _vehicle_models(vehicles)  # reads the vehicle files: a file a run cannot use is refused now
+        models = _vehicle_models(self.vehicles)
         if "payload_kg" in grid or "payload_kg" in random:
-            others = [v for v in vehicles if not _has_payload(models[v])]
+            others = [v for v in self.vehicles if not _has_payload(models[v])]
             if others:
                 raise WorkbenchInputError(
                     f"payload_kg is given but vehicle(s) {', '.join(others)} have no payload; a payload applies to "
@@ -409,7 +438,11 @@ class StudySpec:
         object.__setattr__(self, "random", MappingProxyType(random))
         object.__setattr__(self, "controller_grid", MappingProxyType(controller_grid))
         object.__setattr__(self, "controller_random", MappingProxyType(controller_random))
-        has_draws = bool(random) or any(controller_random.values())
+        return models
+
+    def _check_samples(self) -> None:
+        """samples is given exactly when something is drawn."""
+        has_draws = bool(self.random) or any(self.controller_random.values())
         if self.samples is not None:
             if isinstance(self.samples, bool) or not isinstance(self.samples, int) or self.samples < 1:
                 raise WorkbenchInputError(f"study.samples must be a whole number >= 1; got {value_text(self.samples)}")
@@ -417,12 +450,6 @@ class StudySpec:
                 raise WorkbenchInputError(f"study.samples = {self.samples} but [random] draws nothing; drop samples")
         elif has_draws:
             raise WorkbenchInputError("[random] draws parameters: give study.samples, the number of draws")
-        if self.optimise is not None:
-            object.__setattr__(self, "optimise", self._checked_optimise(self.optimise))
-        if isinstance(self.max_runs, bool) or not isinstance(self.max_runs, int) or self.max_runs < 1:
-            raise WorkbenchInputError(f"study.max_runs must be a whole number >= 1; got {value_text(self.max_runs)}")
-        self._check_size()
-        self._check_files(models)
 
     # ------------------------------------------------------------------------------------------- checks
     def run_count(self) -> int:
