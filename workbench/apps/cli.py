@@ -68,6 +68,8 @@ def _parser(command: str | None = None) -> argparse.ArgumentParser:
     scen.add_argument("--track", type=Path, help="Zandvoort track CSV (TUMFTM racetrack-database format)")
     veh = sub.add_parser("vehicles", help="list the vehicle models and presets")
     veh.add_argument("--show", metavar="NAME", help="print a preset's TOML (copy, edit, pass with --vehicle-file)")
+    cond = sub.add_parser("conditions", help="list the sensing, actuation and road conditions presets")
+    cond.add_argument("--show", metavar="NAME", help="print a preset as TOML (copy, edit, pass with --conditions)")
     ctl = sub.add_parser("controllers", help="list the controllers")
     ctl.add_argument("--show", metavar="NAME", help="print a controller's options as TOML (for --controller-config)")
 
@@ -97,6 +99,7 @@ def _parser(command: str | None = None) -> argparse.ArgumentParser:
     run.add_argument("--controller-rate-hz", type=float, default=50.0, help="controller rate (default 50 Hz)")
     run.add_argument("--plant-rate-hz", type=float, default=1000.0, help="plant integration rate (default 1 kHz)")
     run.add_argument("--lat-accel-g", type=float, default=0.3, help="speed-profile lateral bound (default 0.3 g)")
+    _conditions_options(run)
     run.add_argument("--no-plots", action="store_true", help="write the trace and metrics only")
     _overwrite_option(run)
 
@@ -126,12 +129,29 @@ def _parser(command: str | None = None) -> argparse.ArgumentParser:
     )
     fig.add_argument("--out", type=Path, required=True, metavar="DIR", help="output directory (report.html in it)")
     fig.add_argument("--speed", type=float, default=30.0, metavar="KMH", help="target speed, km/h (default 30)")
+    _conditions_options(fig)
     _overwrite_option(fig)
 
     paper = sub.add_parser("paper", help="regenerate the paper's figures 4b-16 and a table of ours against its numbers")
     paper.add_argument("--out", type=Path, required=True, metavar="DIR", help="output directory")
     paper.add_argument("--track", type=Path, help="Zandvoort track CSV (Figures 15-16)")
     _overwrite_option(paper)
+
+    rob = sub.add_parser(
+        "robustness",
+        help="each controller against actuation delay, pose latency, position noise, friction and payload mismatch",
+    )
+    rob.add_argument("scenario", help="a scenario name (see `workbench scenarios`) or a waypoint CSV file")
+    rob.add_argument("--controllers", required=True, metavar="A,B,...", help="comma-separated controller names")
+    rob.add_argument("--vehicle", required=True, metavar="NAME", help="vehicle preset or vehicle TOML file")
+    rob.add_argument("--out", type=Path, required=True, metavar="DIR", help="output directory (rerun to resume)")
+    rob.add_argument("--speed", type=float, default=30.0, metavar="KMH", help="target speed, km/h (default 30)")
+    rob.add_argument("--track", type=Path, help="track CSV for the zandvoort scenario")
+    rob.add_argument(
+        "--max-cte", type=float, default=0.5, metavar="M", help="a run passes within this max |CTE| (default 0.5 m)"
+    )
+    _conditions_options(rob)
+    _backend_options(rob, command in (None, "robustness"))
 
     swp = sub.add_parser(
         "sweep", help="run every run a study spec plans (grids, random draws); resumes; DIR/results.parquet"
@@ -190,6 +210,26 @@ def _sim_options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--track", type=Path, help="track CSV for the zandvoort scenario")
     parser.add_argument("--laps", type=int, default=1, help="laps of a closed path (default 1)")
     parser.add_argument("--lat-accel-g", type=float, default=0.3, help="speed-profile lateral bound (default 0.3 g)")
+    _conditions_options(parser)
+
+
+def _conditions_options(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--conditions",
+        default="ideal",
+        metavar="NAME|FILE.toml",
+        help="sensing, actuation and road conditions: a preset (`workbench conditions`) or a TOML file "
+        "(default: ideal, the plant's exact state at once)",
+    )
+    parser.add_argument("--seed", type=int, default=0, help="seed of the conditions' noise (default 0)")
+
+
+def _simulation_config(args: argparse.Namespace, **fields: object) -> object:
+    """The SimulationConfig of a command's options: `fields` plus the conditions and seed."""
+    from workbench.simulation.conditions import load_conditions
+    from workbench.simulation.simulator import SimulationConfig
+
+    return SimulationConfig(**fields, conditions=load_conditions(args.conditions), seed=args.seed)
 
 
 def _names(text: str, what: str) -> list[str]:
@@ -247,7 +287,6 @@ def _compare(args: argparse.Namespace) -> int:
     from workbench.apps.report import ReportSection, write_report
     from workbench.base.output_dir import OutputDir
     from workbench.simulation.scenarios import ScenarioOptions
-    from workbench.simulation.simulator import SimulationConfig
 
     out = OutputDir(args.out, "compare", args.overwrite)
     _check_inputs(args)
@@ -256,7 +295,7 @@ def _compare(args: argparse.Namespace) -> int:
         for vehicle in _names(args.vehicle, "vehicle")
         for controller in _names(args.controllers, "controllers")
     ]
-    config = SimulationConfig(speed_kmh=args.speed, laps=args.laps, max_lateral_accel_g=args.lat_accel_g)
+    config = _simulation_config(args, speed_kmh=args.speed, laps=args.laps, max_lateral_accel_g=args.lat_accel_g)
     comparison = compare(args.scenario, runs, config, ScenarioOptions(track_file=args.track), warn=warn_on_stderr)
     with _writing(out):
         comparison.save(args.out)
@@ -292,10 +331,9 @@ def _paper(args: argparse.Namespace) -> int:
 def _fig17(args: argparse.Namespace) -> int:
     from workbench.apps.fig17 import run_fig17
     from workbench.base.output_dir import OutputDir
-    from workbench.simulation.simulator import SimulationConfig
 
     out = OutputDir(args.out, "fig17", args.overwrite)
-    result = run_fig17(SimulationConfig(speed_kmh=args.speed))
+    result = run_fig17(_simulation_config(args, speed_kmh=args.speed))
     with _writing(out):
         written = result.save(args.out)
     print("Figure 17, fair set (each controller on each plant):")
@@ -341,6 +379,43 @@ def _start_study(args: argparse.Namespace, kind: str) -> tuple[StudySpec, Backen
     except OSError as exc:
         raise WorkbenchInputError(f"--out {str(args.out)!r}: cannot write the spec's copy ({exc})") from None
     return spec, backend
+
+
+def _robustness(args: argparse.Namespace) -> int:
+    from workbench.apps.robustness import plan_robustness, run_robustness
+    from workbench.apps.studies import make_backend
+    from workbench.base.errors import require_positive
+    from workbench.base.output_dir import check_study_dir
+
+    check_study_dir(args.out)
+    _check_inputs(args)
+    require_positive("--max-cte", args.max_cte)
+    controllers = _names(args.controllers, "controllers")
+    runs = plan_robustness(
+        args.scenario, controllers, args.vehicle, args.speed, args.conditions, args.seed, args.track, Path.cwd()
+    )
+    backend = make_backend(args.backend, args.scheduler, args.workers)
+
+    def study() -> int:
+        print(f"{len(runs)} runs on the {backend.describe()}")
+        with backend:
+            result = run_robustness(
+                runs,
+                args.out,
+                backend,
+                args.scenario,
+                args.vehicle,
+                controllers,
+                args.conditions,
+                args.speed,
+                progress=sys.stderr.isatty(),
+            )
+        written = result.save(args.out)
+        print(result.tolerance().to_string(index=False, float_format=lambda v: f"{v:.3g}"))
+        print(f"wrote {', '.join(str(p) for p in written)} and {args.out / 'results.parquet'}")
+        return 0
+
+    return _interruptible(study, args.out)
 
 
 def _sweep(args: argparse.Namespace) -> int:
@@ -407,7 +482,7 @@ def _run(args: argparse.Namespace) -> int:
     from workbench.base.output_dir import OutputDir
     from workbench.simulation.limit_cycle import detect_limit_cycle
     from workbench.simulation.scenarios import ScenarioOptions, make_scenario
-    from workbench.simulation.simulator import Simulation, SimulationConfig
+    from workbench.simulation.simulator import Simulation
     from workbench.vehicles import make_vehicle
 
     out = OutputDir(args.out, "run", args.overwrite)
@@ -423,7 +498,8 @@ def _run(args: argparse.Namespace) -> int:
     scenario = make_scenario(
         args.scenario, ScenarioOptions(vehicle_width_m=vehicle.geometry.width_m, track_file=args.track)
     )
-    config = SimulationConfig(
+    config = _simulation_config(
+        args,
         speed_kmh=args.speed,
         laps=args.laps,
         controller_rate_hz=args.controller_rate_hz,
@@ -481,6 +557,16 @@ def _vehicles(args: argparse.Namespace) -> None:
             print(f"{name:<20} {description}\n{'':<20} {VEHICLES[name]().describe()}")
 
 
+def _conditions(args: argparse.Namespace) -> None:
+    from workbench.simulation.conditions import CONDITIONS, conditions_to_toml, load_conditions
+
+    if args.show:
+        print(conditions_to_toml(load_conditions(args.show)), end="")
+    else:
+        for name, conditions in CONDITIONS.items():
+            print(f"{name:<12} {conditions.describe()}")
+
+
 def _controllers(args: argparse.Namespace) -> None:
     from workbench.apps.controller_config import config_template
 
@@ -503,6 +589,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             _vehicles(args)
         elif args.command == "controllers":
             _controllers(args)
+        elif args.command == "conditions":
+            _conditions(args)
         elif args.command == "compare":
             return _compare(args)
         elif args.command == "fig17":
@@ -511,6 +599,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             return _paper(args)
         elif args.command == "sweep":
             return _sweep(args)
+        elif args.command == "robustness":
+            return _robustness(args)
         elif args.command == "optimise":
             return _optimise(args)
         else:

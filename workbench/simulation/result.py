@@ -106,6 +106,8 @@ class SimulationResult:
         written = [out / "trace.parquet", out / "metrics.json"]
         self.to_pandas().to_parquet(written[0], index=False)
         document = self.metrics.to_dict() | {"status": self.status.value, "message": self.message}
+        if not self.config.conditions.is_ideal:  # an ideal run's file stays as it was before conditions existed
+            document |= {"conditions": self.config.conditions.name, "seed": self.config.seed}
         written[1].write_text(json.dumps(document, indent=2) + "\n")
         if with_plots:
             written += plots.save_run_plots(self, out)

@@ -4,7 +4,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from workbench.base.errors import WorkbenchInputError, require_in_range, require_positive
+from workbench.base.errors import WorkbenchInputError, require_in_range, require_positive, value_text
+from workbench.simulation.conditions import CONDITIONS, Conditions
 
 
 @dataclass(frozen=True)
@@ -17,7 +18,9 @@ class SimulationConfig:
     closed path; max_time_s: time-out (None: three times the planned lap time plus 30 s); max_abs_cte_m: a run
     whose |CTE| exceeds this has left the path and stops; max_past_end_m: so has a run whose reference point goes
     this far beyond either end of an open path (along the end's tangent); speed_feedforward: the speed controller
-    feeds the planned speed's rate of change forward (speed x dv_ref/ds) besides its PI action (False: PI only).
+    feeds the planned speed's rate of change forward (speed x dv_ref/ds) besides its PI action (False: PI only);
+    conditions: what lies between the plant and the controller (sensing, actuation, road; `conditions.py`; the
+    default, `ideal`, changes nothing); seed: the seed of the conditions' noise (the same seed, the same run).
     """
 
     speed_kmh: float = 30.0
@@ -31,6 +34,8 @@ class SimulationConfig:
     max_abs_cte_m: float = 30.0
     max_past_end_m: float = 5.0
     speed_feedforward: bool = True
+    conditions: Conditions = CONDITIONS["ideal"]
+    seed: int = 0
 
     def __post_init__(self) -> None:
         require_in_range("speed_kmh", self.speed_kmh, 1e-3, 400.0, "km/h (must be > 0)")
@@ -53,6 +58,13 @@ class SimulationConfig:
         require_positive("max_past_end_m", self.max_past_end_m)
         if not isinstance(self.speed_feedforward, bool):
             raise WorkbenchInputError(f"speed_feedforward must be True or False; got {self.speed_feedforward!r}")
+        if not isinstance(self.conditions, Conditions):
+            raise WorkbenchInputError(
+                f"conditions must be a Conditions (a preset of {', '.join(CONDITIONS)} or a file, "
+                f"`load_conditions`); got {value_text(self.conditions)}"
+            )
+        if isinstance(self.seed, bool) or not isinstance(self.seed, int) or not 0 <= self.seed < 2**63:
+            raise WorkbenchInputError(f"seed must be a whole number in [0, 2**63); got {value_text(self.seed)}")
 
     @property
     def substeps(self) -> int:

@@ -29,6 +29,7 @@ from workbench.simulation.control_interface import (
 from workbench.simulation.result import SimulationResult, Status
 from workbench.simulation.run_config import SimulationConfig
 from workbench.simulation.scenarios import Scenario
+from workbench.simulation.sensing import ActuatorModel, SensorModel
 from workbench.simulation.speed_control import PISpeedController, PISpeedGains
 from workbench.simulation.speed_profile import G_MPS2, SpeedLimits, plan_speed_profile
 from workbench.vehicles.base import VehicleModel
@@ -160,18 +161,33 @@ class Simulation:
         state = vehicle.initial_state(x0, y0, yaw0, float(path.speed_mps[0]))
         tracker = path.tracker(0.0)
         controller.reset(path, dt)
+        # The conditions between plant and controller (`conditions.py`): each model is left out when ideal, so an
+        # ideal run is today's run bit for bit; what the controller saw is logged beside the true state.
+        conditions = cfg.conditions
+        sensors = None if conditions.sensing_is_ideal else SensorModel(conditions, cfg.seed, dt)
+        actuator = None if conditions.actuation.is_ideal else ActuatorModel(conditions, dt, cfg.substeps)
+        road = conditions.road
+        friction = road.friction_at(0.0)
+        if getattr(vehicle, "road_friction", 1.0) != friction:
+            vehicle.set_road_friction(friction)
+        seen = not conditions.is_ideal
         speed_controller = PISpeedController(PISpeedGains())
 
         log = _TraceLog(vehicle.output_names, max_steps)
         status, message = Status.TIMEOUT, f"did not finish within {max_time:.1f} s"
-        steer_cmd = accel_cmd = 0.0
+        steer_cmd = accel_cmd = applied_cmd = 0.0
         held, first_held = 0, ""  # steps whose measurement the controller's screen rejected (it held its command)
         bar = tqdm(total=round(total_length), unit="m", delay=2.0, disable=not progress, leave=False)
         t = 0.0
-        for _ in range(max_steps):
-            out = vehicle.outputs(state, steer_cmd, accel_cmd)
+        for step in range(max_steps):
+            out = vehicle.outputs(state, applied_cmd, accel_cmd)
             x, y, yaw, vx, vy, yaw_rate, steer_wheel = out[:7]
+            if step == 0 and actuator is not None:
+                actuator.reset(float(steer_wheel))
             foot = tracker.update(x, y)
+            if not road.is_constant:
+                friction = road.friction_at(foot.s_m)
+                vehicle.set_road_friction(friction)
             if foot.past_end_m > cfg.max_past_end_m:
                 end = "end" if foot.at_end else "start"
                 status = Status.LEFT_PATH
@@ -190,6 +206,8 @@ class Simulation:
                 status, message = Status.COMPLETED, "completed"
                 break
             measurement = Measurement(t, x, y, vx, vy, yaw, yaw_rate, steer_wheel)
+            if sensors is not None:
+                measurement = sensors.measure(measurement)
             start = time.perf_counter()
             try:
                 steer_cmd = controller.step(measurement, path)
@@ -224,7 +242,14 @@ class Simulation:
                 step_time,
                 controller.diagnostics,
             )
-            state = vehicle.advance(state, steer_cmd, accel_cmd, dt, cfg.substeps)
+            if actuator is None:
+                state = vehicle.advance(state, steer_cmd, accel_cmd, dt, cfg.substeps)
+                applied_cmd = steer_cmd
+            else:
+                for substeps, applied_cmd in actuator.segments(steer_cmd):
+                    state = vehicle.advance(state, applied_cmd, accel_cmd, dt * substeps / cfg.substeps, substeps)
+            if seen:
+                log.seen(measurement, applied_cmd, friction)
             t += dt
             if not np.all(np.isfinite(state)):
                 bad = [n for n, v in zip(vehicle.state_names, state, strict=False) if not math.isfinite(v)]
@@ -269,6 +294,7 @@ class _TraceLog:
         self.outputs = np.empty((self.capacity, len(output_names)))
         self.signals = np.empty((self.capacity, len(self.SIGNALS)))
         self.diagnostics: dict[str, np.ndarray] = {}
+        self.seen_columns: np.ndarray | None = None
         self.n = 0
 
     def _grow(self) -> None:
@@ -278,6 +304,8 @@ class _TraceLog:
         self.outputs = doubled(self.outputs)
         self.signals = doubled(self.signals)
         self.diagnostics = {key: doubled(column) for key, column in self.diagnostics.items()}
+        if self.seen_columns is not None:
+            self.seen_columns = doubled(self.seen_columns)
         self.capacity *= 2
 
     SIGNALS = (
@@ -319,10 +347,43 @@ class _TraceLog:
             column[i] = value
         self.n += 1
 
+    #: What the controller saw and what reached the plant, logged when the conditions are not ideal: the
+    #: measurement's fields (seen_*), the steering command applied at the end of the step (after the actuator's
+    #: dead time and rate limit) and the road's friction scale.
+    SEEN = (
+        "seen_x_m",
+        "seen_y_m",
+        "seen_yaw_rad",
+        "seen_vx_mps",
+        "seen_vy_mps",
+        "seen_yaw_rate_rad_s",
+        "seen_steer_wheel_rad",
+        "applied_steer_wheel_cmd_rad",
+        "road_friction",
+    )
+
+    def seen(self, m: Measurement, applied_cmd: float, friction: float) -> None:
+        """The seen columns of the row `append` just wrote."""
+        if self.seen_columns is None:
+            self.seen_columns = np.full((self.capacity, len(self.SEEN)), np.nan)
+        self.seen_columns[self.n - 1] = (
+            m.x_m,
+            m.y_m,
+            m.yaw_rad,
+            m.vx_mps,
+            m.vy_mps,
+            m.yaw_rate_rad_s,
+            m.steer_wheel_rad,
+            applied_cmd,
+            friction,
+        )
+
     def to_dict(self) -> dict[str, np.ndarray]:
         n = self.n
         trace = {"t_s": self.signals[:n, 0].copy()}
         trace.update({name: self.outputs[:n, k].copy() for k, name in enumerate(self.output_names)})
         trace.update({name: self.signals[:n, k].copy() for k, name in enumerate(self.SIGNALS) if k > 0})
         trace.update({f"ctrl_{key}": col[:n].copy() for key, col in self.diagnostics.items()})
+        if self.seen_columns is not None:
+            trace.update({name: self.seen_columns[:n, k].copy() for k, name in enumerate(self.SEEN)})
         return trace

@@ -19,6 +19,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from workbench.base.errors import WorkbenchInputError, require_in_range
 from workbench.vehicles.geometry import VehicleGeometry
 from workbench.vehicles.single_track import PredictionParams, params_from_geometry
 
@@ -35,6 +36,14 @@ STANDARD_OUTPUTS: tuple[str, ...] = (
     "lat_accel_mps2",
 )
 
+#: Range of the road-friction scale `VehicleModel.set_road_friction` accepts (Pacejka's lambda_mu), relative to the
+#: road the tyre data describe (1.0): from about ice (0.05) to a road half as grippy again (1.5).
+ROAD_FRICTION_RANGE: tuple[float, float] = (0.05, 1.5)
+
+#: The models whose tyres `set_road_friction` scales, named in the refusal of a model without tyres (the registry,
+#: `workbench.vehicles.VEHICLES`, imports this module, so it is not consulted here).
+MODELS_WITH_TYRES_TEXT = "dynamic-bicycle, tractor-semitrailer, commonroad-mb"
+
 
 class VehicleModel(ABC):
     """A plant. Subclasses set `name`, `state_names`, `extra_output_names`, and in `__init__` `params` (a frozen
@@ -45,6 +54,9 @@ class VehicleModel(ABC):
 
     Extra outputs with these names are picked up by the metrics: `ltr` (load transfer ratio, max over axle
     groups, |LTR| = 1 is wheel lift-off), `trailer_x_m`/`trailer_y_m` (the trailer's rear-axle centre).
+
+    Road friction: a model with tyres (`has_tyres`) implements `_apply_road_friction`, and `set_road_friction`
+    then scales its tyres' peak friction between controller steps (see there).
     """
 
     name: ClassVar[str]
@@ -52,8 +64,13 @@ class VehicleModel(ABC):
     extra_output_names: ClassVar[tuple[str, ...]] = ()
     #: States that start at the heading yaw_rad (the yaw of a trailing unit: the units start in line).
     heading_states: ClassVar[tuple[str, ...]] = ()
+    #: Whether the model has tyres whose friction `set_road_friction` scales (a subclass setting True implements
+    #: `_apply_road_friction`).
+    has_tyres: ClassVar[bool] = False
     params: Any
     _geometry: VehicleGeometry
+    #: The road-friction scale in force; an instance attribute once `set_road_friction` has been called.
+    _road_friction: float = 1.0
 
     @property
     def geometry(self) -> VehicleGeometry:
@@ -74,6 +91,40 @@ class VehicleModel(ABC):
         lim = g.max_road_wheel_angle_rad
         delta_cmd = min(max(steer_wheel_cmd_rad / g.steering_ratio, -lim), lim)
         return delta_cmd, min(max(accel_cmd_mps2, -p.max_decel_mps2), p.max_accel_mps2)
+
+    @property
+    def road_friction(self) -> float:
+        """The tyre-road friction scale in force (1.0, the road of the tyre data, until `set_road_friction`)."""
+        return self._road_friction
+
+    def set_road_friction(self, scale: float) -> None:
+        """Scale the tyres' peak friction by `scale` for the following `advance` and `outputs` calls.
+
+        Pacejka's friction scaling factor lambda_mu ("Tyre and Vehicle Dynamics", chapter 4): the peak force becomes
+        D = scale x friction x load while the cornering stiffness (B C D, the slope at zero slip) is kept, so a
+        slippery road lowers the limit, not the linear handling. The scale holds until set again (the simulator
+        may set it between any two controller steps, e.g. varying along the path); 1.0 is exactly the model as
+        built. `params`, `single_track()` (what a controller is told) and the model's state are unchanged: the
+        road is not the vehicle. `scale` must be a finite number in ROAD_FRICTION_RANGE; a model without tyres
+        accepts only 1.0.
+        """
+        require_in_range("road_friction", scale, *ROAD_FRICTION_RANGE)
+        scale = float(scale)
+        if not self.has_tyres:
+            if scale != 1.0:
+                raise WorkbenchInputError(
+                    f"road_friction {scale!r} needs tyres, and the {self.name} model has none (it does not slip: "
+                    f"only 1.0 is accepted); use a model with tyres ({MODELS_WITH_TYRES_TEXT})"
+                )
+            return
+        if scale != self._road_friction:
+            self._apply_road_friction(scale)
+            self._road_friction = scale
+
+    def _apply_road_friction(self, scale: float) -> None:
+        """Make the tyres' peak friction `scale` times that of the parameters (scale 1.0 must restore the model as
+        built bit for bit); called by `set_road_friction` with a validated scale that differs from the one in force."""
+        raise NotImplementedError(f"{type(self).__name__} sets has_tyres but does not implement _apply_road_friction")
 
     @abstractmethod
     def advance(

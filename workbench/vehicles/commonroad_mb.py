@@ -6,10 +6,22 @@ fixed-step RK4 of its pure-Python derivative function, so it is slow (two orders
 compiled models; `benchmarks/run.py` times it). Its inputs are the front road-wheel angle *rate* and the acceleration;
 this adapter closes the same first-order, rate-limited steering actuator as the other models around it, and
 converts its CG reference point to the rear-axle centre: p_rear = p_cg - b (cos yaw, sin yaw).
+
+Road friction (`set_road_friction`, Pacejka's lambda_mu): CommonRoad's tyre (`vehiclemodels.utils.tire_model`) has
+D = p_d1 F_z and B = K / (C D) with the slip stiffness K = p_k1 F_z independent of p_d1, longitudinally and
+laterally, so multiplying the peak coefficients p_dx1 and p_dy1 by the scale scales the peaks and keeps the
+cornering (and longitudinal slip) stiffness B C D = K exactly (the slope at the curve's own origin: at zero slip
+ratio, the small horizontal shift p_hx1 moves the longitudinal slope by 0.5 % at 0.3). The combined-slip forces
+follow (proportional to the pure-slip ones, the kappa-induced side force to mu_y). The vertical shifts (p_vx1, and
+the camber thrust p_vy1, p_vy3), which Pacejka's full magic formula also scales by a friction factor, are left as
+published: they act at zero slip, i.e. in the linear handling, which the scale is to keep (scaled by 0.5 they
+changed the rear-axle sideslip of a 0.05 g turn at 15 m/s by 73 %; left, it changes by 2 %). The MB model runs on
+a copy of CommonRoad's parameters with p_dx1 and p_dy1 scaled; at 1.0 on CommonRoad's own parameters object.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 from functools import partial
@@ -58,6 +70,11 @@ _MB_STATES: tuple[str, ...] = (
 )
 
 
+#: CommonRoad tyre coefficients a road-friction scale multiplies: the longitudinal and lateral peak friction (the
+#: module docstring says why these and no others).
+_FRICTION_SCALED_TYRE_COEFFS: tuple[str, ...] = ("p_dx1", "p_dy1")
+
+
 @dataclass(frozen=True)
 class CommonRoadMBParams:
     """Which CommonRoad vehicle, plus the steering system and envelope CommonRoad does not model."""
@@ -91,6 +108,7 @@ class CommonRoadMB(VehicleModel):
     name: ClassVar[str] = "commonroad-mb"
     state_names: ClassVar[tuple[str, ...]] = _MB_STATES
     extra_output_names: ClassVar[tuple[str, ...]] = ("roll_rad", "path_curvature_1pm")
+    has_tyres: ClassVar[bool] = True
 
     def __init__(self, params: CommonRoadMBParams | None = None) -> None:
         from vehiclemodels.init_mb import init_mb
@@ -99,6 +117,8 @@ class CommonRoadMB(VehicleModel):
         self.params = p = params or CommonRoadMBParams()
         self._f, self._init = vehicle_dynamics_mb, init_mb
         self._cr = cr = _commonroad_parameters(p.vehicle_id)
+        #: The parameters the MB derivative runs on: `_cr` itself at road friction 1.0, else a scaled copy.
+        self._cr_road = cr
         self._b = float(cr.b)
         self._geometry = VehicleGeometry(
             wheelbase_m=float(cr.a + cr.b),
@@ -137,6 +157,17 @@ class CommonRoadMB(VehicleModel):
             source=source + f" (CommonRoad vehicle {p.vehicle_id} as a single track)",
         )
 
+    def _apply_road_friction(self, scale: float) -> None:
+        """Run the MB model on a copy of CommonRoad's parameters with the peak friction p_dx1 and p_dy1 multiplied
+        by `scale` (the module docstring: peaks scaled, slip stiffnesses kept); at 1.0 on CommonRoad's own
+        parameters object, so that the model is exactly the one built."""
+        cr = self._cr
+        if scale == 1.0:
+            self._cr_road = cr
+            return
+        scaled = {name: scale * getattr(cr.tire, name) for name in _FRICTION_SCALED_TYRE_COEFFS}
+        self._cr_road = dataclasses.replace(cr, tire=dataclasses.replace(cr.tire, **scaled))
+
     def initial_state(self, x_m: float, y_m: float, yaw_rad: float, speed_mps: float) -> np.ndarray:
         xc, yc = x_m + self._b * math.cos(yaw_rad), y_m + self._b * math.sin(yaw_rad)
         return np.array(self._init([xc, yc, 0.0, speed_mps, yaw_rad, 0.0, 0.0], self._cr), dtype=float)
@@ -146,7 +177,7 @@ class CommonRoadMB(VehicleModel):
         division by zero), so the simulator reports the state as diverged instead of a stray exception."""
         steer_rate = (delta_cmd - x[2]) / self.params.steering_time_constant_s
         try:
-            return np.array(self._f(x.tolist(), [steer_rate, accel], self._cr), dtype=float)
+            return np.array(self._f(x.tolist(), [steer_rate, accel], self._cr_road), dtype=float)
         except (ZeroDivisionError, OverflowError, ValueError):
             return np.full(len(_MB_STATES), np.nan)
 

@@ -8,7 +8,9 @@ fy_rear_N (axle lateral forces, lagging their steady-state value by the relaxati
 with B = k / (C mu) so that the cornering stiffness is k Fz, and Fz the axle load including the longitudinal
 load transfer m a_x h / L (as CommonRoad's ST model). Below kinematic_blend_high_mps the lateral accelerations
 blend into the kinematic bicycle's, so the model is well-posed at v = 0 and equals the kinematic bicycle there.
-The steering actuator is the kinematic bicycle's: first order, rate- and angle-limited.
+The steering actuator is the kinematic bicycle's: first order, rate- and angle-limited. A road-friction scale
+lambda (`set_road_friction`) makes mu = lambda x tyre_friction, in the peak mu Fz and in B = k / (C mu): the peak
+scales, the cornering stiffness k Fz stays.
 """
 
 from __future__ import annotations
@@ -161,6 +163,8 @@ class DynamicBicycle(CompiledVehicleModel):
     )
     extra_output_names: ClassVar[tuple[str, ...]] = ("fy_front_N", "fy_rear_N", "path_curvature_1pm")
 
+    has_tyres: ClassVar[bool] = True
+
     _advance_kernel = staticmethod(_advance)
     _outputs_kernel = staticmethod(_outputs)
 
@@ -177,11 +181,19 @@ class DynamicBicycle(CompiledVehicleModel):
         arr[P_TAU], arr[P_RATE] = p.steering_time_constant_s, p.max_road_wheel_rate_rad_s
         arr[P_SIGMA] = p.relaxation_length_m
         arr[P_VLO], arr[P_VHI] = p.kinematic_blend_low_mps, p.kinematic_blend_high_mps
-        arr[P_MU], arr[P_C], arr[P_E] = p.tyre_friction, p.tyre_shape_factor, p.tyre_curvature_factor
-        arr[P_BF] = p.front_cornering_coeff_per_rad / (p.tyre_shape_factor * p.tyre_friction)
-        arr[P_BR] = p.rear_cornering_coeff_per_rad / (p.tyre_shape_factor * p.tyre_friction)
+        arr[P_C], arr[P_E] = p.tyre_shape_factor, p.tyre_curvature_factor
         self._p = arr
+        self._apply_road_friction(1.0)
         self._geometry = VehicleGeometry.from_params(p, p.wheelbase_m)
+
+    def _apply_road_friction(self, scale: float) -> None:
+        """Peak friction mu = scale x tyre_friction (D = mu Fz, in the kernel) and B = k / (C mu), so that the
+        cornering stiffness B C D = k Fz is kept; scale 1.0 gives exactly the entries built from the parameters."""
+        p, arr = self.params, self._p
+        mu = scale * p.tyre_friction
+        arr[P_MU] = mu
+        arr[P_BF] = p.front_cornering_coeff_per_rad / (p.tyre_shape_factor * mu)
+        arr[P_BR] = p.rear_cornering_coeff_per_rad / (p.tyre_shape_factor * mu)
 
     def single_track(self, source: str | None = None) -> PredictionParams:
         """This model as a single track: its axles, static axle loads, tyres (cornering stiffness = coefficient x

@@ -3,7 +3,9 @@
 Stands in for the TruckSim 5-axle rig of the paper. Two rigid units joined at the fifth wheel (hitch); each axle
 group (tractor steer axle, drive tandem, trailer tandem) is lumped at its centre with one tyre force that follows
 a magic formula (peak = friction x static group load, cornering stiffness = coefficient x static group load) and
-lags it by a relaxation length. The reference point is the tractor's drive-group centre.
+lags it by a relaxation length. The reference point is the tractor's drive-group centre. A road-friction scale
+lambda (`set_road_friction`) multiplies the friction, in the peak and in B = coefficient / (C friction): the peak
+scales, the cornering stiffness stays.
 
 States (SI): x_m, y_m (drive-group centre), yaw_rad (tractor), vx_mps (tractor longitudinal speed),
 vy_cg_mps (tractor CG lateral velocity, tractor frame), yaw_rate_rad_s (tractor), trailer_yaw_rad,
@@ -392,6 +394,7 @@ class TractorSemitrailer(CompiledVehicleModel):
         "fy_trailer_N",
     )
     heading_states: ClassVar[tuple[str, ...]] = ("trailer_yaw_rad",)
+    has_tyres: ClassVar[bool] = True
     extra_output_names: ClassVar[tuple[str, ...]] = (
         "ltr",
         "ltr_front",
@@ -417,14 +420,22 @@ class TractorSemitrailer(CompiledVehicleModel):
         arr[P_TAU], arr[P_RATE] = p.steering_time_constant_s, p.max_road_wheel_rate_rad_s
         arr[P_SIGMA] = p.relaxation_length_m
         arr[P_VLO], arr[P_VHI] = p.kinematic_blend_low_mps, p.kinematic_blend_high_mps
-        coeffs = (p.front_cornering_coeff_per_rad, p.drive_cornering_coeff_per_rad, p.trailer_cornering_coeff_per_rad)
-        for i, (load, k) in enumerate(zip(dv.loads_n, coeffs, strict=True)):
-            arr[P_DF + i] = p.tyre_friction * load
-            arr[P_BF + i] = k / (p.tyre_shape_factor * p.tyre_friction)
         arr[P_SHAPE], arr[P_HOFF] = p.tyre_shape_factor, p.hitch_ahead_of_drive_m
         arr[P_KF1:P_N] = np.ravel(dv.ltr_per_ay)
         self._p = arr
+        self._apply_road_friction(1.0)
         self._geometry = VehicleGeometry.from_params(p, p.cg_to_front_axle_m + p.cg_to_drive_axle_m)
+
+    def _apply_road_friction(self, scale: float) -> None:
+        """Per axle group, peak D = mu x static load and B = coefficient / (C mu) with mu = scale x tyre_friction,
+        so that the cornering stiffness B C D = coefficient x load is kept; scale 1.0 gives exactly the entries
+        built from the parameters."""
+        p, arr = self.params, self._p
+        mu = scale * p.tyre_friction
+        coeffs = (p.front_cornering_coeff_per_rad, p.drive_cornering_coeff_per_rad, p.trailer_cornering_coeff_per_rad)
+        for i, (load, k) in enumerate(zip(self.derived.loads_n, coeffs, strict=True)):
+            arr[P_DF + i] = mu * load
+            arr[P_BF + i] = k / (p.tyre_shape_factor * mu)
 
     def single_track(self, source: str | None = None) -> PredictionParams:
         """Equivalent single track (module docstring): the tractor plus the kingpin's share of the trailer as a

@@ -26,6 +26,7 @@ from typing import Any
 from controllers import CONTROLLERS, make_controller
 from tuning.own_tuning import with_vehicle_tuning
 from workbench.apps.controller_config import read_controller_config
+from workbench.apps.studies.condition_parameters import CONDITION_FIELDS, run_conditions
 from workbench.apps.studies.lead_filter_scaling import scaled_filter
 from workbench.apps.studies.spec import EXTRA_RUN_PARAMETERS, LEAD_FILTER_SCALES, PlannedRun
 from workbench.simulation.metrics import METRIC_KEYS
@@ -80,15 +81,22 @@ def simulate(run: PlannedRun, progress: bool = False) -> SimulationResult:
     """Build and simulate the run; return the SimulationResult."""
     values = dict(run.values)
     extra = {k: values.pop(k, None) for k in EXTRA_RUN_PARAMETERS}
-    config = SimulationConfig(**values)
+    name = values.pop("conditions", None)
+    fields = {k: values.pop(k) for k in list(values) if k in CONDITION_FIELDS}
+    config = SimulationConfig(**values, conditions=run_conditions(name, fields))
     vehicle = load_vehicle(run.vehicle, extra["payload_kg"])  # a preset name or a vehicle file
     scenario = make_scenario(run.scenario, ScenarioOptions(vehicle.geometry.width_m, run.track_file))
     heading_deg = extra["initial_heading_error_deg"]
     scenario = scenario.with_initial_error(
         extra["initial_offset_m"], None if heading_deg is None else math.radians(heading_deg)
     )
-    options = build_controller_config(run, vehicle)
-    controller = make_controller(run.controller, vehicle.geometry, options, vehicle=vehicle)
+    # The controller is built for the vehicle with controller_payload_kg when given (a payload mismatch), else for
+    # the plant itself.
+    built_for = vehicle
+    if extra["controller_payload_kg"] is not None:
+        built_for = load_vehicle(run.vehicle, extra["controller_payload_kg"])
+    options = build_controller_config(run, built_for)
+    controller = make_controller(run.controller, vehicle.geometry, options, vehicle=built_for)
     return Simulation(scenario, vehicle, controller, config).run(progress=progress)
 
 

@@ -3,9 +3,11 @@ and seeded random draws; for `workbench optimise` also the objective and the sea
 
 The format, tables [study], [grid], [grid.NAME], [random], [random.NAME] and [optimise] (with its objective and
 search), is described with an example in README.md ("Studies: sweeps and optimisation"). Run parameters
-(RUN_PARAMETERS) are the fields of `SimulationConfig`, payload_kg, initial_offset_m and initial_heading_error_deg
-(omitted: the scenario's own). Controller parameters are the controller's options and, for a controller that
-reads a lead filter, lead_filter_zero_scale and lead_filter_pole_scale (`lead_filter_scaling.py`).
+(RUN_PARAMETERS) are the fields of `SimulationConfig` (its conditions as a preset name or file, and each of their
+scalar fields, `condition_parameters.py`), payload_kg, controller_payload_kg (the payload the controller is built
+for; omitted: the plant's), initial_offset_m and initial_heading_error_deg (omitted: the scenario's own).
+Controller parameters are the controller's options and, for a controller that reads a lead filter,
+lead_filter_zero_scale and lead_filter_pole_scale (`lead_filter_scaling.py`).
 
 Planned runs are the product, per scenario, vehicle and controller, of the run-parameter axes, that controller's
 axes and the random samples (draw i of every key together). Each run's id is a hash of its canonical parameters
@@ -36,6 +38,7 @@ from types import MappingProxyType
 from typing import Any
 
 from controllers import CONTROLLERS
+from workbench.apps.studies.condition_parameters import CONDITION_PARAMETERS, resolve_conditions
 from workbench.apps.studies.distributions import SEARCHABLE, Distribution, key_rng
 from workbench.base.errors import WorkbenchInputError, value_text
 from workbench.base.input_files import check_input_file, read_json, read_toml
@@ -48,12 +51,19 @@ from workbench.vehicles import VEHICLES
 #: The run parameters besides SimulationConfig's fields, with their types.
 EXTRA_RUN_PARAMETERS: dict[str, Any] = {
     "payload_kg": float,
+    "controller_payload_kg": float,
     "initial_offset_m": float,
     "initial_heading_error_deg": float,
 }
-#: Every run parameter and its type: SimulationConfig's fields, then the extras.
+#: Every run parameter and its type: SimulationConfig's fields (its conditions as `conditions`, a preset name or a
+#: file, and each scalar field of them, `condition_parameters.py`), then the extras.
 RUN_PARAMETERS: dict[str, Any] = {
-    **{f.name: typing.get_type_hints(SimulationConfig)[f.name] for f in dataclasses.fields(SimulationConfig)},
+    **{
+        f.name: typing.get_type_hints(SimulationConfig)[f.name]
+        for f in dataclasses.fields(SimulationConfig)
+        if f.name != "conditions"
+    },
+    **CONDITION_PARAMETERS,
     **EXTRA_RUN_PARAMETERS,
 }
 #: Factors on a lead filter's zero and pole frequencies, parameters of controllers that read one (`filter_file`).
@@ -405,7 +415,14 @@ class StudySpec:
         use is refused now."""
         base, controllers = self.base_dir, self.controllers
         grid = _axes("grid", self.grid, RUN_PARAMETERS, base)
+        if "conditions" in grid:
+            grid["conditions"] = tuple(resolve_conditions(v, base) for v in grid["conditions"])
         random = _draws("random", self.random, RUN_PARAMETERS, base)
+        if "conditions" in random:
+            raise WorkbenchInputError(
+                "random.conditions: draw the conditions' fields (e.g. actuation_dead_time_s), not the preset; give "
+                "conditions in [grid]"
+            )
         controller_grid, controller_random = {}, {}
         for where, table, out, parse in (
             ("grid", self.controller_grid, controller_grid, _axes),
@@ -427,7 +444,7 @@ class StudySpec:
                     f"{', '.join(both)} is both in [grid{where}] and in [random{where}]; keep one"
                 )
         models = _vehicle_models(self.vehicles)
-        if "payload_kg" in grid or "payload_kg" in random:
+        if any(k in grid or k in random for k in ("payload_kg", "controller_payload_kg")):
             others = [v for v in self.vehicles if not _has_payload(models[v])]
             if others:
                 raise WorkbenchInputError(

@@ -1,0 +1,289 @@
+"""How each controller degrades away from ideal conditions: one factor at a time around a base (`ideal` by default),
+over the actuation dead time, the pose latency, the position noise, the road's friction and, for a vehicle with a
+payload, a controller built for another payload than the plant carries. Every run is a study run (`PlannedRun`),
+executed on the study backends (local processes or Dask) into a resumable store; the report is one self-contained
+HTML file with the degradation curves (max |CTE|, steering oscillation, completion) and a table of the values at
+which each controller stops completing or starts to limit-cycle.
+"""
+
+from __future__ import annotations
+
+import base64
+import dataclasses
+import html
+import io
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from datetime import UTC, datetime
+from pathlib import Path
+from typing import Any
+
+import pandas as pd
+
+from workbench.apps.studies.backends import Backend
+from workbench.apps.studies.spec import PlannedRun, StudySpec
+from workbench.apps.studies.store import RunStore, write_results
+from workbench.apps.studies.sweep import execute_runs
+from workbench.base.errors import WorkbenchInputError, require_positive
+from workbench.vehicles import load_vehicle
+
+
+@dataclass(frozen=True)
+class Axis:
+    """One factor varied around the base: the run parameter, its values (the base's own first), how the report
+    shows them (label, unit, factor from the parameter's unit to the shown one)."""
+
+    parameter: str
+    values: tuple[float, ...]
+    label: str
+    unit: str
+    shown_factor: float = 1.0
+    #: Larger values are harder (the tolerance is the largest value that still passes); False: smaller are.
+    rising: bool = True
+
+
+#: The factors, each from its base value outward.
+AXES: tuple[Axis, ...] = (
+    Axis("actuation_dead_time_s", (0.0, 0.05, 0.1, 0.15, 0.2, 0.25, 0.3), "actuation dead time", "ms", 1000.0),
+    Axis("localisation_latency_s", (0.0, 0.05, 0.1, 0.2, 0.3), "pose latency", "ms", 1000.0),
+    Axis("localisation_position_noise_m", (0.0, 0.05, 0.1, 0.2, 0.5), "position noise sigma", "m"),
+    Axis("road_friction_scale", (1.0, 0.8, 0.6, 0.4), "road friction scale", "", rising=False),
+)
+#: A run passes when it completes, its steering does not limit-cycle and its max |CTE| stays within this (m; half
+#: of an ISO 3888 lane's spare width for a 2.5 m wide truck is about 0.25 m, so 0.5 m is leaving the lane).
+PASS_MAX_CTE_M = 0.5
+
+
+def _payload_kg(vehicle: str) -> float | None:
+    """The plant's own payload (None for a vehicle without one)."""
+    return getattr(load_vehicle(vehicle).params, "payload_kg", None)
+
+
+def plan_robustness(
+    scenario: str,
+    controllers: Sequence[str],
+    vehicle: str,
+    speed_kmh: float = 30.0,
+    conditions: str = "ideal",
+    seed: int = 0,
+    track_file: Path | None = None,
+    base_dir: Path | None = None,
+    axes: Sequence[Axis] = AXES,
+) -> list[PlannedRun]:
+    """Every run of the study: per controller, the base run, each axis's other values, and for a vehicle with a
+    payload the two payload mismatches (controller built for the loaded vehicle on the empty one, and the
+    reverse). Each axis's value is set on top of `conditions`."""
+    base = {"speed_kmh": speed_kmh, "conditions": conditions, "seed": seed}
+    grids = [dict(base)]
+    for axis in axes:
+        if axis.parameter == "road_friction_scale" and not load_vehicle(vehicle).has_tyres:
+            continue
+        grids.append(base | {axis.parameter: list(axis.values[1:])})
+    payload = _payload_kg(vehicle)
+    if payload is not None:
+        for plant, built_for in ((0.0, payload), (payload, 0.0)):
+            grids.append(base | {"payload_kg": plant, "controller_payload_kg": built_for})
+    runs: dict[str, PlannedRun] = {}
+    for grid in grids:
+        spec = StudySpec(
+            scenarios=[scenario],
+            controllers=list(controllers),
+            vehicles=[vehicle],
+            grid=grid,
+            track_file=track_file,
+            base_dir=base_dir or Path.cwd(),
+            description="robustness",
+        )
+        for run in spec.plan():
+            runs.setdefault(run.run_id, run)
+    return [dataclasses.replace(run, index=i) for i, run in enumerate(runs.values())]
+
+
+@dataclass(frozen=True)
+class RobustnessResult:
+    """The study's rows (one per run, the study columns) and what it was asked."""
+
+    rows: pd.DataFrame
+    scenario: str
+    vehicle: str
+    controllers: tuple[str, ...]
+    conditions: str
+    speed_kmh: float
+    axes: tuple[Axis, ...] = AXES
+    max_cte_m: float = PASS_MAX_CTE_M
+
+    def passed(self, row: pd.Series) -> bool:
+        """Completed, no steering limit cycle, max |CTE| within max_cte_m."""
+        return self.why_failed(row) == ""
+
+    def why_failed(self, row: pd.Series) -> str:
+        """Why the run does not pass ("" when it does)."""
+        if row["status"] != "completed":
+            return str(row["status"])
+        if bool(row["limit_cycle"]):
+            return "limit cycle"
+        if not row["max_abs_cte_m"] <= self.max_cte_m:
+            return f"max |CTE| > {self.max_cte_m:g} m"
+        return ""
+
+    def axis_rows(self, axis: Axis, controller: str) -> pd.DataFrame:
+        """The runs of one axis and controller, the base run included, by the axis's value (the base's value where
+        the column is empty), in the axis's order."""
+        df = self.rows[self.rows["controller"] == controller]
+        other_axes = [a.parameter for a in self.axes if a is not axis and a.parameter in df]
+        mismatch = [c for c in ("controller_payload_kg",) if c in df]
+        keep = df[[all(pd.isna(r[c]) for c in other_axes + mismatch) for _, r in df.iterrows()]].copy()
+        column = keep[axis.parameter] if axis.parameter in keep else pd.Series(math.nan, index=keep.index)
+        keep["value"] = column.fillna(axis.values[0]).astype(float)
+        return keep.sort_values("value", ascending=axis.rising)
+
+    def tolerance(self) -> pd.DataFrame:
+        """Per controller and axis: the last value, going outward from the base, at which every run so far passed,
+        and the first at which one did not (None when all passed)."""
+        out = []
+        for controller in self.controllers:
+            for axis in self.axes:
+                rows = self.axis_rows(axis, controller)
+                if len(rows) <= 1:
+                    continue
+                tolerated, failed, why = None, None, ""
+                for _, row in rows.iterrows():
+                    if self.passed(row):
+                        tolerated = row["value"]
+                        continue
+                    failed, why = row["value"], self.why_failed(row)
+                    break
+                out.append(
+                    {
+                        "controller": controller,
+                        "factor": axis.label,
+                        "unit": axis.unit,
+                        "tolerated": None if tolerated is None else tolerated * axis.shown_factor,
+                        "fails_at": None if failed is None else failed * axis.shown_factor,
+                        "how": why,
+                    }
+                )
+        return pd.DataFrame(out)
+
+    def mismatch(self) -> pd.DataFrame:
+        """The payload-mismatch runs: plant payload, controller built for, status, max |CTE|, oscillation."""
+        if "controller_payload_kg" not in self.rows:
+            return pd.DataFrame()
+        df = self.rows[self.rows["controller_payload_kg"].notna()]
+        columns = ["controller", "payload_kg", "controller_payload_kg", "status", "max_abs_cte_m"]
+        return df[[*columns, "steer_oscillation_deg", "limit_cycle"]].reset_index(drop=True)
+
+    def figure(self, axis: Axis):  # -> matplotlib Figure
+        """Max |CTE|, steering oscillation and completion against the axis's value, a line per controller."""
+        import matplotlib.pyplot as plt
+
+        fig, panels = plt.subplots(1, 3, figsize=(13, 3.6), layout="constrained")
+        for controller in self.controllers:
+            rows = self.axis_rows(axis, controller)
+            x = rows["value"] * axis.shown_factor
+            panels[0].plot(x, rows["max_abs_cte_m"], "o-", label=controller)
+            panels[1].plot(x, rows["steer_oscillation_deg"], "o-", label=controller)
+            passes = [1.0 if self.passed(r) else 0.0 for _, r in rows.iterrows()]
+            panels[2].plot(x, passes, "o-", label=controller)
+        unit = f" ({axis.unit})" if axis.unit else ""
+        for ax, ylabel in zip(
+            panels, ("max |CTE| (m)", "steering oscillation (deg)", "passes (1) / fails (0)"), strict=True
+        ):
+            ax.set(xlabel=f"{axis.label}{unit}", ylabel=ylabel)
+            ax.grid(True, alpha=0.3)
+        panels[0].set_yscale("log")
+        panels[2].set_ylim(-0.1, 1.1)
+        panels[0].legend()
+        fig.suptitle(f"{self.scenario}, {self.vehicle}: {axis.label}")
+        return fig
+
+    def report_html(self) -> str:
+        """The self-contained report (figures embedded as base64 PNG)."""
+        import matplotlib.pyplot as plt
+
+        title = f"Robustness: {', '.join(self.controllers)} on {self.vehicle}, {self.scenario}"
+        parts = [
+            "<!DOCTYPE html>",
+            '<html lang="en"><head><meta charset="utf-8">',
+            f"<title>{html.escape(title)}</title><style>{_STYLE}</style></head><body>",
+            f"<h1>{html.escape(title)}</h1>",
+            f"<p>Target speed {self.speed_kmh:g} km/h; each factor varied on its own around the base conditions "
+            f"<b>{html.escape(self.conditions)}</b>. A run passes when it completes, its steering does not "
+            f"limit-cycle and its max |CTE| stays within {self.max_cte_m:g} m.</p>",
+            f"<p><small>Generated {datetime.now(UTC):%Y-%m-%d %H:%M} UTC by the lateral-control workbench.</small></p>",
+            "<h2>Where each controller stops passing</h2>",
+            _html_table(self.tolerance()),
+        ]
+        mismatch = self.mismatch()
+        if len(mismatch):
+            parts += ["<h2>Payload mismatch</h2>", _html_table(mismatch)]
+        for axis in self.axes:
+            if axis.parameter not in self.rows and axis.values[0] is None:
+                continue
+            if all(len(self.axis_rows(axis, c)) <= 1 for c in self.controllers):
+                continue
+            fig = self.figure(axis)
+            buffer = io.BytesIO()
+            fig.savefig(buffer, format="png", dpi=90)
+            plt.close(fig)
+            alt = html.escape(f"degradation against {axis.label}")
+            png = base64.b64encode(buffer.getvalue()).decode("ascii")
+            parts.append(
+                f'<figure><img alt="{alt}" src="data:image/png;base64,{png}"><figcaption>{alt}</figcaption></figure>'
+            )
+        parts.append("</body></html>")
+        return "\n".join(parts)
+
+    def save(self, out_dir: str | Path) -> list[Path]:
+        """DIR/report.html and DIR/tolerance.csv (results.parquet is written as the runs finish)."""
+        out = Path(out_dir)
+        report, table = out / "report.html", out / "tolerance.csv"
+        report.write_text(self.report_html(), encoding="utf-8")
+        self.tolerance().to_csv(table, index=False)
+        return [report, table]
+
+
+_STYLE = (
+    "body{font-family:sans-serif;max-width:1300px;margin:2em auto;color:#222}"
+    "table{border-collapse:collapse;margin:1em 0}td,th{border:1px solid #bbb;padding:3px 8px;text-align:right}"
+    "th{background:#eee}figure{margin:1em 0}img{max-width:100%}"
+)
+
+
+def _html_table(frame: pd.DataFrame) -> str:
+    def cell(value: Any) -> str:
+        if value is None or (isinstance(value, float) and math.isnan(value)):
+            return "none"
+        if isinstance(value, float):
+            return f"{value:.3g}"
+        return html.escape(str(value))
+
+    head = "".join(f"<th>{html.escape(str(c))}</th>" for c in frame.columns)
+    body = "".join("<tr>" + "".join(f"<td>{cell(v)}</td>" for v in row) + "</tr>" for row in frame.itertuples(False))
+    return f"<table><tr>{head}</tr>{body}</table>"
+
+
+def run_robustness(
+    runs: Sequence[PlannedRun],
+    out_dir: str | Path,
+    backend: Backend,
+    scenario: str,
+    vehicle: str,
+    controllers: Sequence[str],
+    conditions: str = "ideal",
+    speed_kmh: float = 30.0,
+    progress: bool = False,
+    max_cte_m: float = PASS_MAX_CTE_M,
+) -> RobustnessResult:
+    """Run (or resume) the planned runs into out_dir (DIR/runs/, DIR/results.parquet) and return the result."""
+    require_positive("max_cte_m", max_cte_m)
+    if not runs:
+        raise WorkbenchInputError("the robustness study plans no runs")
+    rows, _ = execute_runs(runs, RunStore(out_dir), backend, progress, "robustness")
+    write_results(out_dir, rows)
+    frame = pd.DataFrame(rows)
+    return RobustnessResult(frame, scenario, vehicle, tuple(controllers), conditions, speed_kmh, max_cte_m=max_cte_m)
+
+
+__all__ = ["AXES", "Axis", "RobustnessResult", "plan_robustness", "run_robustness"]
