@@ -105,7 +105,11 @@ class ClothoidConfig:
     frechet_point_spacing_m: sampling of the curves compared (m); tolerance_x_m, tolerance_y_m: delta_x, delta_y of
     Eq. 3 (m); max_curvature_rate_1pm2: saturation of the clothoid's kappa' (1/m^2); initial_curvature: kappa(0)
     of Eq. 3, "yaw-rate", "command" or "steering"; heading: "course" or "yaw"; prediction_time_s: pose prediction
-    (s; 0: off); path_feedforward: the two-degree-of-freedom form (`path_feedforward.py`; False: Eq. 3 alone);
+    (s; 0: off); known_delay_s: the loop's dead time the controller knows, measurement latency (the pose measured
+    is that long old) plus actuation dead time (a command reaches the steering that much later) (s; 0: none): the
+    pose is predicted over prediction_time_s + known_delay_s, the reference pose and the feed-forward point move
+    ahead with it, and the lookahead floor's loop analysis has it as a pure delay (`loop_analysis.LoopSettings`);
+    path_feedforward: the two-degree-of-freedom form (`path_feedforward.py`; False: Eq. 3 alone);
     feedforward_window_m: the window the path's curvature rate is averaged over (m); feedforward_time_s,
     reference_lead_s: its timings (s; None: from the vehicle's identified lags); tuning: the steered vehicle's own
     tuning (lead filter, curvature limits, identified lags; `tuning.own_tuning.tuning_for` finds it, and
@@ -138,6 +142,7 @@ class ClothoidConfig:
     initial_curvature: str = "yaw-rate"
     heading: str = "course"
     prediction_time_s: float = 0.2
+    known_delay_s: float = 0.0
     path_feedforward: bool = True
     feedforward_window_m: float = 6.0
     feedforward_time_s: float | None = None
@@ -154,6 +159,7 @@ class ClothoidConfig:
         check_choice("heading", self.heading, HEADINGS)
         check_choice("threshold_mode", self.threshold_mode, THRESHOLD_MODES)
         check_number("prediction_time_s", self.prediction_time_s, 0.0, 2.0, "s")
+        check_number("known_delay_s", self.known_delay_s, 0.0, 1.0, "s", note="0: none")
         check_number("min_preview_time_s", self.min_preview_time_s, 0.0, 10.0, "s")
         check_number("lookahead_hysteresis_m", self.lookahead_hysteresis_m, 0.0, 50.0, "m")
         require_rate("max_lookahead_growth_m_per_m", self.max_lookahead_growth_m_per_m)
@@ -286,11 +292,12 @@ class ClothoidController(Controller):
     def loop_settings(self, speed_kmh: float) -> LoopSettings:
         """What the controller does at this speed, for `loop_analysis`."""
         lead = self.filter_schedule.at_speed(speed_kmh) if self.filter_schedule is not None else None
-        return LoopSettings(self._dt, self.config.prediction_time_s, lead=lead)
+        return LoopSettings(self._dt, self.config.prediction_time_s, lead=lead, known_delay_s=self.config.known_delay_s)
 
     def lookahead_floor_m(self, speed_mps: float) -> float:
         """The shortest lookahead (m) that keeps the configured margins at this speed (per FLOOR_SPEED_BAND_KMH band,
-        computed once per band and run; min_lookahead_m without a tuning or with the margins set to 0)."""
+        computed once per band and run; min_lookahead_m without a tuning or with the margins set to 0). The analysis
+        is cached on all of `loop_settings`, the known delay included."""
         cfg = self.config
         band = max(1, round(speed_mps * 3.6 / FLOOR_SPEED_BAND_KMH))
         floor = self._floors.get(band)
@@ -314,7 +321,9 @@ class ClothoidController(Controller):
     def feedforward_timing(self, speed_mps: float) -> FeedforwardTiming:
         """The feed-forward's timing at this speed: the options, else from the identified lags (path_feedforward.py):
         feed-forward time = the low-frequency delay of lead filter and path lag; reference lead = the path lag's less
-        the measured (yaw-rate) lag's, within [0, prediction time]; K of the path lag."""
+        the measured (yaw-rate) lag's, within [0, prediction time]; K of the path lag. A known delay adds to the
+        feed-forward time (the steering commanded now takes effect that much later, from a pose that much older)
+        and to the prediction time."""
         cfg, speed_kmh = self.config, speed_mps * 3.6
         lags = self.plant_lags(speed_kmh)
         lead = self.filter_schedule.at_speed(speed_kmh) if self.filter_schedule is not None else None
@@ -322,9 +331,10 @@ class ClothoidController(Controller):
         measured_delay = path_delay if lags is None or lags.measured is None else lags.measured.group_delay_s
         lead_delay = 0.0 if lead is None else lead.group_delay_s
         ff = cfg.feedforward_time_s if cfg.feedforward_time_s is not None else max(0.0, path_delay + lead_delay)
+        ff += cfg.known_delay_s
         ref = cfg.reference_lead_s
         if ref is None:
-            ref = min(max(path_delay - measured_delay, 0.0), cfg.prediction_time_s)
+            ref = min(max(path_delay - measured_delay, 0.0), self._prediction_horizon_s)
         gain = 1.0 if lags is None else lags.path.steady_state_gain
         return FeedforwardTiming(min(ff, 5.0), min(ref, 5.0), gain)
 
@@ -337,15 +347,21 @@ class ClothoidController(Controller):
             return steering_kappa
         return self._kappa_cmd
 
+    @property
+    def _prediction_horizon_s(self) -> float:
+        """How far ahead the pose is predicted (s): prediction_time_s plus the known delay."""
+        return self.config.prediction_time_s + self.config.known_delay_s
+
     def _start_pose(self, m: Measurement, kappa0: float) -> tuple[float, float, float]:
         """(x, y, heading) the clothoid starts from: the rear axle, heading along its course (or body yaw), moved
-        ahead by prediction_time_s on the current curvature (Figure 2, step 5)."""
+        ahead by prediction_time_s + known_delay_s on the current curvature (Figure 2, step 5)."""
         cfg = self.config
         heading = m.yaw_rad
         if cfg.heading == "course" and m.vx_mps > MIN_SPEED_MPS:
             heading += math.atan2(m.vy_mps, m.vx_mps)
-        if cfg.prediction_time_s > 0.0:
-            return along_arc(m.x_m, m.y_m, heading, kappa0, m.speed_mps * cfg.prediction_time_s)
+        horizon = self._prediction_horizon_s
+        if horizon > 0.0:
+            return along_arc(m.x_m, m.y_m, heading, kappa0, m.speed_mps * horizon)
         return m.x_m, m.y_m, heading
 
     def _lookahead(self, path: ReferencePath, foot_index: float, cte_m: float, pose, kappa0: float, speed_mps: float):
@@ -391,7 +407,7 @@ class ClothoidController(Controller):
         clothoid_kdot = reference_kdot = feedforward_kdot = kdot
         if cfg.path_feedforward:  # path_feedforward.py: feedback relative to the path's own clothoid, plus its rate
             kdot, reference_kdot, feedforward_kdot = two_degree_of_freedom_rate(
-                kdot, path, self._here.update(m.x_m, m.y_m), (tx, ty), m.speed_mps, cfg.prediction_time_s,
+                kdot, path, self._here.update(m.x_m, m.y_m), (tx, ty), m.speed_mps, self._prediction_horizon_s,
                 self.feedforward_timing(m.speed_mps), cfg.feedforward_window_m,
             )  # fmt: skip
 

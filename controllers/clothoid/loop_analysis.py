@@ -6,12 +6,13 @@ in deviations from it: lateral offset y, heading error psi, curvature kappa.
 
 - Plant: the steering sent (as kinematic curvature u) -> the identified lag of Eq. 5 (K wn^2 / (s^2 + 2 zeta wn s +
   wn^2), with its pure delay) -> path curvature kappa; psi' = V kappa - V kappa_r^2 y, y' = V psi (Frenet);
-  discretised with a zero-order hold at the controller period, plus any measurement delay (whole periods).
-- Controller, exactly as `controller.py` steps it: the start pose predicted over the prediction time on kappa(0)
-  (the measured curvature, yaw rate / speed, or the integrator's command); kappa' of Eq. 3 at that pose as
-  feedback on (y, psi, kappa), its gains taken by finite differences of the compiled hyper-clothoid fit to a target
-  on the path at the lookahead (so the arc's geometry is in them); kappa' V integrated by forward Euler; the lead
-  filter of Eq. 6 (Tustin). The controller's state-space is read off its own linear step function by unit probes.
+  discretised with a zero-order hold at the controller period, plus any delay (whole periods; `LoopSettings`).
+- Controller, exactly as `controller.py` steps it: the start pose predicted over the prediction time and the known
+  delay on kappa(0) (the measured curvature, yaw rate / speed, or the integrator's command); kappa' of Eq. 3 at
+  that pose as feedback on (y, psi, kappa), its gains taken by finite differences of the compiled hyper-clothoid
+  fit to a target on the path at the lookahead (so the arc's geometry is in them); kappa' V integrated by forward
+  Euler; the lead filter of Eq. 6 (Tustin). The controller's state-space is read off its own linear step function
+  by unit probes.
 - The loop is broken at the steering sent: L(z) = -C(z) P(z), negative-feedback convention.
 
 Margins: phase margin at every gain crossover (the least reported); gain margin (how much the loop gain may rise,
@@ -59,18 +60,28 @@ _GRID_POINTS = 2000
 class LoopSettings:
     """What the controller does, for the analysis: sample_time_s (controller period, s), prediction_time_s (pose
     prediction, s), initial_curvature (kappa(0) of Eq. 3: "yaw-rate", the measured curvature, or "command", the
-    integrator's), lead (Eq. 6 filter, None: off), measurement_delay_s (s, rounded to whole periods)."""
+    integrator's), lead (Eq. 6 filter, None: off), measurement_delay_s (a dead time the controller does not know,
+    s, rounded to whole periods), known_delay_s (the dead time it knows, measurement latency plus actuation dead
+    time, s: the same pure delay in the loop, and the pose is predicted over it too, prediction_time_s +
+    known_delay_s; `ClothoidConfig.known_delay_s`).
+
+    Where a delay sits does not matter here: the loop is single-input (broken at the steering sent) and every
+    output the controller measures (y, psi, kappa) comes out of the same plant, so a measurement latency z^-n P(z)
+    and an actuation dead time P(z) z^-n give the same loop transfer; both are modelled as a delay of the plant's
+    input. The controller's own state (its integrator, read as kappa(0) with "command") is delayed by neither."""
 
     sample_time_s: float = 0.02
     prediction_time_s: float = 0.2
     initial_curvature: str = "yaw-rate"
     lead: LeadFilterParams | None = None
     measurement_delay_s: float = 0.0
+    known_delay_s: float = 0.0
 
     def __post_init__(self) -> None:
         require_in_range("sample_time_s", self.sample_time_s, 1e-4, 1.0, "s")
         require_in_range("prediction_time_s", self.prediction_time_s, 0.0, 2.0, "s")
         require_in_range("measurement_delay_s", self.measurement_delay_s, 0.0, 2.0, "s")
+        require_in_range("known_delay_s", self.known_delay_s, 0.0, 2.0, "s")
         if self.initial_curvature not in INITIAL_CURVATURES:
             raise WorkbenchInputError(
                 f"initial_curvature must be one of {', '.join(INITIAL_CURVATURES)} for the analysis; got "
@@ -191,7 +202,7 @@ def _plant_parts(
     c_c = np.zeros((3, 6))
     c_c[0, 3], c_c[1, 2], c_c[2, 4] = 1.0, 1.0, measured.steady_state_gain
     a, b, c, d, _ = signal.cont2discrete((a_c, b_c, c_c, np.zeros((3, 2))), dt, method="zoh")
-    extra = settings.measurement_delay_s
+    extra = settings.measurement_delay_s + settings.known_delay_s
     taps = (_delay_steps(path.delay_s + extra, dt), _delay_steps(measured.delay_s + extra, dt))
     return control.ss(a, b, c, d, dt), taps
 
@@ -228,7 +239,7 @@ def _controller_step(
     if settings.lead is not None:
         a_f, b_f, c_f, d_f = DiscreteLeadFilter(settings.lead, dt).state_space
         a_f, b_f, c_f = np.array(a_f), np.array(b_f), np.array(c_f)
-    dp = v * settings.prediction_time_s
+    dp = v * (settings.prediction_time_s + settings.known_delay_s)  # the pose predicted over the known delay too
     measured = settings.initial_curvature == "yaw-rate"
 
     def step(s: np.ndarray, meas: np.ndarray) -> tuple[np.ndarray, float]:

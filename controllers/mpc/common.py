@@ -16,6 +16,11 @@ Each step (section 6.6 of the paper compares the clothoid controller with an MPC
      times the steering ratio, saturated. A solve that is not accepted (failed, iteration limit, late, infeasible,
      non-finite) is not used: the previous plan, shifted, is replayed (hold of the current command if there is
      none), and the trace says so (`ctrl_fallback` = 1, `ctrl_solver_status`, `ctrl_plan_age_s`).
+
+A known measurement latency L and actuation dead time D (`measurement_latency_s`, `input_delay_s`) are compensated
+as Autoware's lateral MPC does: the state of step 2, which describes t - L, is predicted to t + D with the commands
+already sent (`MPCController.predict_ahead`), and the plan starts there (`ctrl_delay_compensation_s` = L + D,
+logged when it is not 0).
 """
 
 from __future__ import annotations
@@ -25,12 +30,15 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
+import casadi as ca
 import numpy as np
+from numba import njit
 
 from controllers.base import Controller, Measurement
 from controllers.config_checks import check_bool, check_choice, check_number, check_optional_instance, check_whole
+from controllers.mpc.codegen import FastFunction, compile_function
 from controllers.mpc.ocp import TrackingOCP, TrackingWeights
-from controllers.mpc.plan import Plan
+from controllers.mpc.plan import Plan, shift_rows
 from controllers.mpc.prediction_model import (
     MODEL_KINDS,
     PredictionModel,
@@ -56,6 +64,8 @@ GEOMETRY_TOLERANCE = 0.02
 NO_OBJECTIVE = -1.0
 #: The largest cost weight the options allow (larger ones only make the QPs ill-conditioned).
 MAX_WEIGHT = 1e9
+#: Command knots closer than this (s) to an end of the prediction window start no segment of their own.
+_KNOT_MERGE_S = 1e-9
 
 
 @dataclass(frozen=True)
@@ -76,7 +86,11 @@ class MPCConfig:
     limit on the predicted lateral acceleration (m/s^2; 0: none) with weight_lat_accel_slack (s^4/m^2);
     min_model_speed_mps: the prediction never runs slower than this (m/s); max_solve_time_s: the solver's wall-time
     budget (s), a solve cut short by it is late and not used (0: the controller's sample time); codegen: compile
-    the model's derivatives with the system C compiler where that pays (cached; ignored without a compiler).
+    the model's derivatives with the system C compiler where that pays (cached; ignored without a compiler);
+    input_delay_s: the known actuation dead time D (s; a command sent at t reaches the steering at t + D) and
+    measurement_latency_s: the known measurement latency L (s; the measurement stamped t describes t - L), which the
+    controller compensates by predicting the measured state to t + D with the commands already sent and planning
+    from there (module docstring; 0 and 0: no compensation, the plan starts at the measurement).
     """
 
     vehicle: str = "auto"
@@ -95,6 +109,8 @@ class MPCConfig:
     min_model_speed_mps: float = 3.0
     max_solve_time_s: float = 0.0
     codegen: bool = True
+    input_delay_s: float = 0.0
+    measurement_latency_s: float = 0.0
 
     def __post_init__(self) -> None:
         from workbench.vehicles import VEHICLES
@@ -113,6 +129,8 @@ class MPCConfig:
         check_number("min_model_speed_mps", self.min_model_speed_mps, 0.5, 50.0, "m/s")
         check_number("max_solve_time_s", self.max_solve_time_s, 0.0, 10.0, "s", note="0: the sample time")
         check_bool("codegen", self.codegen)
+        check_number("input_delay_s", self.input_delay_s, 0.0, 1.0, "s", note="0: none")
+        check_number("measurement_latency_s", self.measurement_latency_s, 0.0, 1.0, "s", note="0: none")
 
     @property
     def weights(self) -> TrackingWeights:
@@ -191,6 +209,10 @@ class MPCController(Controller):
         )
         self._build_solver()
         self._sample_time_s = 0.02
+        self._delay_s = cfg.measurement_latency_s + cfg.input_delay_s
+        self._delay_integrators: dict[tuple[int, int], FastFunction] = {}
+        self._delay_integrator: FastFunction | None = None
+        self._delay_chunk = 0
         self._reset_state()
 
     # ------------------------------------------------------------------ subclass hooks
@@ -211,11 +233,19 @@ class MPCController(Controller):
         self._reset_state()
         self._tracker: PathTracker = path.tracker(0.0)
         self._preview = PathPreview(path)
+        if self._delay_s > 0.0:
+            self._prepare_delay_integrator()
 
     def _reset_state(self) -> None:
         self._plan: Plan | None = None
         self._last_command: float | None = None
         self._failures = 0
+        # The road-wheel commands sent (and their times), oldest first, the newest at the end: what the plant
+        # receives over the delays (`_delayed_state`). Room for the window L + D + one period, twice over.
+        capacity = 2 * math.ceil((self._delay_s + self._sample_time_s) / self._sample_time_s) + 8
+        self._sent_times = np.zeros(capacity)
+        self._sent_commands = np.zeros(capacity)
+        self._sent_count = 0
         self._diag = {
             "solver_status": float(SolveStatus.SOLVED),
             "solve_time_s": 0.0,
@@ -228,20 +258,28 @@ class MPCController(Controller):
             "road_wheel_rate_cmd_rad_s": 0.0,
             "model_speed_mps": 0.0,
         }
+        if self._delay_s > 0.0:  # logged only when compensating, so a run without is today's trace bit for bit
+            self._diag["delay_compensation_s"] = self._delay_s
 
     def _command(self, measurement: Measurement, path: ReferencePath) -> float:
         m, ocp, model = measurement, self.ocp, self.model
         foot = self._tracker.update(m.x_m, m.y_m)
         plan = self._plan
-        shifted = plan.shifted(m.t_s) if plan is not None else None
-        x0 = self._initial_state(m, foot, shifted[0][0] if shifted else None)
+        # The plan's time origin: now, or with a known actuation dead time D the time the command sent now starts
+        # to reach the steering (t + D); warm start and fallback are taken at the same origin.
+        origin = m.t_s + self.config.input_delay_s
+        shifted = plan.shifted(origin) if plan is not None else None
         v0 = max(m.vx_mps if model.kind == "dynamic" else m.speed_mps, 0.0)
+        if self._delay_s > 0.0:  # the measured state (at t - L) predicted to t + D with the commands sent
+            x0, s0, v0 = self._delayed_state(m, foot, plan, v0)
+        else:
+            x0, s0 = self._initial_state(m, foot, shifted[0][0] if shifted else None), foot.s_m
         h = ocp.step_s
         if shifted is not None:
             progress = shifted[2]
         else:
             progress = max(v0, ocp.min_speed_mps) * h * np.arange(ocp.N + 1)
-        along = self._preview.along(foot.s_m, progress, v0, ocp.min_speed_mps)
+        along = self._preview.along(s0, progress, v0, ocp.min_speed_mps)
         kappa, speed = along[:, 0], along[:, 1]
         first = shifted is None
         if first:
@@ -251,36 +289,40 @@ class MPCController(Controller):
         else:
             guess_states, guess_inputs = shifted[0], shifted[1]
             # Only IPOPT returns multipliers; the QP solvers keep their own, so no positions are computed for them.
-            dual = self.solver.shift_dual(plan.dual, plan.positions(m.t_s)) if plan.dual else ()
+            dual = self.solver.shift_dual(plan.dual, plan.positions(origin)) if plan.dual else ()
         result = self.solver.solve(x0, kappa, speed, guess_states, guess_inputs, dual, first)
 
-        t_next = m.t_s + self._sample_time_s
+        t_next = origin + self._sample_time_s
         if result.accepted:
             progress = ocp.progress(result.states, kappa, speed)
-            self._plan = plan = Plan(m.t_s, h, result.states, result.inputs, progress, model.i_cmd, result.dual)
+            self._plan = plan = Plan(origin, h, result.states, result.inputs, progress, model.i_cmd, result.dual)
         else:
             self._failures += 1
         if plan is not None:
             command = plan.command_at(t_next)
-            rate = plan.rate_at(m.t_s)
+            rate = plan.rate_at(origin)
         else:  # no plan yet: hold the current command
             command, rate = float(x0[model.i_cmd]), 0.0
         limit = self.prediction.max_road_wheel_angle_rad
         command = min(max(command, -limit), limit)
         if math.isfinite(command):  # else the base class holds the last command and says so
             self._last_command = command
+        if self._delay_s > 0.0 and self._last_command is not None:
+            self._record_sent(m.t_s, self._last_command)
         self._diag = {
             "solver_status": float(result.status),
             "solve_time_s": float(result.solve_time_s),
             "solver_iterations": float(result.iterations),
             "fallback": 0.0 if result.accepted else 1.0,
-            "plan_age_s": 0.0 if plan is None else m.t_s - plan.t_s,
+            "plan_age_s": 0.0 if plan is None else origin - plan.t_s,
             "failed_solves": float(self._failures),
             "objective": float(result.objective) if math.isfinite(result.objective) else NO_OBJECTIVE,
             "predicted_cte_end_m": 0.0 if plan is None else float(plan.states[-1, model.i_cte]),
             "road_wheel_rate_cmd_rad_s": rate,
             "model_speed_mps": float(speed[0]),
         }
+        if self._delay_s > 0.0:
+            self._diag["delay_compensation_s"] = self._delay_s
         return self.saturate(command * self.prediction.steering_ratio)
 
     def _diagnostics(self) -> Mapping[str, float]:
@@ -292,8 +334,11 @@ class MPCController(Controller):
         return self._plan
 
     # ------------------------------------------------------------------ state estimate
-    def _initial_state(self, m: Measurement, foot: Projection, predicted: np.ndarray | None) -> np.ndarray:
-        """The model state now: measured components, the last command, and the shifted plan for the rest."""
+    def _initial_state(
+        self, m: Measurement, foot: Projection, predicted: np.ndarray | None, command: float | None = None
+    ) -> np.ndarray:
+        """The model state the measurement describes: measured components, the commanded angle (`command`; None:
+        the last command sent, the measured angle on a run's first step), and the previous plan for the rest."""
         model, prm = self.model, self.prediction
         names = model.state_names
         x = np.zeros(model.nx) if predicted is None else np.array(predicted, dtype=float)
@@ -305,9 +350,10 @@ class MPCController(Controller):
             heading += math.atan2(m.vy_mps, m.vx_mps)
         x[model.i_cte] = foot.cte_m
         x[model.i_heading] = float(wrap_angle(heading - foot.heading_rad))
-        if self._last_command is None:  # the first step: the commanded angle is the measured one, within its bounds
-            limit = prm.max_road_wheel_angle_rad
-            command = min(max(road_wheel, -limit), limit)
+        if command is not None:
+            pass
+        elif self._last_command is None:  # the first step: the commanded angle is the measured one, within its bounds
+            command = self._measured_command(m)
         else:
             command = self._last_command
         x[model.i_cmd] = command
@@ -330,3 +376,161 @@ class MPCController(Controller):
                 if "delayed_wheelbase_x_curvature" in names:
                     x[names.index("delayed_wheelbase_x_curvature")] = kinematic
         return x
+
+    def _measured_command(self, m: Measurement) -> float:
+        """The measured road-wheel angle within its bounds: the commanded angle assumed before any command."""
+        limit = self.prediction.max_road_wheel_angle_rad
+        return min(max(m.steer_wheel_rad / self.prediction.steering_ratio, -limit), limit)
+
+    # ------------------------------------------------------------------ known delays
+    def _delay_segment_s(self) -> float:
+        """The longest segment of the prediction over the delays (s): a controller period, at most a prediction step."""
+        return min(self._sample_time_s, self.ocp.step_s)
+
+    def _prepare_delay_integrator(self) -> None:
+        """The compiled integrator of `predict_ahead` for this sample time, built once per (chunk, sub-steps) and
+        kept. One call integrates a chunk of segments, as many as the window L + D has with one per controller
+        period (padded with empty ones; more segments take more calls), each by RK4 over its own duration dt with
+        its rate u and path (kappa, v) held, in enough sub-steps for the fastest mode at the longest segment
+        (`substeps_for`); the state is augmented by the progress along the path s (s' = `progress_rate`)."""
+        model, ocp = self.model, self.ocp
+        longest = self._delay_segment_s()
+        chunk = math.ceil(self._delay_s / longest - 1e-9) + 2
+        substeps = model.substeps_for(longest, ocp.min_speed_mps)
+        key = (chunk, substeps)
+        if key not in self._delay_integrators:
+            nx = model.nx
+            z, u, p, dt = ca.SX.sym("z", nx + 1), ca.SX.sym("u", 1), ca.SX.sym("p", 2), ca.SX.sym("dt", 1)
+
+            def rate(zk: ca.SX) -> ca.SX:
+                return ca.vertcat(model.ode(zk[:nx], u, p), model.progress_rate(zk[:nx], p))
+
+            h = dt / substeps
+            zk = z
+            for _ in range(substeps):
+                k1 = rate(zk)
+                k2 = rate(zk + 0.5 * h * k1)
+                k3 = rate(zk + 0.5 * h * k2)
+                k4 = rate(zk + h * k3)
+                zk = zk + h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+            mapped = ca.Function("delay_step", [z, u, p, dt], [zk]).mapaccum(chunk)
+            inputs = mapped.mx_in()
+            name = f"mpc_{model.kind.replace('-', '_')}_delay_{chunk}x{substeps}"
+            compiled = compile_function(ca.Function(name, inputs, mapped.call(inputs)), self.config.codegen)
+            self._delay_integrators[key] = FastFunction(compiled.function)
+        self._delay_integrator, self._delay_chunk = self._delay_integrators[key], chunk
+
+    def _record_sent(self, t_s: float, command: float) -> None:
+        """Buffer a road-wheel command sent at t_s (the oldest falls out when full). The first one is preceded by the
+        commanded angle assumed before any command, one period earlier (`_delayed_state`)."""
+        times, commands = self._sent_times, self._sent_commands
+        if self._sent_count < times.size:
+            times[self._sent_count], commands[self._sent_count] = t_s, command
+            self._sent_count += 1
+        else:
+            times[:-1], commands[:-1] = times[1:], commands[1:]
+            times[-1], commands[-1] = t_s, command
+
+    def _delayed_state(
+        self, m: Measurement, foot: Projection, plan: Plan | None, v0_mps: float
+    ) -> tuple[np.ndarray, float, float]:
+        """(model state at t + D, arc length of its foot point, speed there) from a measurement stamped t that
+        describes t - L (MPCConfig's input_delay_s D, measurement_latency_s L).
+
+        As Autoware's lateral MPC (`autoware_mpc_lateral_controller`, `MPC::updateStateForDelayCompensation`, which
+        rolls the initial state over `input_delay` with the commands kept in `m_input_buffer` and resamples the
+        reference from `nearest_time + input_delay`): the plant receives at tau the command sent at tau - D, so over
+        [t - L, t + D] it receives the buffered commands sent over [t - L - D, t - D]. In the model's convention,
+        where the command sent at t_j is the commanded angle reached one period T later (the plan's command at
+        t + T is sent at t), the commanded angle at tau is the buffered commands, linearly interpolated, at
+        tau - D - T: so it starts at the command being received at t - L and the input rates are the slopes between
+        buffered commands; before the first command it is the measured angle of the first step, after the last
+        the last held. States no sensor gives are the previous plan's at t - L (its start if t - L is earlier)."""
+        cfg, T = self.config, self._sample_time_s
+        if self._sent_count == 0:  # a run's first step: the angle measured now has been commanded all along
+            self._record_sent(m.t_s - T, self._measured_command(m))
+        n = self._sent_count
+        start = m.t_s - cfg.measurement_latency_s - cfg.input_delay_s - T  # t - L, in the buffer's time (tau - D - T)
+        dts, rates, command = _delay_segments(
+            self._sent_times[:n], self._sent_commands[:n], start, self._delay_s, self._delay_segment_s()
+        )
+        unmeasured = None
+        if plan is not None:
+            unmeasured = shift_rows(
+                plan.states, max((m.t_s - cfg.measurement_latency_s - plan.t_s) / plan.step_s, 0.0), 1
+            )[0]
+        x = self._initial_state(m, foot, unmeasured, command)
+        return self.predict_ahead(x, foot.s_m, v0_mps, dts, rates)
+
+    def predict_ahead(
+        self, x0: np.ndarray, s0_m: float, v0_mps: float, durations_s: np.ndarray, rates: np.ndarray
+    ) -> tuple[np.ndarray, float, float]:
+        """(state, foot arc length s0 + progress (m), speed (m/s)) after the segments `durations_s` (s, each at most
+        `_delay_segment_s`) with the input rates `rates` (rad/s, the commanded angle's), from state x0 at foot arc
+        length s0_m and speed v0_mps: the model integrated along the path (reset first), each segment on the path's
+        curvature and speed at its middle (`PathPreview.along`, at progress estimated at the model's speed; the
+        Frenet errors and the progress are the model's own), RK4. The speed at the end follows the path's speed
+        profile from v0 as the preview does. Needs input_delay_s or measurement_latency_s > 0."""
+        integrate, chunk, nx = self._delay_integrator, self._delay_chunk, self.model.nx
+        assert integrate is not None, "predict_ahead needs input_delay_s or measurement_latency_s > 0 and a reset"
+        dt, u, nodes = _chunked(durations_s, rates, chunk, max(v0_mps, self.ocp.min_speed_mps))
+        path = self._preview.along(s0_m, nodes, v0_mps, self.ocp.min_speed_mps)
+        z = np.empty(nx + 1)
+        z[:nx], z[nx] = x0, 0.0
+        for c in range(0, dt.shape[0], chunk):
+            (out,) = integrate(z, u[c : c + chunk], path[c : c + chunk].T, dt[c : c + chunk])
+            z = out[-(nx + 1) :].copy()
+        progress = float(z[nx])
+        planned_change = float(self._preview.along(s0_m, np.array([progress, progress]), 0.0, -math.inf)[0, 1])
+        return z[:nx], s0_m + progress, v0_mps + planned_change
+
+
+@njit(cache=True)
+def _chunked(
+    durations: np.ndarray, rates: np.ndarray, chunk: int, speed_mps: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:  # pragma: no cover - compiled
+    """Segments padded with empty ones (duration and rate 0) to whole chunks: (durations, rates, progress at
+    each node estimated at speed_mps, the padding's at the last). Compiled: it runs every step."""
+    k = durations.shape[0]
+    size = max(1, -(-k // chunk)) * chunk
+    dt, u, nodes = np.zeros(size), np.zeros(size), np.zeros(size + 1)
+    for i in range(k):
+        dt[i], u[i] = durations[i], rates[i]
+    for i in range(size):
+        nodes[i + 1] = nodes[i] + speed_mps * dt[i]
+    return dt, u, nodes
+
+
+@njit(cache=True)
+def _delay_segments(
+    times: np.ndarray, commands: np.ndarray, start: float, horizon: float, max_step: float
+) -> tuple[np.ndarray, np.ndarray, float]:  # pragma: no cover - compiled
+    """The commanded angle over [start, start + horizon] as segments: (durations (s), rates (rad/s), the angle at
+    start). The angle is the buffered commands linearly interpolated in time, held before the first and after the
+    last; segments break at the buffered times and are at most max_step long. Compiled: it runs every step."""
+    end = start + horizon
+    breaks = np.empty(times.shape[0] + 2)
+    breaks[0] = start
+    count = 1
+    for t in times:
+        if start + _KNOT_MERGE_S < t < end - _KNOT_MERGE_S:
+            breaks[count] = t
+            count += 1
+    breaks[count] = end
+    count += 1
+    pieces = np.empty(count - 1, dtype=np.int64)
+    for i in range(count - 1):
+        pieces[i] = max(1, math.ceil((breaks[i + 1] - breaks[i]) / max_step - 1e-9))
+    durations = np.empty(pieces.sum())
+    rates = np.empty(durations.shape[0])
+    first = np.interp(start, times, commands)
+    before, j = first, 0
+    for i in range(count - 1):
+        after = np.interp(breaks[i + 1], times, commands)
+        length = breaks[i + 1] - breaks[i]
+        for _ in range(pieces[i]):
+            durations[j] = length / pieces[i]
+            rates[j] = (after - before) / length if length > 0.0 else 0.0
+            j += 1
+        before = after
+    return durations, rates, first
