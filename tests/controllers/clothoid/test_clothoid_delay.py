@@ -5,11 +5,9 @@ controller keeps tracking without the limit cycle it falls into unaware of the d
 
 from __future__ import annotations
 
-import collections
 import dataclasses
 import math
 
-import numpy as np
 import pytest
 
 from controllers.base import Measurement
@@ -19,13 +17,20 @@ from controllers.clothoid.pose_prediction import along_arc
 from tuning.own_tuning import tuned_controller, tuning_for
 from workbench.base.clothoid_chain import ClothoidChain
 from workbench.base.errors import WorkbenchInputError
+from workbench.simulation.conditions import Actuation, Conditions
 from workbench.simulation.scenarios import ScenarioOptions, make_scenario
 from workbench.simulation.simulator import Simulation, SimulationConfig
 from workbench.vehicles import make_vehicle
-from workbench.vehicles.base import VehicleModel
 from workbench.vehicles.steering_lag import SteeringLag
 
 PERIOD = 0.02
+
+
+def _late(delay_s: float) -> Conditions:
+    """The steering command reaching the plant delay_s late (the simulator's actuation dead time)."""
+    return Conditions(name="late", actuation=Actuation(dead_time_s=delay_s))
+
+
 CAR = make_vehicle("dynamic-bicycle")
 CAR_TUNING = tuning_for(CAR)
 BEND = ClothoidChain().straight(20.0).clothoid_to(1 / 30, 15.0).arc(30.0).clothoid_to(0.0, 15.0).straight(40.0)
@@ -38,66 +43,8 @@ TRUCK_LEAD = LeadFilterParams(6.0, 1.2, 24.0)
 V = 30 / 3.6
 
 
-class DelayedSteering(VehicleModel):
-    """A vehicle whose steering-wheel command reaches it `steps` controller steps late; the rest is the inner one's
-    (its name and params too, so that its own tuning is found for it)."""
-
-    def __init__(self, inner: VehicleModel, steps: int) -> None:
-        self.inner, self.steps = inner, steps
-        self.name, self.params, self._geometry = inner.name, inner.params, inner.geometry
-        self.state_names, self.extra_output_names = inner.state_names, inner.extra_output_names
-        self._queue: collections.deque[float] = collections.deque()
-        self._applied = 0.0
-
-    def initial_state(self, x_m: float, y_m: float, yaw_rad: float, speed_mps: float) -> np.ndarray:
-        self._queue, self._applied = collections.deque([0.0] * self.steps), 0.0  # straight wheels, as the state
-        return self.inner.initial_state(x_m, y_m, yaw_rad, speed_mps)
-
-    def advance(self, state, steer_wheel_cmd_rad, accel_cmd_mps2, dt_s, substeps):
-        self._queue.append(steer_wheel_cmd_rad)
-        self._applied = self._queue.popleft()
-        return self.inner.advance(state, self._applied, accel_cmd_mps2, dt_s, substeps)
-
-    def outputs(self, state, steer_wheel_cmd_rad, accel_cmd_mps2):
-        return self.inner.outputs(state, self._applied, accel_cmd_mps2)
-
-    def single_track(self, source=None):
-        return self.inner.single_track(source)
-
-    @property
-    def road_friction(self) -> float:
-        return self.inner.road_friction
-
-    def set_road_friction(self, scale: float) -> None:
-        self.inner.set_road_friction(scale)
-
-
-def _recorded_measurements(count: int = 80) -> list[Measurement]:
-    """Made-up measurements along the bend: a weaving offset, noisy speed, yaw, yaw rate and steering."""
-    rng = np.random.default_rng(3)
-    out = []
-    for k in range(count):
-        s = 6.0 + 0.16 * k
-        x, y = BEND_PATH.position(s)
-        heading = float(BEND_PATH.heading(s))
-        offset = 0.3 * math.sin(0.1 * k)
-        out.append(
-            Measurement(
-                PERIOD * k,
-                float(x) - offset * math.sin(heading),
-                float(y) + offset * math.cos(heading),
-                8.0 + rng.normal(0.0, 0.1),
-                rng.normal(0.0, 0.05),
-                heading + rng.normal(0.0, 0.02),
-                8.0 * float(BEND_PATH.curvature(s)) + rng.normal(0.0, 0.01),
-                rng.normal(0.0, 0.3),
-            )
-        )
-    return out
-
-
 @pytest.mark.parametrize("vehicle_name", ["dynamic-bicycle", "tractor-semitrailer"])
-def test_no_known_delay_changes_nothing(vehicle_name: str) -> None:
+def test_no_known_delay_changes_nothing(vehicle_name: str, weaving) -> None:
     """known_delay_s = 0: commands and diagnostics equal bit for bit those of a controller built without it, and
     so do the loop settings the floor is computed from."""
     vehicle = make_vehicle(vehicle_name)
@@ -105,7 +52,7 @@ def test_no_known_delay_changes_nothing(vehicle_name: str) -> None:
     explicit = tuned_controller("clothoid", vehicle, ClothoidConfig(known_delay_s=0.0))
     plain.reset(BEND_PATH, PERIOD)
     explicit.reset(BEND_PATH, PERIOD)
-    for m in _recorded_measurements():
+    for m in weaving(BEND_PATH, 80, 3, 6.0):
         assert plain.step(m, BEND_PATH) == explicit.step(m, BEND_PATH)  # exactly
         assert dict(plain.diagnostics) == dict(explicit.diagnostics)
     assert plain.loop_settings(30.0) == explicit.loop_settings(30.0)
@@ -185,12 +132,13 @@ def test_the_floor_rises_with_the_known_delay() -> None:
 
 
 def _dlc_metrics(speed_kmh: float, delay_s: float, known_delay_s: float):
-    inner = make_vehicle("dynamic-bicycle")
-    vehicle = DelayedSteering(inner, round(delay_s / PERIOD))
+    vehicle = make_vehicle("dynamic-bicycle")
     controller = tuned_controller("clothoid", vehicle, ClothoidConfig(known_delay_s=known_delay_s))
     assert controller.tuning is not None
-    scenario = make_scenario("dlc", ScenarioOptions(vehicle_width_m=inner.geometry.width_m))
-    result = Simulation(scenario, vehicle, controller, SimulationConfig(speed_kmh=speed_kmh)).run()
+    scenario = make_scenario("dlc", ScenarioOptions(vehicle_width_m=vehicle.geometry.width_m))
+    result = Simulation(
+        scenario, vehicle, controller, SimulationConfig(speed_kmh=speed_kmh, conditions=_late(delay_s))
+    ).run()
     assert result.completed, result.message
     return result.metrics
 

@@ -4,7 +4,6 @@ whose steering arrives late it tracks where the uncompensated controller oscilla
 
 from __future__ import annotations
 
-import collections
 import math
 
 import numpy as np
@@ -16,74 +15,23 @@ from controllers.mpc.common import _delay_segments
 from tuning.own_tuning import tuned_controller
 from workbench.base.clothoid_chain import ClothoidChain
 from workbench.base.errors import WorkbenchInputError
+from workbench.simulation.conditions import Actuation, Conditions
 from workbench.simulation.scenarios import ScenarioOptions, make_scenario
 from workbench.simulation.simulator import Simulation, SimulationConfig
 from workbench.vehicles import make_vehicle
-from workbench.vehicles.base import VehicleModel
 
 #: Generous solver budget: a loaded machine must not make solves late.
 RELAXED = 0.5
 PERIOD = 0.02
+
+
+def _late(delay_s: float) -> Conditions:
+    """The steering command reaching the plant delay_s late (the simulator's actuation dead time)."""
+    return Conditions(name="late", actuation=Actuation(dead_time_s=delay_s))
+
+
 BEND = ClothoidChain().straight(20.0).clothoid_to(1 / 30, 15.0).arc(30.0).clothoid_to(0.0, 15.0).straight(40.0)
 BEND_PATH = BEND.to_path("bend")
-
-
-class DelayedSteering(VehicleModel):
-    """A vehicle whose steering-wheel command reaches it `steps` controller steps late (an actuation dead time of
-    steps x the controller period); everything else is the inner vehicle's."""
-
-    def __init__(self, inner: VehicleModel, steps: int) -> None:
-        self.inner, self.steps = inner, steps
-        self.name, self.params, self._geometry = inner.name, inner.params, inner.geometry
-        self.state_names, self.extra_output_names = inner.state_names, inner.extra_output_names
-        self._queue: collections.deque[float] = collections.deque()
-        self._applied = 0.0
-
-    def initial_state(self, x_m: float, y_m: float, yaw_rad: float, speed_mps: float) -> np.ndarray:
-        self._queue, self._applied = collections.deque([0.0] * self.steps), 0.0  # straight wheels, as the state
-        return self.inner.initial_state(x_m, y_m, yaw_rad, speed_mps)
-
-    def advance(self, state, steer_wheel_cmd_rad, accel_cmd_mps2, dt_s, substeps):
-        self._queue.append(steer_wheel_cmd_rad)
-        self._applied = self._queue.popleft()
-        return self.inner.advance(state, self._applied, accel_cmd_mps2, dt_s, substeps)
-
-    def outputs(self, state, steer_wheel_cmd_rad, accel_cmd_mps2):
-        return self.inner.outputs(state, self._applied, accel_cmd_mps2)
-
-    def single_track(self, source=None):
-        return self.inner.single_track(source)
-
-    @property
-    def road_friction(self) -> float:
-        return self.inner.road_friction
-
-    def set_road_friction(self, scale: float) -> None:
-        self.inner.set_road_friction(scale)
-
-
-def _recorded_measurements(count: int = 60) -> list[Measurement]:
-    """Made-up measurements along the bend: a weaving offset, noisy speed, yaw, yaw rate and steering."""
-    rng = np.random.default_rng(7)
-    out = []
-    for k in range(count):
-        s = 8.0 + 0.16 * k
-        x, y = BEND_PATH.position(s)
-        heading = float(BEND_PATH.heading(s))
-        offset = 0.3 * math.sin(0.1 * k)
-        out.append(
-            Measurement(
-                PERIOD * k,
-                float(x) - offset * math.sin(heading),
-                float(y) + offset * math.cos(heading),
-                8.0 + rng.normal(0.0, 0.1),
-                rng.normal(0.0, 0.05),
-                heading + rng.normal(0.0, 0.02),
-                8.0 * float(BEND_PATH.curvature(s)) + rng.normal(0.0, 0.01),
-                rng.normal(0.0, 0.3),
-            )
-        )
-    return out
 
 
 @pytest.mark.parametrize(
@@ -95,7 +43,7 @@ def _recorded_measurements(count: int = 60) -> list[Measurement]:
     ],
     ids=["nmpc-rti", "nmpc-ipopt", "lmpc"],
 )
-def test_no_delay_changes_nothing(cls, config_type, options) -> None:
+def test_no_delay_changes_nothing(cls, config_type, options, weaving) -> None:
     """Both options at 0: the commands (and every diagnostic but the solve time) equal bit for bit those of a
     controller built without them, and the delay machinery is never built."""
     vehicle = make_vehicle("dynamic-bicycle")
@@ -104,14 +52,14 @@ def test_no_delay_changes_nothing(cls, config_type, options) -> None:
     explicit = cls(vehicle.geometry, zeros, vehicle=vehicle)
     plain.reset(BEND_PATH, PERIOD)
     explicit.reset(BEND_PATH, PERIOD)
-    for m in _recorded_measurements():
+    for m in weaving(BEND_PATH, 60, 7, 8.0):
         a, b = plain.step(m, BEND_PATH), explicit.step(m, BEND_PATH)
         assert a == b  # exactly
         da, db = dict(plain.diagnostics), dict(explicit.diagnostics)
         da.pop("solve_time_s"), db.pop("solve_time_s")
         assert da == db and "delay_compensation_s" not in da and da["fallback"] == 0.0
     assert explicit._delay_integrator is None
-    assert plain.last_plan is not None and plain.last_plan.t_s == _recorded_measurements()[-1].t_s
+    assert plain.last_plan is not None and plain.last_plan.t_s == weaving(BEND_PATH, 60, 7, 8.0)[-1].t_s
 
 
 @pytest.mark.parametrize("name", ["input_delay_s", "measurement_latency_s"])
@@ -210,11 +158,12 @@ def test_segments_follow_the_buffer() -> None:
 def _dlc_run(controller_name: str, config: object, speed_kmh: float, delay_s: float, compensated: bool = True):
     """The dlc on the dynamic bicycle with its steering delay_s late; a compensated run must complete (an
     uncompensated one may leave the path: its metrics say how far it got)."""
-    inner = make_vehicle("dynamic-bicycle")
-    vehicle = DelayedSteering(inner, round(delay_s / PERIOD))
+    vehicle = make_vehicle("dynamic-bicycle")
     controller = tuned_controller(controller_name, vehicle, config)
-    scenario = make_scenario("dlc", ScenarioOptions(vehicle_width_m=inner.geometry.width_m))
-    result = Simulation(scenario, vehicle, controller, SimulationConfig(speed_kmh=speed_kmh)).run()
+    scenario = make_scenario("dlc", ScenarioOptions(vehicle_width_m=vehicle.geometry.width_m))
+    result = Simulation(
+        scenario, vehicle, controller, SimulationConfig(speed_kmh=speed_kmh, conditions=_late(delay_s))
+    ).run()
     assert result.completed or not compensated, result.message
     return result
 
