@@ -17,7 +17,8 @@ Added to the paper so that the loop keeps its margins on the vehicle it steers (
   - a lookahead floor per speed: `loop_analysis.py` linearises the loop (Eq. 3 on the predicted pose, Figure 2's
     integrator, the lead filter, the lags of Eq. 5, sampling) and finds the shortest lookahead from which the
     phase and gain margins hold about a straight and an arc; the loop gain goes as L^-3, so the search's choice
-    is followed with hysteresis and at a limited rate, slowly against L / V (`lookahead_filter.py`);
+    is followed with hysteresis and at a limited rate, slowly against L / V (`lookahead_filter.py`); a geometric
+    ceiling keeps the target within max_target_turn_deg of the path's turn (ClothoidConfig), never below the floor;
   - two degrees of freedom (`path_feedforward.py`): feedback on Eq. 3's kappa' less the path's own clothoid's,
     and the path's curvature rate fed forward, so tracking needs no short lookaheads where the loop has no margin;
   - the steered vehicle's own lead filter, curvature limits and lags (`vehicle_tuning.py`, made by `tuning
@@ -38,7 +39,13 @@ from controllers.base import Controller, Measurement
 from controllers.clothoid.curvature_limits import CurvatureLimits
 from controllers.clothoid.filter_schedule import FilterSchedule
 from controllers.clothoid.lead_filter import DiscreteLeadFilter, PassThroughFilter, SteeringFilter
-from controllers.clothoid.lookahead import MAX_CURVE_POINTS, adaptive_search, candidate_count, evaluate_candidate
+from controllers.clothoid.lookahead import (
+    MAX_CURVE_POINTS,
+    adaptive_search,
+    candidate_count,
+    evaluate_candidate,
+    turn_limited_lookahead,
+)
 from controllers.clothoid.lookahead_filter import LookaheadFilter, LookaheadFilterSettings, require_rate
 from controllers.clothoid.loop_analysis import LoopSettings, PlantLags, lookahead_floor
 from controllers.clothoid.path_feedforward import FeedforwardTiming, two_degree_of_freedom_rate
@@ -63,6 +70,10 @@ THRESHOLD_MODES = ("excess", "absolute")
 MIN_SPEED_MPS = 0.5
 #: The lookahead floor is computed per band of this many km/h (and at least at the band's lower speed, 5 km/h).
 FLOOR_SPEED_BAND_KMH = 5.0
+#: A run moves to a lower band's (shorter) floor only this far (km/h) below the band's edge, to a higher one at its
+#: edge: the lookahead follows a falling floor at once (`lookahead_filter.py`), so a speed hovering at an edge (its
+#: noise, the speed loop's ripple) must not switch the floor, and the loop gain with it, to and fro.
+FLOOR_BAND_HYSTERESIS_KMH = 1.0
 #: Longest lookahead (m) the floor search considers when the configured range has no margin at a speed.
 MAX_FLOOR_LOOKAHEAD_M = 40.0
 #: Lateral acceleration (g) of the arc about which the floor is checked besides the straight (the speed profile's
@@ -75,6 +86,7 @@ DIAGNOSTIC_KEYS = (
     "lookahead_m",
     "searched_lookahead_m",
     "lookahead_floor_m",
+    "lookahead_ceiling_m",
     "frechet_m",
     "curvature_rate_1pm2",
     "clothoid_curvature_rate_1pm2",
@@ -100,10 +112,14 @@ class ClothoidConfig:
     min_preview_time_s: raises the lower end of the range to this time x speed (s; 0: off); lookahead_hysteresis_m,
     max_lookahead_growth_m_per_m, max_lookahead_shrink_m_per_m: how the search's choice is followed
     (`lookahead_filter.py`; None: at once); min_phase_margin_deg, min_gain_margin_db: the margins the lookahead
-    floor keeps (`loop_analysis.py`; 0 and 0: no floor); frechet_threshold_m: the adaptive threshold (m; the paper:
-    0.5 m) and threshold_mode how it applies ("excess" of |CTE| or "absolute"; module docstring);
-    frechet_point_spacing_m: sampling of the curves compared (m); tolerance_x_m, tolerance_y_m: delta_x, delta_y of
-    Eq. 3 (m); max_curvature_rate_1pm2: saturation of the clothoid's kappa' (1/m^2); initial_curvature: kappa(0)
+    floor keeps (`loop_analysis.py`; 0 and 0: no floor); max_target_turn_deg: the lookahead's geometric ceiling, no
+    target farther round a bend than the path turning this much from the foot point (deg; 0: none; never below the
+    floor): an offset of the vehicle shows at a target theta round the bend as offset x cos(theta), and Eq. 3's gain
+    on it falls alike (0.46 of a straight's at 60 deg, none at 90 deg), which the margins do not see;
+    frechet_threshold_m: the adaptive threshold (m; the paper: 0.5 m) and threshold_mode how it applies ("excess" of
+    |CTE| or "absolute"; module docstring); frechet_point_spacing_m: sampling of the curves compared (m);
+    tolerance_x_m, tolerance_y_m: delta_x, delta_y of Eq. 3 (m); max_curvature_rate_1pm2: saturation of the
+    clothoid's kappa' (1/m^2); initial_curvature: kappa(0)
     of Eq. 3, "yaw-rate", "command" or "steering"; heading: "course" or "yaw"; prediction_time_s: pose prediction
     (s; 0: off); known_delay_s: the loop's dead time the controller knows, measurement latency (the pose measured
     is that long old) plus actuation dead time (a command reaches the steering that much later) (s; 0: none): the
@@ -131,6 +147,7 @@ class ClothoidConfig:
     max_lookahead_shrink_m_per_m: float | None = 0.5
     min_phase_margin_deg: float = 45.0
     min_gain_margin_db: float = 6.0
+    max_target_turn_deg: float = 60.0
     fixed_lookahead_m: float = 10.0
     lookahead_gain_s: float = 1.0
     frechet_threshold_m: float = 0.02
@@ -166,6 +183,7 @@ class ClothoidConfig:
         require_rate("max_lookahead_shrink_m_per_m", self.max_lookahead_shrink_m_per_m)
         check_number("min_phase_margin_deg", self.min_phase_margin_deg, 0.0, 89.0, "deg")
         check_number("min_gain_margin_db", self.min_gain_margin_db, 0.0, 40.0, "dB")
+        check_number("max_target_turn_deg", self.max_target_turn_deg, 0.0, 180.0, "deg", note="0: no ceiling")
         check_number("min_lookahead_m", self.min_lookahead_m, 0.5, MAX_LOOKAHEAD_M, "m")
         check_number("max_lookahead_m", self.max_lookahead_m, 0.5, MAX_LOOKAHEAD_M, "m")
         check_number("fixed_lookahead_m", self.fixed_lookahead_m, 0.5, MAX_LOOKAHEAD_M, "m")
@@ -262,6 +280,7 @@ class ClothoidController(Controller):
         self._filter: SteeringFilter = PassThroughFilter()
         self._filter_speed_kmh = -1
         self._choice.reset()
+        self._held_band: int | None = None  # the speed band whose floor applies (_floor_band)
         self._diag: dict[str, float] = dict.fromkeys(DIAGNOSTIC_KEYS, 0.0)
         if path.speed_mps is not None:  # the floors of the planned speeds now, not inside a step (~0.1 s per band)
             for speed_mps in np.unique(np.round(path.speed_mps * 3.6 / FLOOR_SPEED_BAND_KMH)) * FLOOR_SPEED_BAND_KMH:
@@ -298,8 +317,11 @@ class ClothoidController(Controller):
         """The shortest lookahead (m) that keeps the configured margins at this speed (per FLOOR_SPEED_BAND_KMH band,
         computed once per band and run; min_lookahead_m without a tuning or with the margins set to 0). The analysis
         is cached on all of `loop_settings`, the known delay included."""
+        return self._band_floor_m(max(1, round(speed_mps * 3.6 / FLOOR_SPEED_BAND_KMH)))
+
+    def _band_floor_m(self, band: int) -> float:
+        """lookahead_floor_m of the speed band `band` (its speed band x FLOOR_SPEED_BAND_KMH)."""
         cfg = self.config
-        band = max(1, round(speed_mps * 3.6 / FLOOR_SPEED_BAND_KMH))
         floor = self._floors.get(band)
         if floor is None:
             speed_kmh = band * FLOOR_SPEED_BAND_KMH
@@ -364,16 +386,34 @@ class ClothoidController(Controller):
             return along_arc(m.x_m, m.y_m, heading, kappa0, m.speed_mps * horizon)
         return m.x_m, m.y_m, heading
 
+    def _floor_band(self, speed_mps: float) -> int:
+        """The speed band whose floor applies this step: the nearest, but a lower one only once the speed is
+        FLOOR_BAND_HYSTERESIS_KMH below the held band's lower edge."""
+        x = speed_mps * 3.6 / FLOOR_SPEED_BAND_KMH
+        band, held = max(1, round(x)), self._held_band
+        if held is not None and band < held and x > held - 0.5 - FLOOR_BAND_HYSTERESIS_KMH / FLOOR_SPEED_BAND_KMH:
+            band = held
+        self._held_band = band
+        return band
+
     def _lookahead(self, path: ReferencePath, foot_index: float, cte_m: float, pose, kappa0: float, speed_mps: float):
-        """(lookahead m, the adaptive search's choice m, the floor m, number of candidates evaluated)."""
+        """(lookahead m, the adaptive search's choice m, the floor m, the ceiling m, number of candidates
+        evaluated)."""
         cfg = self.config
-        floor = max(self.lookahead_floor_m(speed_mps), cfg.min_lookahead_m, cfg.min_preview_time_s * speed_mps)
+        floor = self._band_floor_m(self._floor_band(speed_mps))
+        floor = max(floor, cfg.min_lookahead_m, cfg.min_preview_time_s * speed_mps)
         top = max(cfg.max_lookahead_m, floor)
         if cfg.lookahead_mode == "fixed":
-            return cfg.fixed_lookahead_m, cfg.fixed_lookahead_m, floor, 0
+            return cfg.fixed_lookahead_m, cfg.fixed_lookahead_m, floor, top, 0
+        if cfg.max_target_turn_deg > 0.0:  # the geometric ceiling (ClothoidConfig.max_target_turn_deg)
+            ceiling = turn_limited_lookahead(
+                path.x_m, path.y_m, path.heading_rad, path.closed, foot_index, pose[0], pose[1],
+                math.radians(cfg.max_target_turn_deg), top,
+            )  # fmt: skip
+            top = max(floor, ceiling)
         if cfg.lookahead_mode == "speed":
             lookahead = min(max(cfg.lookahead_gain_s * speed_mps, floor), top)
-            return lookahead, lookahead, floor, 0
+            return lookahead, lookahead, floor, top, 0
         threshold = cfg.frechet_threshold_m + (abs(cte_m) if cfg.threshold_mode == "excess" else 0.0)
         x, y, heading = pose
         chosen, evaluations = adaptive_search(
@@ -382,7 +422,7 @@ class ClothoidController(Controller):
             cfg.frechet_point_spacing_m, self._buffers, self._scores,
         )  # fmt: skip
         lookahead = self._choice.step(chosen, floor, top, speed_mps * self._dt)
-        return lookahead, chosen, floor, evaluations
+        return lookahead, chosen, floor, top, evaluations
 
     def _command(self, measurement: Measurement, path: ReferencePath) -> float:
         cfg, g, m = self.config, self.geometry, measurement
@@ -397,7 +437,7 @@ class ClothoidController(Controller):
         pose = self._start_pose(m, kappa0)
         foot = self._tracker.update(pose[0], pose[1])
         foot_index = foot.s_m / path.spacing_m
-        lookahead, searched, floor, evaluations = self._lookahead(
+        lookahead, searched, floor, ceiling, evaluations = self._lookahead(
             path, foot_index, foot.cte_m, pose, kappa0, m.speed_mps
         )
         frechet, kdot, length, tx, ty, ex, ey, status = evaluate_candidate(
@@ -421,6 +461,7 @@ class ClothoidController(Controller):
             "lookahead_m": lookahead,
             "searched_lookahead_m": searched,
             "lookahead_floor_m": floor,
+            "lookahead_ceiling_m": ceiling,
             "frechet_m": frechet,
             "curvature_rate_1pm2": kdot,
             "clothoid_curvature_rate_1pm2": clothoid_kdot,

@@ -15,6 +15,7 @@ log2(grid size) fits instead of one per candidate. When no candidate qualifies (
 path than the threshold: the Fréchet distance is at least the end-point distance |CTE|), it takes the candidate
 of least Fréchet distance (Figure 5b's "minimum Fréchet distance"), found by a coarse scan refined around its
 best point. Everything here is compiled with numba: a step's whole search costs tens of microseconds.
+`turn_limited_lookahead` is the geometric ceiling: no target farther round a bend than a given turn of the path.
 """
 
 from __future__ import annotations
@@ -175,6 +176,43 @@ def adaptive_search(
         if scores[k] < scores[best]:
             best = k
     return min_lookahead_m + best * step_m, evaluations
+
+
+@njit(cache=True)
+def turn_limited_lookahead(
+    path_x: np.ndarray,
+    path_y: np.ndarray,
+    path_heading: np.ndarray,
+    closed: bool,
+    foot_index: float,
+    px: float,
+    py: float,
+    max_turn_rad: float,
+    max_m: float,
+) -> float:  # pragma: no cover - compiled
+    """The longest lookahead (m, at most max_m) whose target (`first_beyond` from (px, py)) the path reaches before
+    its heading has turned by more than max_turn_rad from the heading at the foot point: the largest distance from
+    (px, py) of the samples before that turn. Why (controller.py, ClothoidConfig.max_target_turn_deg): a lateral
+    offset of the vehicle shows at a target a turn theta round the bend only as offset x cos(theta), and Eq. 3's
+    gain on it falls with it. A closed path's unwrapped headings continue over its seam; beyond an open path's end
+    the target lies on its straight extension, which turns no further (max_m)."""
+    n_seg = path_x.size - 1
+    lap_turn = path_heading[-1] - path_heading[0]
+    i0 = int(foot_index)
+    i0w = i0 % n_seg if closed else min(i0, n_seg - 1)
+    f0 = foot_index - i0
+    h0 = path_heading[i0w] + f0 * (path_heading[i0w + 1] - path_heading[i0w])
+    longest = 0.0
+    last = i0 + n_seg if closed else n_seg
+    for j in range(i0 + 1, last + 1):
+        i = j % n_seg if closed else j
+        heading = path_heading[i] + (lap_turn * (j // n_seg - i0 // n_seg) if closed else 0.0)
+        if abs(heading - h0) > max_turn_rad:
+            return min(longest, max_m)
+        longest = max(longest, np.hypot(path_x[i] - px, path_y[i] - py))
+        if longest >= max_m:
+            return max_m
+    return max_m
 
 
 @dataclass(frozen=True, slots=True)

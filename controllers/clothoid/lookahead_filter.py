@@ -7,7 +7,8 @@ drove its limit cycle). The loop's gain goes as L^-3 (`loop_analysis.py`), so ea
 loop; margins computed for a frozen lookahead only hold while it varies slowly against the loop's own time scale,
 L / V. So:
 
-- the floor (`loop_analysis.lookahead_floor`, per speed) is a hard lower bound, applied at once;
+- the floor (`loop_analysis.lookahead_floor`, per speed) is a hard lower bound, applied at once both ways: the
+  lookahead rises with it and, when it falls (the vehicle slowed), falls by as much, keeping its excess over it;
 - a change of choice smaller than the hysteresis is ignored (the search's grid jitter);
 - the lookahead moves towards the choice by at most `max_growth_m_per_m` (longer) or `max_shrink_m_per_m`
   (shorter) metres per metre travelled, i.e. d ln L / dt at most that times V / L, the loop's crossover scale.
@@ -43,20 +44,25 @@ class LookaheadFilterSettings:
 class LookaheadFilter:
     """The lookahead actually used, from the search's choice step by step (module docstring)."""
 
-    __slots__ = ("_current", "settings")
+    __slots__ = ("_current", "_floor", "settings")
 
     def __init__(self, settings: LookaheadFilterSettings) -> None:
         self.settings = settings
         self._current: float | None = None
+        self._floor: float | None = None
 
     def reset(self) -> None:
         self._current = None
+        self._floor = None
 
     def step(self, choice_m: float, floor_m: float, ceiling_m: float, distance_m: float) -> float:
         """The lookahead (m) for this step: choice_m filtered, within [floor_m, ceiling_m]; distance_m: travelled
         since the last step (m)."""
         s = self.settings
         current = self._current
+        if current is not None and self._floor is not None and floor_m < self._floor:
+            current = max(current - (self._floor - floor_m), floor_m)  # a falling floor takes the lookahead down
+        self._floor = floor_m
         if current is None or abs(choice_m - current) <= s.hysteresis_m:
             target = choice_m if current is None else current
         else:

@@ -21,6 +21,13 @@ A known measurement latency L and actuation dead time D (`measurement_latency_s`
 as Autoware's lateral MPC does: the state of step 2, which describes t - L, is predicted to t + D with the commands
 already sent (`MPCController.predict_ahead`), and the plan starts there (`ctrl_delay_compensation_s` = L + D,
 logged when it is not 0).
+
+An optional pose filter (`pose_filter_cutoff_hz`, off by default) goes before step 1: a complementary filter that
+dead-reckons the pose with the measured velocity and yaw rate and pulls it toward the measured pose at a first-order
+crossover (`PoseFilter`). Pose noise in the loop's own correction band (the NMPC corrects an offset with
+an S-shaped steering pulse at 0.6-0.8 Hz on the loaded truck) then no longer drives the steering, where a low-pass on
+the command would have to cut into that band; the motion the rates describe passes without lag, so the delay
+compensation needs nothing more.
 """
 
 from __future__ import annotations
@@ -35,7 +42,14 @@ import numpy as np
 from numba import njit
 
 from controllers.base import Controller, Measurement
-from controllers.config_checks import check_bool, check_choice, check_number, check_optional_instance, check_whole
+from controllers.config_checks import (
+    check_bool,
+    check_choice,
+    check_number,
+    check_optional_instance,
+    check_optional_number,
+    check_whole,
+)
 from controllers.mpc.codegen import FastFunction, compile_function
 from controllers.mpc.ocp import TrackingOCP, TrackingWeights
 from controllers.mpc.plan import Plan, shift_rows
@@ -50,7 +64,7 @@ from controllers.mpc.prediction_model import (
 from controllers.mpc.preview import PathPreview
 from controllers.mpc.solver import MPCSolver
 from controllers.mpc.status import SolveStatus
-from workbench.base.errors import WorkbenchInputError
+from workbench.base.errors import WorkbenchInputError, value_text
 from workbench.base.path import PathTracker, Projection, ReferencePath, wrap_angle
 from workbench.vehicles.geometry import VehicleGeometry
 from workbench.vehicles.steering_lag import SteeringLag
@@ -66,6 +80,63 @@ NO_OBJECTIVE = -1.0
 MAX_WEIGHT = 1e9
 #: Command knots closer than this (s) to an end of the prediction window start no segment of their own.
 _KNOT_MERGE_S = 1e-9
+#: The largest crossover frequency of the pose filter (Hz): far above it the filter passes the measurement as it is.
+MAX_POSE_FILTER_HZ = 100.0
+
+
+class PoseFilter:
+    """Complementary filter on the measured pose (x, y, yaw) at crossover frequency `cutoff_hz`.
+
+    Each step it dead-reckons its estimate over the time dt since the last step with the measured body velocity and
+    yaw rate (the velocities' mean and the yaw rate at the interval's middle, held: an arc, integrated exactly), then
+    moves it toward the measured pose by k = 1 - exp(-2 pi cutoff_hz dt): the measured pose through a first-order
+    low-pass at the cutoff, plus the dead-reckoned motion through the complementary high-pass. With exact signals the
+    estimate is the measured pose (exactly on an arc; to the change of the rates within a step otherwise); white pose
+    noise keeps k / (2 - k) of its variance per axis. The yaw rate is taken where the pose is: `yaw_rate_lead_s` (the
+    yaw rate's latency minus the pose's) shifts it along the line through its last two samples. The first
+    measurement after a reset is taken as it is; a pose held by a slower localisation (or, with a latency, before the
+    run's start) counts as measured again, as it does without the filter, and the estimate runs ahead of it until
+    the hold ends."""
+
+    def __init__(self, cutoff_hz: float, yaw_rate_lead_s: float = 0.0) -> None:
+        self.cutoff_hz, self.yaw_rate_lead_s = float(cutoff_hz), float(yaw_rate_lead_s)
+        self.reset()
+
+    def reset(self) -> None:
+        """Forget the estimate: the next measurement starts it."""
+        self._previous: Measurement | None = None
+        self._x = self._y = self._yaw = 0.0
+
+    def gain(self, elapsed_s: float) -> float:
+        """The correction gain k after `elapsed_s` seconds without one."""
+        return 1.0 - math.exp(-2.0 * math.pi * self.cutoff_hz * elapsed_s)
+
+    def __call__(self, m: Measurement) -> Measurement:
+        """The measurement with its pose replaced by the filter's estimate."""
+        previous = self._previous
+        self._previous = m
+        if previous is None:
+            self._x, self._y, self._yaw = m.x_m, m.y_m, m.yaw_rad
+            return m
+        dt = m.t_s - previous.t_s
+        if dt > 0.0:  # (a repeated time stamp adds nothing)
+            # The yaw rate at the middle of the interval the pose moved over: samples dt apart, the newer describing
+            # yaw_rate_lead_s before the pose's time (-1/2: their mean when the latencies agree).
+            c = self.yaw_rate_lead_s / dt - 0.5
+            rate = m.yaw_rate_rad_s + c * (m.yaw_rate_rad_s - previous.yaw_rate_rad_s)
+            vx, vy = 0.5 * (m.vx_mps + previous.vx_mps), 0.5 * (m.vy_mps + previous.vy_mps)
+            half = 0.5 * rate * dt  # the arc's chord: exact for constant body velocity and yaw rate
+            chord = dt * (math.sin(half) / half if abs(half) > 1e-4 else 1.0 - half * half / 6.0)
+            cos_m, sin_m = math.cos(self._yaw + half), math.sin(self._yaw + half)
+            k = self.gain(dt)
+            self._x += chord * (cos_m * vx - sin_m * vy)
+            self._x += k * (m.x_m - self._x)
+            self._y += chord * (sin_m * vx + cos_m * vy)
+            self._y += k * (m.y_m - self._y)
+            self._yaw += rate * dt
+            self._yaw += k * float(wrap_angle(m.yaw_rad - self._yaw))
+        yaw = m.yaw_rad - float(wrap_angle(m.yaw_rad - self._yaw))  # the estimate, on the measurement's branch
+        return Measurement(m.t_s, self._x, self._y, m.vx_mps, m.vy_mps, yaw, m.yaw_rate_rad_s, m.steer_wheel_rad)
 
 
 @dataclass(frozen=True)
@@ -90,7 +161,11 @@ class MPCConfig:
     input_delay_s: the known actuation dead time D (s; a command sent at t reaches the steering at t + D) and
     measurement_latency_s: the known measurement latency L (s; the measurement stamped t describes t - L), which the
     controller compensates by predicting the measured state to t + D with the commands already sent and planning
-    from there (module docstring; 0 and 0: no compensation, the plan starts at the measurement).
+    from there (module docstring; 0 and 0: no compensation, the plan starts at the measurement);
+    pose_filter_cutoff_hz: the crossover frequency (Hz) of the complementary filter on the measured pose
+    (`PoseFilter`; 0: off, the measured pose is used as it is); yaw_rate_latency_s: the known latency (s) of the
+    measured yaw rate when it differs from measurement_latency_s, by which the pose filter aligns the yaw rate with
+    the pose (None: measurement_latency_s; only with the pose filter).
     """
 
     vehicle: str = "auto"
@@ -111,6 +186,8 @@ class MPCConfig:
     codegen: bool = True
     input_delay_s: float = 0.0
     measurement_latency_s: float = 0.0
+    pose_filter_cutoff_hz: float = 0.0
+    yaw_rate_latency_s: float | None = None
 
     def __post_init__(self) -> None:
         from workbench.vehicles import VEHICLES
@@ -131,6 +208,21 @@ class MPCConfig:
         check_bool("codegen", self.codegen)
         check_number("input_delay_s", self.input_delay_s, 0.0, 1.0, "s", note="0: none")
         check_number("measurement_latency_s", self.measurement_latency_s, 0.0, 1.0, "s", note="0: none")
+        check_number("pose_filter_cutoff_hz", self.pose_filter_cutoff_hz, 0.0, MAX_POSE_FILTER_HZ, "Hz", note="0: off")
+        check_optional_number(
+            "yaw_rate_latency_s", self.yaw_rate_latency_s, 0.0, 1.0, "s", none_means="measurement_latency_s"
+        )
+        if self.yaw_rate_latency_s is not None and self.pose_filter_cutoff_hz == 0.0:
+            raise WorkbenchInputError(
+                "yaw_rate_latency_s is used by the pose filter only: set pose_filter_cutoff_hz > 0 or leave "
+                f"yaw_rate_latency_s unset (none); got {value_text(self.yaw_rate_latency_s)}"
+            )
+
+    @property
+    def yaw_rate_lead_s(self) -> float:
+        """How much older the measured yaw rate is than the measured pose (s): yaw_rate_latency_s - L."""
+        latency = self.measurement_latency_s if self.yaw_rate_latency_s is None else self.yaw_rate_latency_s
+        return latency - self.measurement_latency_s
 
     @property
     def weights(self) -> TrackingWeights:
@@ -213,6 +305,9 @@ class MPCController(Controller):
         self._delay_integrators: dict[tuple[int, int], FastFunction] = {}
         self._delay_integrator: FastFunction | None = None
         self._delay_chunk = 0
+        self._pose_filter = (
+            PoseFilter(cfg.pose_filter_cutoff_hz, cfg.yaw_rate_lead_s) if cfg.pose_filter_cutoff_hz > 0.0 else None
+        )
         self._reset_state()
 
     # ------------------------------------------------------------------ subclass hooks
@@ -260,9 +355,15 @@ class MPCController(Controller):
         }
         if self._delay_s > 0.0:  # logged only when compensating, so a run without is today's trace bit for bit
             self._diag["delay_compensation_s"] = self._delay_s
+        if self._pose_filter is not None:  # logged only with the filter on, as the delay compensation
+            self._pose_filter.reset()
+            self._diag["pose_filter_offset_m"] = 0.0
+            self._diag["pose_filter_heading_offset_rad"] = 0.0
 
     def _command(self, measurement: Measurement, path: ReferencePath) -> float:
         m, ocp, model = measurement, self.ocp, self.model
+        if self._pose_filter is not None:
+            m = self._pose_filter(measurement)
         foot = self._tracker.update(m.x_m, m.y_m)
         plan = self._plan
         # The plan's time origin: now, or with a known actuation dead time D the time the command sent now starts
@@ -323,6 +424,9 @@ class MPCController(Controller):
         }
         if self._delay_s > 0.0:
             self._diag["delay_compensation_s"] = self._delay_s
+        if self._pose_filter is not None:  # what the filter took off the measured pose
+            self._diag["pose_filter_offset_m"] = math.hypot(measurement.x_m - m.x_m, measurement.y_m - m.y_m)
+            self._diag["pose_filter_heading_offset_rad"] = measurement.yaw_rad - m.yaw_rad
         return self.saturate(command * self.prediction.steering_ratio)
 
     def _diagnostics(self) -> Mapping[str, float]:
