@@ -131,9 +131,9 @@ class RobustnessResult:
         """The runs of one axis and controller, the base run included, by the axis's value (the base's value where
         the column is empty), in the axis's order."""
         df = self.rows[self.rows["controller"] == controller]
-        other_axes = [a.parameter for a in self.axes if a is not axis and a.parameter in df]
-        mismatch = [c for c in ("controller_payload_kg",) if c in df]
-        keep = df[[all(pd.isna(r[c]) for c in other_axes + mismatch) for _, r in df.iterrows()]].copy()
+        others = [a.parameter for a in self.axes if a is not axis and a.parameter in df]
+        others += [c for c in ("controller_payload_kg",) if c in df]
+        keep = df[df[others].isna().all(axis=1)].copy()
         column = keep[axis.parameter] if axis.parameter in keep else pd.Series(math.nan, index=keep.index)
         keep["value"] = column.fillna(axis.values[0]).astype(float)
         return keep.sort_values("value", ascending=axis.rising)
@@ -219,10 +219,8 @@ class RobustnessResult:
         if len(mismatch):
             parts += ["<h2>Payload mismatch</h2>", _html_table(mismatch)]
         for axis in self.axes:
-            if axis.parameter not in self.rows and axis.values[0] is None:
-                continue
             if all(len(self.axis_rows(axis, c)) <= 1 for c in self.controllers):
-                continue
+                continue  # not varied (the friction of a model without tyres)
             fig = self.figure(axis)
             buffer = io.BytesIO()
             fig.savefig(buffer, format="png", dpi=90)
