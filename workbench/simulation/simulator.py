@@ -167,6 +167,7 @@ class Simulation:
         sensors = None if conditions.sensing_is_ideal else SensorModel(conditions, cfg.seed, dt)
         actuator = None if conditions.actuation.is_ideal else ActuatorModel(conditions, dt, cfg.substeps)
         road = conditions.road
+        road_varies = not road.is_constant
         friction = road.friction_at(0.0)
         if getattr(vehicle, "road_friction", 1.0) != friction:
             vehicle.set_road_friction(friction)
@@ -185,7 +186,7 @@ class Simulation:
             if step == 0 and actuator is not None:
                 actuator.reset(float(steer_wheel))
             foot = tracker.update(x, y)
-            if not road.is_constant:
+            if road_varies:  # foot.s_m is the arc length on the path, within a lap on a closed one
                 friction = road.friction_at(foot.s_m)
                 vehicle.set_road_friction(friction)
             if foot.past_end_m > cfg.max_past_end_m:
