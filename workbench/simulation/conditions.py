@@ -27,6 +27,7 @@ are refused naming the field, the value and the allowed range.
 from __future__ import annotations
 
 import bisect
+import dataclasses
 import math
 import os
 from collections.abc import Mapping
@@ -424,12 +425,7 @@ CONDITIONS: dict[str, Conditions] = {
     "automotive": Conditions(
         name="automotive",
         localisation=_RTK_LOCALISATION,
-        inertial=Inertial(
-            yaw_rate_noise_rad_s=math.radians(0.05),
-            yaw_rate_bias_rad_s=math.radians(0.01),
-            speed_noise_mps=0.014,
-            latency_s=0.020,
-        ),
+        inertial=dataclasses.replace(_RTK_INERTIAL, latency_s=0.020),
         steering_sensor=_CAN_STEERING_SENSOR,
         actuation=_CAN_ACTUATION,
         source="the rtk pose, with the vehicle's signals over CAN: yaw rate and steering-wheel angle 20 ms late "

@@ -45,37 +45,13 @@ def test_off_by_default() -> None:
         assert config.yaw_rate_lead_s == 0.0
 
 
-def _recorded_measurements(count: int = 60) -> list[Measurement]:
-    """Made-up measurements along the bend: a weaving offset, noisy speed, yaw, yaw rate and steering."""
-    rng = np.random.default_rng(7)
-    out = []
-    for k in range(count):
-        s = 8.0 + 0.16 * k
-        x, y = BEND_PATH.position(s)
-        heading = float(BEND_PATH.heading(s))
-        offset = 0.3 * math.sin(0.1 * k)
-        out.append(
-            Measurement(
-                PERIOD * k,
-                float(x) - offset * math.sin(heading),
-                float(y) + offset * math.cos(heading),
-                8.0 + rng.normal(0.0, 0.1),
-                rng.normal(0.0, 0.05),
-                heading + rng.normal(0.0, 0.02),
-                8.0 * float(BEND_PATH.curvature(s)) + rng.normal(0.0, 0.01),
-                rng.normal(0.0, 0.3),
-            )
-        )
-    return out
-
-
 @pytest.mark.parametrize(
     ("cls", "config_type", "options"),
     [(NMPCController, NMPCConfig, {"solver": "rti"}), (LMPCController, LMPCConfig, {})],
     ids=["nmpc-rti", "lmpc"],
 )
 @pytest.mark.parametrize("delays", [{}, {"input_delay_s": 0.1, "measurement_latency_s": 0.02}], ids=["now", "late"])
-def test_off_changes_nothing(cls, config_type, options, delays) -> None:
+def test_off_changes_nothing(cls, config_type, options, delays, weaving) -> None:
     """pose_filter_cutoff_hz = 0 (the default): commands and every diagnostic but the solve time equal bit for bit
     those of a controller built without the option; no filter is built and its diagnostics are not logged. With it
     on, the same measurements give other commands and the filter's diagnostics."""
@@ -87,7 +63,7 @@ def test_off_changes_nothing(cls, config_type, options, delays) -> None:
     for controller in (plain, explicit, filtered):
         controller.reset(BEND_PATH, PERIOD)
     differ = 0
-    for m in _recorded_measurements():
+    for m in weaving(BEND_PATH, 60, 7, 8.0):
         a, b, c = plain.step(m, BEND_PATH), explicit.step(m, BEND_PATH), filtered.step(m, BEND_PATH)
         assert a == b  # exactly
         differ += a != c
