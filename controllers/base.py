@@ -3,7 +3,9 @@
 A controller is built once for a vehicle (its geometry and limits) and a frozen config, `reset` for a path and
 its sample time, then stepped at that rate with what GPS/IMU and the steering sensor give. It returns a
 steering-wheel angle command. Whatever it wants logged about its last step (lookahead, solver status, ...) it
-exposes as `diagnostics`, which the simulator records as `ctrl_<name>` columns. Controllers contain no plotting
+names once in `_reset` (`_declare_diagnostics`) and writes each step into the array that returns, in that order:
+no per-step mapping on the hot path. The simulator records them as `ctrl_<name>` columns from
+`diagnostic_names` / `diagnostic_values`; `diagnostics` gives them as a mapping. Controllers contain no plotting
 and no I/O.
 
 The contract (issue 16), kept here once for every controller: a real steering ECU holds its last command on a
@@ -25,8 +27,8 @@ the controller. On a rejected step the controller's own diagnostics are those of
 0.0), all finite, the same keys every step. `reset` clears the held command and the last accepted time. A frame
 stamped earlier than the last accepted one is rejected, unless CLOCK_RESET_FRAMES come so in a row: then the
 clock was reset, and the controller restarts (as `reset`) and takes the frame, so that one frame stamped far
-ahead cannot lock it out. Subclasses implement the abstract `_reset` and `_command` and optionally
-`_diagnostics`; they do not override `step`, `reset` or `diagnostics`. `rejection` says in words why the last
+ahead cannot lock it out. Subclasses implement the abstract `_reset` (declaring their diagnostics, if any) and
+`_command`; they do not override `step`, `reset` or the diagnostics' accessors. `rejection` says in words why the last
 rejected step was rejected.
 """
 
@@ -35,16 +37,15 @@ from __future__ import annotations
 import math
 import sys
 from abc import ABC, abstractmethod
-from collections.abc import Mapping
-from types import MappingProxyType
+from collections.abc import Mapping, Sequence
 from typing import Any, ClassVar
+
+import numpy as np
 
 from workbench.base.errors import require_positive
 from workbench.base.path import ReferencePath, wrap_angle
 from workbench.simulation.control_interface import COMMAND_REJECTED, MEASUREMENT_REJECTED, Measurement
 from workbench.vehicles.geometry import VehicleGeometry
-
-_NO_DIAGNOSTICS: Mapping[str, float] = MappingProxyType({})
 
 # The plausible envelope of a measurement (`Controller.step` rejects a frame outside it). Each bound is far beyond
 # what any vehicle here can do, so that no plausible run is ever touched, and near enough that what lies beyond is
@@ -74,8 +75,8 @@ _FIELDS = ("t_s", "x_m", "y_m", "vx_mps", "vy_mps", "yaw_rad", "yaw_rate_rad_s",
 
 
 class Controller(ABC):
-    """Base class: subclasses set `name`, `config_type` and implement `_reset`, `_command` and, if they log
-    anything, `_diagnostics` (the module docstring's contract is kept here, in `step`)."""
+    """Base class: subclasses set `name`, `config_type` and implement `_reset` (calling `_declare_diagnostics` if
+    they log anything) and `_command` (the module docstring's contract is kept here, in `step`)."""
 
     name: ClassVar[str]
     config_type: ClassVar[type]
@@ -89,7 +90,8 @@ class Controller(ABC):
         if not isinstance(self.config, self.config_type):
             raise TypeError(f"{self.name} takes a {self.config_type.__name__}; got {type(self.config).__name__}")
         self._clear_hold()
-        self._report: dict[str, float] = {MEASUREMENT_REJECTED: 0.0, COMMAND_REJECTED: 0.0}
+        self._declare_diagnostics(())
+        self._publish_declared()
 
     @classmethod
     def summary(cls) -> str:
@@ -103,8 +105,9 @@ class Controller(ABC):
         require_positive("sample_time_s", sample_time_s)
         self._clear_hold()
         self._sample_time_s = float(sample_time_s)
+        self._declare_diagnostics(())
         self._reset(path, sample_time_s)
-        self._report = self._merged(self._diagnostics(), 0.0, 0.0)
+        self._publish_declared()
 
     def step(self, measurement: Measurement, path: ReferencePath) -> float:
         """Steering-wheel angle command (rad) for this step: always finite and within the vehicle's limit (the
@@ -117,26 +120,40 @@ class Controller(ABC):
                 screened = None
             else:  # the clock has been reset, not glitched: so is the controller, and it takes the frame
                 self._reset(path, self._sample_time_s)
+        report, n = self._report, self._own.size
         if screened is None:
-            self._report = self._merged(self._report, 1.0, 0.0)  # a new mapping: one handed out earlier stays as it was
+            report[n], report[n + 1] = 1.0, 0.0  # the own values stay those of the last accepted step
             return self._held_command
         command = float(self._command(screened, path))
-        own = self._diagnostics()
-        if not (math.isfinite(command) and all(map(math.isfinite, own.values()))):
+        own = self._own
+        if not (math.isfinite(command) and (n == 0 or math.isfinite(own.sum()))):  # a NaN or inf makes the sum one
             self.rejection = "the controller's command or diagnostics were not finite"
-            self._report = self._merged(self._report, 0.0, 1.0)
+            report[n], report[n + 1] = 0.0, 1.0
             return self._held_command
         limit = self.geometry.max_steer_wheel_angle_rad
         command = min(max(command, -limit), limit)
         self._held_command, self._last_t_s, self._rewound_frames = command, screened.t_s, 0
-        self._report = self._merged(own, 0.0, 0.0)
+        report[:n] = own
+        report[n], report[n + 1] = 0.0, 0.0
         return command
 
     @property
-    def diagnostics(self) -> Mapping[str, float]:
-        """Internal signals of the last step, to be logged: the controller's own (those of the last accepted step
-        when this one was rejected) and the flags `measurement_rejected` and `command_rejected` (1.0 / 0.0)."""
+    def diagnostic_names(self) -> tuple[str, ...]:
+        """The names of `diagnostic_values`: the controller's own, then `measurement_rejected` and
+        `command_rejected`; the same every step from `reset` on."""
+        return self._report_names
+
+    @property
+    def diagnostic_values(self) -> np.ndarray:
+        """Internal signals of the last step, to be logged, in the order of `diagnostic_names`: the controller's own
+        (those of the last accepted step when this one was rejected) and the two flags (1.0 / 0.0). The array is the
+        controller's and is overwritten by the next step: copy what you keep."""
         return self._report
+
+    @property
+    def diagnostics(self) -> Mapping[str, float]:
+        """`diagnostic_values` by name, as a new mapping (one handed out earlier stays as it was)."""
+        return dict(zip(self._report_names, self._report.tolist(), strict=True))
 
     @property
     def held_command(self) -> float:
@@ -159,9 +176,12 @@ class Controller(ABC):
         """The steering-wheel command (rad) for a measurement that passed the screen; the base class saturates the
         result and holds the last command when it is not finite."""
 
-    def _diagnostics(self) -> Mapping[str, float]:
-        """The controller's own signals of its last `_command` (the same keys every step; none by default)."""
-        return _NO_DIAGNOSTICS
+    def _declare_diagnostics(self, names: Sequence[str]) -> np.ndarray:
+        """For `_reset`: the names of the controller's own signals, in the order `_command` writes them into the
+        array returned (kept as `self._own`; zeros until the first step). None declared: no signals."""
+        self._own_names = tuple(names)
+        self._own = np.zeros(len(self._own_names))
+        return self._own
 
     # ------------------------------------------------------------------ the screen
     def _clear_hold(self) -> None:
@@ -171,12 +191,11 @@ class Controller(ABC):
         #: Why the last rejected step was rejected ("" until one is), for a person reading a failure.
         self.rejection = ""
 
-    @staticmethod
-    def _merged(own: Mapping[str, float], measurement_rejected: float, command_rejected: float) -> dict[str, float]:
-        report = dict(own)
-        report[MEASUREMENT_REJECTED] = measurement_rejected
-        report[COMMAND_REJECTED] = command_rejected
-        return report
+    def _publish_declared(self) -> None:
+        """The report (`diagnostic_values`) for the declared signals: their initial values, no flag raised."""
+        self._report_names = (*self._own_names, MEASUREMENT_REJECTED, COMMAND_REJECTED)
+        self._report = np.zeros(len(self._report_names))
+        self._report[: self._own.size] = self._own
 
     def _screen(self, m: Measurement) -> Measurement | None:
         """The measurement the controller may see (with its yaw wrapped when beyond MAX_UNWRAPPED_YAW_RAD), or

@@ -9,7 +9,6 @@ about 45 degrees. Curvature kappa = 2 sin(alpha) / l_d, road-wheel angle tan(phi
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import ClassVar
 
@@ -47,7 +46,7 @@ class PurePursuit(Controller):
 
     def _reset(self, path: ReferencePath, sample_time_s: float) -> None:
         self._tracker: PathTracker = path.tracker(0.0)
-        self._diag = {"lookahead_m": 0.0, "target_s_m": 0.0, "curvature_cmd_1pm": 0.0}
+        self._diag = self._declare_diagnostics(("lookahead_m", "target_s_m", "curvature_cmd_1pm"))
 
     def _command(self, measurement: Measurement, path: ReferencePath) -> float:
         cfg = self.config
@@ -64,8 +63,5 @@ class PurePursuit(Controller):
         else:
             alpha = math.atan2(dy, dx) - m.yaw_rad
             curvature = 2.0 * math.sin(alpha) / distance
-        self._diag = {"lookahead_m": lookahead, "target_s_m": target_s, "curvature_cmd_1pm": curvature}
+        self._diag[:] = (lookahead, target_s, curvature)
         return self.saturate(self.geometry.steer_wheel_for_curvature(curvature))
-
-    def _diagnostics(self) -> Mapping[str, float]:
-        return self._diag

@@ -8,7 +8,6 @@ feedforward, atan(L kappa), is optional (off by default, as in the original law)
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import ClassVar
 
@@ -38,7 +37,7 @@ class Stanley(Controller):
 
     def _reset(self, path: ReferencePath, sample_time_s: float) -> None:
         self._tracker: PathTracker = path.tracker(0.0)
-        self._diag = {"front_cte_m": 0.0, "heading_term_rad": 0.0, "cross_track_term_rad": 0.0}
+        self._diag = self._declare_diagnostics(("front_cte_m", "heading_term_rad", "cross_track_term_rad"))
 
     def _command(self, measurement: Measurement, path: ReferencePath) -> float:
         cfg, m, wheelbase = self.config, measurement, self.geometry.wheelbase_m
@@ -50,13 +49,6 @@ class Stanley(Controller):
         road_wheel = heading_term + cross_track_term
         if cfg.curvature_feedforward:
             road_wheel += math.atan(wheelbase * foot.curvature_1pm)
-        self._diag = {
-            "front_cte_m": foot.cte_m,
-            "heading_term_rad": heading_term,
-            "cross_track_term_rad": cross_track_term,
-        }
+        self._diag[:] = (foot.cte_m, heading_term, cross_track_term)
         limit = self.geometry.max_road_wheel_angle_rad
         return self.saturate(min(max(road_wheel, -limit), limit) * self.geometry.steering_ratio)
-
-    def _diagnostics(self) -> Mapping[str, float]:
-        return self._diag

@@ -28,7 +28,6 @@ Added to the paper so that the loop keeps its margins on the vehicle it steers (
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import ClassVar
 
@@ -281,7 +280,7 @@ class ClothoidController(Controller):
         self._filter_speed_kmh = -1
         self._choice.reset()
         self._held_band: int | None = None  # the speed band whose floor applies (_floor_band)
-        self._diag: dict[str, float] = dict.fromkeys(DIAGNOSTIC_KEYS, 0.0)
+        self._diag = self._declare_diagnostics(DIAGNOSTIC_KEYS)
         if path.speed_mps is not None:  # the floors of the planned speeds now, not inside a step (~0.1 s per band)
             for speed_mps in np.unique(np.round(path.speed_mps * 3.6 / FLOOR_SPEED_BAND_KMH)) * FLOOR_SPEED_BAND_KMH:
                 self.lookahead_floor_m(float(speed_mps) / 3.6)
@@ -457,25 +456,22 @@ class ClothoidController(Controller):
         road_wheel = math.atan(g.wheelbase_m * self._kappa_cmd)  # Ackermann: tan(phi) = L kappa
         steer = road_wheel * g.steering_ratio
         command = self.saturate(self._lead_filter(m.speed_mps).step(steer))  # Eq. 6
-        self._diag = {
-            "lookahead_m": lookahead,
-            "searched_lookahead_m": searched,
-            "lookahead_floor_m": floor,
-            "lookahead_ceiling_m": ceiling,
-            "frechet_m": frechet,
-            "curvature_rate_1pm2": kdot,
-            "clothoid_curvature_rate_1pm2": clothoid_kdot,
-            "reference_curvature_rate_1pm2": reference_kdot,
-            "feedforward_curvature_rate_1pm2": feedforward_kdot,
-            "clothoid_length_m": length,
-            "end_error_m": math.hypot(ex - tx, ey - ty),
-            "fit_status": float(status),
-            "evaluations": float(evaluations),
-            "initial_curvature_1pm": kappa0,
-            "curvature_cmd_1pm": self._kappa_cmd,
-            "steer_unfiltered_rad": steer,
-        }
+        self._diag[:] = (  # in the order of DIAGNOSTIC_KEYS
+            lookahead,
+            searched,
+            floor,
+            ceiling,
+            frechet,
+            kdot,
+            clothoid_kdot,
+            reference_kdot,
+            feedforward_kdot,
+            length,
+            math.hypot(ex - tx, ey - ty),
+            float(status),
+            float(evaluations),
+            kappa0,
+            self._kappa_cmd,
+            steer,
+        )
         return command
-
-    def _diagnostics(self) -> Mapping[str, float]:
-        return self._diag

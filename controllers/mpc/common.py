@@ -33,7 +33,6 @@ compensation needs nothing more.
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
@@ -76,6 +75,20 @@ MIN_MEASURED_SPEED_MPS = 0.5
 GEOMETRY_TOLERANCE = 0.02
 #: The objective logged when a solve returned none.
 NO_OBJECTIVE = -1.0
+#: The signals every MPC logs each step, in the order `_command` writes them (then, when on, delay_compensation_s
+#: and the pose filter's pose_filter_offset_m and pose_filter_heading_offset_rad).
+SOLVE_DIAGNOSTICS = (
+    "solver_status",
+    "solve_time_s",
+    "solver_iterations",
+    "fallback",
+    "plan_age_s",
+    "failed_solves",
+    "objective",
+    "predicted_cte_end_m",
+    "road_wheel_rate_cmd_rad_s",
+    "model_speed_mps",
+)
 #: The largest cost weight the options allow (larger ones only make the QPs ill-conditioned).
 MAX_WEIGHT = 1e9
 #: Command knots closer than this (s) to an end of the prediction window start no segment of their own.
@@ -341,24 +354,16 @@ class MPCController(Controller):
         self._sent_times = np.zeros(capacity)
         self._sent_commands = np.zeros(capacity)
         self._sent_count = 0
-        self._diag = {
-            "solver_status": float(SolveStatus.SOLVED),
-            "solve_time_s": 0.0,
-            "solver_iterations": 0.0,
-            "fallback": 0.0,
-            "plan_age_s": 0.0,
-            "failed_solves": 0.0,
-            "objective": NO_OBJECTIVE,
-            "predicted_cte_end_m": 0.0,
-            "road_wheel_rate_cmd_rad_s": 0.0,
-            "model_speed_mps": 0.0,
-        }
+        names = list(SOLVE_DIAGNOSTICS)
         if self._delay_s > 0.0:  # logged only when compensating, so a run without is today's trace bit for bit
-            self._diag["delay_compensation_s"] = self._delay_s
+            names.append("delay_compensation_s")
         if self._pose_filter is not None:  # logged only with the filter on, as the delay compensation
             self._pose_filter.reset()
-            self._diag["pose_filter_offset_m"] = 0.0
-            self._diag["pose_filter_heading_offset_rad"] = 0.0
+            names += ["pose_filter_offset_m", "pose_filter_heading_offset_rad"]
+        self._diag = self._declare_diagnostics(names)
+        self._diag[: len(SOLVE_DIAGNOSTICS)] = (float(SolveStatus.SOLVED), *[0.0] * 5, NO_OBJECTIVE, 0.0, 0.0, 0.0)
+        if self._delay_s > 0.0:
+            self._diag[len(SOLVE_DIAGNOSTICS)] = self._delay_s
 
     def _command(self, measurement: Measurement, path: ReferencePath) -> float:
         m, ocp, model = measurement, self.ocp, self.model
@@ -410,27 +415,22 @@ class MPCController(Controller):
             self._last_command = command
         if self._delay_s > 0.0 and self._last_command is not None:
             self._record_sent(m.t_s, self._last_command)
-        self._diag = {
-            "solver_status": float(result.status),
-            "solve_time_s": float(result.solve_time_s),
-            "solver_iterations": float(result.iterations),
-            "fallback": 0.0 if result.accepted else 1.0,
-            "plan_age_s": 0.0 if plan is None else origin - plan.t_s,
-            "failed_solves": float(self._failures),
-            "objective": float(result.objective) if math.isfinite(result.objective) else NO_OBJECTIVE,
-            "predicted_cte_end_m": 0.0 if plan is None else float(plan.states[-1, model.i_cte]),
-            "road_wheel_rate_cmd_rad_s": rate,
-            "model_speed_mps": float(speed[0]),
-        }
-        if self._delay_s > 0.0:
-            self._diag["delay_compensation_s"] = self._delay_s
-        if self._pose_filter is not None:  # what the filter took off the measured pose
-            self._diag["pose_filter_offset_m"] = math.hypot(measurement.x_m - m.x_m, measurement.y_m - m.y_m)
-            self._diag["pose_filter_heading_offset_rad"] = measurement.yaw_rad - m.yaw_rad
+        self._diag[: len(SOLVE_DIAGNOSTICS)] = (  # in the order of SOLVE_DIAGNOSTICS
+            float(result.status),
+            float(result.solve_time_s),
+            float(result.iterations),
+            0.0 if result.accepted else 1.0,
+            0.0 if plan is None else origin - plan.t_s,
+            float(self._failures),
+            float(result.objective) if math.isfinite(result.objective) else NO_OBJECTIVE,
+            0.0 if plan is None else float(plan.states[-1, model.i_cte]),
+            rate,
+            float(speed[0]),
+        )
+        if self._pose_filter is not None:  # what the filter took off the measured pose (the last two signals)
+            self._diag[-2] = math.hypot(measurement.x_m - m.x_m, measurement.y_m - m.y_m)
+            self._diag[-1] = measurement.yaw_rad - m.yaw_rad
         return self.saturate(command * self.prediction.steering_ratio)
-
-    def _diagnostics(self) -> Mapping[str, float]:
-        return self._diag
 
     @property
     def last_plan(self) -> Plan | None:

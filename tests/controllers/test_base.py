@@ -29,13 +29,12 @@ class _Scripted(Controller):
     def _reset(self, path: ReferencePath, sample_time_s: float) -> None:
         self.seen: list[Measurement] = []
         self.next_command, self.signal = 0.1, 0.0
+        self._signal = self._declare_diagnostics(("signal",))
 
     def _command(self, measurement: Measurement, path: ReferencePath) -> float:
         self.seen.append(measurement)
+        self._signal[0] = self.signal
         return self.next_command
-
-    def _diagnostics(self):
-        return {"signal": self.signal}
 
 
 def _controller() -> _Scripted:

@@ -174,7 +174,10 @@ class Simulation:
         seen = not conditions.is_ideal
         speed_controller = PISpeedController(PISpeedGains())
 
-        log = _TraceLog(vehicle.output_names, max_steps)
+        log = _TraceLog(vehicle.output_names, controller.diagnostic_names, max_steps)
+        diagnostics = controller.diagnostic_values  # the controller's own array, rewritten by each step
+        measurement_rejected = controller.diagnostic_names.index(MEASUREMENT_REJECTED)
+        command_rejected = controller.diagnostic_names.index(COMMAND_REJECTED)
         status, message = Status.TIMEOUT, f"did not finish within {max_time:.1f} s"
         steer_cmd = accel_cmd = applied_cmd = 0.0
         held, first_held = 0, ""  # steps whose measurement the controller's screen rejected (it held its command)
@@ -216,12 +219,11 @@ class Simulation:
                 status, message = Status.CONTROLLER_FAILED, f"{controller.name} raised {type(exc).__name__}: {exc}"
                 break
             step_time = time.perf_counter() - start
-            flags = controller.diagnostics
-            if flags.get(COMMAND_REJECTED) or not math.isfinite(steer_cmd):
+            if diagnostics[command_rejected] or not math.isfinite(steer_cmd):
                 status = Status.CONTROLLER_FAILED
                 message = f"{controller.name} computed a non-finite steering command at t = {t:.2f} s"
                 break
-            if flags.get(MEASUREMENT_REJECTED):
+            if diagnostics[measurement_rejected]:
                 if not held:
                     first_held = f"first at t = {t:.2f} s: {controller.rejection}"
                 held += 1
@@ -241,7 +243,7 @@ class Simulation:
                 foot,
                 float(wrap_angle(yaw - foot.heading_rad)),
                 step_time,
-                controller.diagnostics,
+                diagnostics,
             )
             if actuator is None:
                 state = vehicle.advance(state, steer_cmd, accel_cmd, dt, cfg.substeps)
@@ -289,12 +291,13 @@ class _TraceLog:
     """Columns for the trace, one row per controller step; they double when full, so memory follows the steps
     actually run, not the time-out's capacity."""
 
-    def __init__(self, output_names: tuple[str, ...], capacity: int) -> None:
+    def __init__(self, output_names: tuple[str, ...], diagnostic_names: tuple[str, ...], capacity: int) -> None:
         self.output_names = output_names
+        self.diagnostic_names = diagnostic_names
         self.capacity = min(capacity, 1 << 14)
         self.outputs = np.empty((self.capacity, len(output_names)))
         self.signals = np.empty((self.capacity, len(self.SIGNALS)))
-        self.diagnostics: dict[str, np.ndarray] = {}
+        self.diagnostics = np.empty((self.capacity, len(diagnostic_names)))
         self.seen_columns: np.ndarray | None = None
         self.n = 0
 
@@ -304,7 +307,7 @@ class _TraceLog:
 
         self.outputs = doubled(self.outputs)
         self.signals = doubled(self.signals)
-        self.diagnostics = {key: doubled(column) for key, column in self.diagnostics.items()}
+        self.diagnostics = doubled(self.diagnostics)
         if self.seen_columns is not None:
             self.seen_columns = doubled(self.seen_columns)
         self.capacity *= 2
@@ -341,11 +344,7 @@ class _TraceLog:
             foot.curvature_1pm,
             step_time,
         )
-        for key, value in diagnostics.items():
-            column = self.diagnostics.get(key)
-            if column is None:
-                column = self.diagnostics[key] = np.full(self.capacity, np.nan)
-            column[i] = value
+        self.diagnostics[i] = diagnostics
         self.n += 1
 
     #: What the controller saw and what reached the plant, logged when the conditions are not ideal: the
@@ -384,7 +383,7 @@ class _TraceLog:
         trace = {"t_s": self.signals[:n, 0].copy()}
         trace.update({name: self.outputs[:n, k].copy() for k, name in enumerate(self.output_names)})
         trace.update({name: self.signals[:n, k].copy() for k, name in enumerate(self.SIGNALS) if k > 0})
-        trace.update({f"ctrl_{key}": col[:n].copy() for key, col in self.diagnostics.items()})
+        trace.update({f"ctrl_{key}": self.diagnostics[:n, k].copy() for k, key in enumerate(self.diagnostic_names)})
         if self.seen_columns is not None:
             trace.update({name: self.seen_columns[:n, k].copy() for k, name in enumerate(self.SEEN)})
         return trace
