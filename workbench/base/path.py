@@ -21,7 +21,15 @@ import numpy as np
 from scipy.interpolate import BSpline, make_interp_spline
 
 from workbench.base.errors import WorkbenchInputError, require_positive
-from workbench.base.path_search import closest_in_window, first_beyond, windowed_projection
+from workbench.base.path_search import (
+    TRACK_OUT_SIZE,
+    TRACK_PROGRESS,
+    TRACK_S,
+    TRACK_STATE_SIZE,
+    closest_in_window,
+    first_beyond,
+    track,
+)
 from workbench.base.waypoints import Waypoints
 
 #: Default spacing of the path's samples along s (m). Linear interpolation between samples is then exact to
@@ -160,9 +168,6 @@ class ReferencePath:
         for label, arr in (("heading", self.heading_rad), ("curvature", self.curvature_1pm)):
             if arr.shape != self.x_m.shape:
                 raise WorkbenchInputError(f"{name}: {label} has {arr.size} samples, positions have {self.x_m.size}")
-        # Segment geometry for projections, computed once.
-        self._seg_dx = np.diff(self.x_m)
-        self._seg_dy = np.diff(self.y_m)
 
     # ------------------------------------------------------------------ construction
     @classmethod
@@ -332,64 +337,39 @@ class PathTracker:
     def __init__(self, path: ReferencePath, initial_s_m: float | None = None, min_window_m: float = 5.0) -> None:
         self.path = path
         self.min_window_m = float(min_window_m)
-        self._n_seg = path.x_m.size - 1
         #: The diagonal of the path's bounding box (m): a move longer than this can land anywhere on the path.
         self._extent_m = float(math.hypot(np.ptp(path.x_m), np.ptp(path.y_m)))
+        #: The compiled update's state (`path_search.track`) and its output row.
+        self.state = np.empty(TRACK_STATE_SIZE)
+        self.out = np.empty(TRACK_OUT_SIZE)
         self.reset(initial_s_m)
 
     def reset(self, initial_s_m: float | None = None) -> None:
         """Forget the history; the next update starts from initial_s_m (global search if None)."""
-        self._s: float | None = None if initial_s_m is None else float(self.path.wrap_s(initial_s_m))
-        self._progress = 0.0 if initial_s_m is None else float(initial_s_m)
-        self._last_xy: tuple[float, float] | None = None
+        self.state[:] = np.nan
+        if initial_s_m is not None:
+            self.state[TRACK_S] = float(self.path.wrap_s(initial_s_m))
+        self.state[TRACK_PROGRESS] = 0.0 if initial_s_m is None else float(initial_s_m)
 
     @property
     def progress_m(self) -> float:
         """Arc length travelled (laps counted) as of the last update."""
-        return self._progress
+        return float(self.state[TRACK_PROGRESS])
 
     def update(self, x_m: float, y_m: float) -> Projection:
+        """The foot point of (x_m, y_m), the progress advanced to it (`path_search.track`, compiled)."""
         path = self.path
         if not (math.isfinite(x_m) and math.isfinite(y_m)):
             raise WorkbenchInputError(f"position must be finite to project onto {path.name}; got ({x_m}, {y_m})")
-        moved = 0.0 if self._last_xy is None else math.hypot(x_m - self._last_xy[0], y_m - self._last_xy[1])
-        if self._s is None:
-            s_new = path.project_global(x_m, y_m)
-            self._progress = s_new
-        elif moved > self._extent_m:  # a jump past the path's whole extent: progress is lost, search it all
-            s_new = path.project_global(x_m, y_m)
-            self._progress += s_new - self._s
-        else:
-            s_new = self._windowed_search(x_m, y_m, self._s, max(self.min_window_m, 2.0 * moved))
-            delta = s_new - self._s
-            if path.closed:  # shortest way round the seam
-                delta = (delta + 0.5 * path.length_m) % path.length_m - 0.5 * path.length_m
-            self._progress += delta
-        self._s = s_new
-        self._last_xy = (x_m, y_m)
+        self.advance(float(x_m), float(y_m))
+        s_m, progress, fx, fy, heading, curvature, cte, at_end, past_end, distance = self.out.tolist()
+        return Projection(s_m, progress, fx, fy, heading, curvature, cte, at_end == 1.0, past_end, distance)
 
-        i = min(int(s_new / path.spacing_m), self._n_seg - 1)
-        frac = s_new / path.spacing_m - i
-        fx = float(path.x_m[i] + frac * path._seg_dx[i])
-        fy = float(path.y_m[i] + frac * path._seg_dy[i])
-        heading = float(path.heading_rad[i] + frac * (path.heading_rad[i + 1] - path.heading_rad[i]))
-        curvature = float(path.curvature_1pm[i] + frac * (path.curvature_1pm[i + 1] - path.curvature_1pm[i]))
-        # Signed CTE: component of (position - foot) along the path's left normal.
-        cos_h, sin_h = math.cos(heading), math.sin(heading)
-        cte = -(x_m - fx) * sin_h + (y_m - fy) * cos_h
-        along = (x_m - fx) * cos_h + (y_m - fy) * sin_h  # 0 beside the path; beyond an end, how far beyond
-        at_end, past_end = False, 0.0
-        if not path.closed:
-            at_end = s_new >= path.length_m - 1e-9
-            if at_end or s_new <= 1e-9:
-                past_end = max(along if at_end else -along, 0.0)
-        distance = math.hypot(cte, along)
-        return Projection(s_new, self._progress, fx, fy, heading, curvature, cte, at_end, past_end, distance)
-
-    def _windowed_search(self, x_m: float, y_m: float, s_center: float, half_width_m: float) -> float:
+    def advance(self, x_m: float, y_m: float) -> None:
+        """`update` without the checks and the Projection, for a hot loop: the projection is left in `out`
+        (`path_search.TRACK_OUT_SIZE` values in Projection's order, at_end as 1.0 / 0.0)."""
         path = self.path
-        ds = path.spacing_m
-        half = min(math.ceil(half_width_m / ds), self._n_seg)  # no window needs more than the whole path
-        index = windowed_projection(path.x_m, path.y_m, x_m, y_m, int(s_center / ds), half, path.closed)
-        s_m = index * ds
-        return s_m % path.length_m if path.closed else min(s_m, path.length_m)  # [0, L) on a loop
+        track(
+            path.x_m, path.y_m, path.heading_rad, path.curvature_1pm, path.spacing_m, path.length_m, path.closed,
+            self._extent_m, self.min_window_m, self.state, x_m, y_m, self.out,
+        )  # fmt: skip

@@ -89,3 +89,75 @@ def first_beyond(
             return index % n_seg if closed else index
         ax, ay, index_a = bx, by, float(j)
     return -1.0
+
+
+#: Layout of a tracker's state array (`track`): the foot point's arc length (NaN before the first update), the
+#: progress along the path (laps counted), and the last position projected (NaN before the first update).
+TRACK_S, TRACK_PROGRESS, TRACK_LAST_X, TRACK_LAST_Y = 0, 1, 2, 3
+TRACK_STATE_SIZE = 4
+#: Layout of `track`'s output: the foot point's arc length, progress, x, y, heading, curvature, the signed CTE,
+#: at_end (1.0 / 0.0), past_end_m and distance_m (`path.Projection`'s fields, in its order).
+TRACK_OUT_SIZE = 10
+
+
+@njit(cache=True)
+def track(
+    x: np.ndarray,
+    y: np.ndarray,
+    heading: np.ndarray,
+    curvature: np.ndarray,
+    spacing: float,
+    length: float,
+    closed: bool,
+    extent: float,
+    min_window: float,
+    state: np.ndarray,
+    px: float,
+    py: float,
+    out: np.ndarray,
+) -> None:  # pragma: no cover - compiled
+    """One `path.PathTracker.update` of the finite position (px, py): the foot point searched in a window about the
+    last (sized by how far the position moved, at least min_window each way; over the whole path on the first
+    update or after a jump longer than `extent`, the path's bounding-box diagonal), the progress advanced (the
+    shortest way round a loop's seam) in `state`, and the projection written to `out` (TRACK_OUT_SIZE)."""
+    n_seg = x.size - 1
+    s_old = state[TRACK_S]
+    moved = 0.0
+    if not math.isnan(state[TRACK_LAST_X]):
+        moved = math.hypot(px - state[TRACK_LAST_X], py - state[TRACK_LAST_Y])
+    if math.isnan(s_old) or moved > extent:  # the first update, or a jump: search it all
+        j, t, _ = closest_in_window(x, y, px, py, 0, n_seg - 1, False)
+        s_new = (j + t) * spacing
+        if math.isnan(s_old):
+            state[TRACK_PROGRESS] = s_new
+        else:
+            state[TRACK_PROGRESS] += s_new - s_old
+    else:
+        half = min(math.ceil(max(min_window, 2.0 * moved) / spacing), n_seg)  # no window needs the whole path
+        s_m = windowed_projection(x, y, px, py, int(s_old / spacing), half, closed) * spacing
+        s_new = s_m % length if closed else min(s_m, length)  # [0, L) on a loop
+        delta = s_new - s_old
+        if closed:  # shortest way round the seam
+            delta = (delta + 0.5 * length) % length - 0.5 * length
+        state[TRACK_PROGRESS] += delta
+    state[TRACK_S] = s_new
+    state[TRACK_LAST_X] = px
+    state[TRACK_LAST_Y] = py
+
+    i = min(int(s_new / spacing), n_seg - 1)
+    frac = s_new / spacing - i
+    fx = x[i] + frac * (x[i + 1] - x[i])
+    fy = y[i] + frac * (y[i + 1] - y[i])
+    h = heading[i] + frac * (heading[i + 1] - heading[i])
+    k = curvature[i] + frac * (curvature[i + 1] - curvature[i])
+    # the signed CTE: the component of (position - foot) along the path's left normal
+    cos_h, sin_h = math.cos(h), math.sin(h)
+    cte = -(px - fx) * sin_h + (py - fy) * cos_h
+    along = (px - fx) * cos_h + (py - fy) * sin_h  # 0 beside the path; beyond an end, how far beyond
+    at_end, past_end = False, 0.0
+    if not closed:
+        at_end = s_new >= length - 1e-9
+        if at_end or s_new <= 1e-9:
+            past_end = max(along if at_end else -along, 0.0)
+    out[0], out[1], out[2], out[3], out[4] = s_new, state[TRACK_PROGRESS], fx, fy, h
+    out[5], out[6], out[7], out[8], out[9] = k, cte, 1.0 if at_end else 0.0, past_end, math.hypot(cte, along)
