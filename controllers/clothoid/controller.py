@@ -35,20 +35,14 @@ import numpy as np
 from scipy.constants import g as G_MPS2  # standard gravity, 9.80665 m/s^2
 
 from controllers.base import Controller, Measurement
+from controllers.clothoid import step_kernel as sk
 from controllers.clothoid.curvature_limits import CurvatureLimits
 from controllers.clothoid.filter_schedule import FilterSchedule
-from controllers.clothoid.lead_filter import DiscreteLeadFilter, PassThroughFilter, SteeringFilter
-from controllers.clothoid.lookahead import (
-    MAX_CURVE_POINTS,
-    adaptive_search,
-    candidate_count,
-    evaluate_candidate,
-    turn_limited_lookahead,
-)
-from controllers.clothoid.lookahead_filter import LookaheadFilter, LookaheadFilterSettings, require_rate
+from controllers.clothoid.lead_filter import DiscreteLeadFilter
+from controllers.clothoid.lookahead import MAX_CURVE_POINTS, candidate_count
+from controllers.clothoid.lookahead_filter import require_rate
 from controllers.clothoid.loop_analysis import LoopSettings, PlantLags, lookahead_floor
-from controllers.clothoid.path_feedforward import FeedforwardTiming, two_degree_of_freedom_rate
-from controllers.clothoid.pose_prediction import along_arc
+from controllers.clothoid.path_feedforward import FeedforwardTiming
 from controllers.clothoid.vehicle_tuning import VehicleTuning
 from controllers.config_checks import (
     check_bool,
@@ -259,14 +253,14 @@ class ClothoidController(Controller):
         self._buffers = np.empty((4, MAX_CURVE_POINTS))
         top = max(cfg.max_lookahead_m, MAX_FLOOR_LOOKAHEAD_M)
         self._scores = np.empty(candidate_count(cfg.min_lookahead_m, top, cfg.lookahead_step_m))
-        self._filters: dict[int, DiscreteLeadFilter] = {}
         self._floors: dict[int, float] = {}  # per speed band, for the sample time _floors_dt
         self._floors_dt: float | None = None
-        self._choice = LookaheadFilter(
-            LookaheadFilterSettings(
-                cfg.lookahead_hysteresis_m, cfg.max_lookahead_growth_m_per_m, cfg.max_lookahead_shrink_m_per_m
-            )
-        )
+        self._state = np.empty(sk.STATE_SIZE)
+        self._floor_table = np.empty(sk.FLOOR_ROWS)
+        self._filter_table = np.empty((sk.FILTER_ROWS, 9))
+        self._scratch = np.empty(sk.SCRATCH_SIZE)
+        self._params = self._parameters()
+        self._tables()
 
     def _reset(self, path: ReferencePath, sample_time_s: float) -> None:
         if float(sample_time_s) != self._floors_dt:  # the floors depend on the sample time, not on the path
@@ -274,32 +268,63 @@ class ClothoidController(Controller):
         self._dt = float(sample_time_s)
         self._tracker: PathTracker = path.tracker(0.0)
         self._here: PathTracker = path.tracker(0.0)
-        self._kappa_cmd: float | None = None
-        self._filters = {}
-        self._filter: SteeringFilter = PassThroughFilter()
-        self._filter_speed_kmh = -1
-        self._choice.reset()
-        self._held_band: int | None = None  # the speed band whose floor applies (_floor_band)
+        self._state[:] = np.nan
+        self._state[sk.S_HELD_BAND] = self._state[sk.S_FILTER_KMH] = -1.0
+        self._floor_table[:] = np.nan
+        self._filter_table[:] = np.nan
+        p = self._params
+        p[sk.P_DT], p[sk.P_PATH_SPACING], p[sk.P_PATH_LENGTH] = self._dt, path.spacing_m, path.length_m
+        p[sk.P_PATH_EXTENT], p[sk.P_TRACKER_WINDOW] = self._tracker.extent_m, self._tracker.min_window_m
         self._diag = self._declare_diagnostics(DIAGNOSTIC_KEYS)
+        self._tables()  # read again: limits, tuning and schedule are the controller's attributes
         if path.speed_mps is not None:  # the floors of the planned speeds now, not inside a step (~0.1 s per band)
             for speed_mps in np.unique(np.round(path.speed_mps * 3.6 / FLOOR_SPEED_BAND_KMH)) * FLOOR_SPEED_BAND_KMH:
                 self.lookahead_floor_m(float(speed_mps) / 3.6)
 
-    def _lead_filter(self, speed_mps: float) -> SteeringFilter:
-        """The lead filter for this speed: the schedule's filter at the nearest whole km/h (discretised once per
-        km/h and cached), continuing from the previous filter's state."""
-        if self.filter_schedule is None:
-            return self._filter
-        speed_kmh = round(speed_mps * 3.6) if len(self.filter_schedule.speeds_kmh) > 1 else 0
-        if speed_kmh != self._filter_speed_kmh:
-            new = self._filters.get(speed_kmh)
-            if new is None:
-                new = DiscreteLeadFilter(self.filter_schedule.at_speed(float(speed_kmh)), self._dt)
-                self._filters[speed_kmh] = new
-            if self._filter_speed_kmh >= 0:
-                new.continue_from(self._filter)
-            self._filter, self._filter_speed_kmh = new, speed_kmh
-        return self._filter
+    def _tables(self) -> None:
+        """The tables the compiled step reads (step_kernel.py): the limits, the identified lags and the lead
+        filter's schedule (no rows: untuned, no lead filter), each against speed."""
+        self._limit_speeds, self._limits = self.limits.table
+        if self.tuning is not None:
+            self._lag_speeds, self._lags, self._measured_lags = self.tuning.lag_tables
+        else:
+            self._lag_speeds, self._lags, self._measured_lags = np.zeros(0), np.zeros((0, 4)), np.zeros((0, 4))
+        if self.filter_schedule is not None:
+            self._schedule_speeds, self._schedule = self.filter_schedule.table
+        else:
+            self._schedule_speeds, self._schedule = np.zeros(0), np.zeros((0, 3))
+
+    def _parameters(self) -> np.ndarray:
+        """The compiled step's parameter vector (step_kernel.P_*): geometry and options (the period and the path's
+        are set by `_reset`)."""
+        cfg, g, p = self.config, self.geometry, np.full(sk.PARAM_COUNT, np.nan)
+        p[sk.P_WHEELBASE], p[sk.P_STEERING_RATIO], p[sk.P_MAX_STEER] = (
+            g.wheelbase_m,
+            g.steering_ratio,
+            g.max_steer_wheel_angle_rad,
+        )
+        p[sk.P_HORIZON], p[sk.P_KNOWN_DELAY] = self._prediction_horizon_s, cfg.known_delay_s
+        p[sk.P_LOOKAHEAD_MODE] = LOOKAHEAD_MODES.index(cfg.lookahead_mode)
+        p[sk.P_INITIAL_CURVATURE] = INITIAL_CURVATURE.index(cfg.initial_curvature)
+        p[sk.P_COURSE], p[sk.P_EXCESS] = cfg.heading == "course", cfg.threshold_mode == "excess"
+        p[sk.P_MIN_LOOKAHEAD], p[sk.P_MAX_LOOKAHEAD] = cfg.min_lookahead_m, cfg.max_lookahead_m
+        p[sk.P_LOOKAHEAD_STEP], p[sk.P_MIN_PREVIEW] = cfg.lookahead_step_m, cfg.min_preview_time_s
+        p[sk.P_FIXED_LOOKAHEAD], p[sk.P_LOOKAHEAD_GAIN] = cfg.fixed_lookahead_m, cfg.lookahead_gain_s
+        p[sk.P_MAX_TURN_RAD] = math.radians(cfg.max_target_turn_deg)
+        p[sk.P_FRECHET_THRESHOLD], p[sk.P_POINT_SPACING] = cfg.frechet_threshold_m, cfg.frechet_point_spacing_m
+        p[sk.P_TOLERANCE_X], p[sk.P_TOLERANCE_Y] = cfg.tolerance_x_m, cfg.tolerance_y_m
+        p[sk.P_KDOT_MAX], p[sk.P_FEEDFORWARD] = cfg.max_curvature_rate_1pm2, cfg.path_feedforward
+        p[sk.P_FEEDFORWARD_WINDOW] = cfg.feedforward_window_m
+        for index, value in (
+            (sk.P_FEEDFORWARD_TIME, cfg.feedforward_time_s),
+            (sk.P_REFERENCE_LEAD, cfg.reference_lead_s),
+            (sk.P_MAX_GROWTH, cfg.max_lookahead_growth_m_per_m),
+            (sk.P_MAX_SHRINK, cfg.max_lookahead_shrink_m_per_m),
+        ):
+            p[index] = math.nan if value is None else value
+        p[sk.P_HYSTERESIS], p[sk.P_MIN_SPEED] = cfg.lookahead_hysteresis_m, MIN_SPEED_MPS
+        p[sk.P_BAND_KMH], p[sk.P_BAND_HYSTERESIS_KMH] = FLOOR_SPEED_BAND_KMH, FLOOR_BAND_HYSTERESIS_KMH
+        return p
 
     def plant_lags(self, speed_kmh: float) -> PlantLags | None:
         """The vehicle's identified lags at this speed (None without a tuning)."""
@@ -345,133 +370,32 @@ class ClothoidController(Controller):
         the measured (yaw-rate) lag's, within [0, prediction time]; K of the path lag. A known delay adds to the
         feed-forward time (the steering commanded now takes effect that much later, from a pose that much older)
         and to the prediction time."""
-        cfg, speed_kmh = self.config, speed_mps * 3.6
-        lags = self.plant_lags(speed_kmh)
-        lead = self.filter_schedule.at_speed(speed_kmh) if self.filter_schedule is not None else None
-        path_delay = 0.0 if lags is None else lags.path.group_delay_s
-        measured_delay = path_delay if lags is None or lags.measured is None else lags.measured.group_delay_s
-        lead_delay = 0.0 if lead is None else lead.group_delay_s
-        ff = cfg.feedforward_time_s if cfg.feedforward_time_s is not None else max(0.0, path_delay + lead_delay)
-        ff += cfg.known_delay_s
-        ref = cfg.reference_lead_s
-        if ref is None:
-            ref = min(max(path_delay - measured_delay, 0.0), self._prediction_horizon_s)
-        gain = 1.0 if lags is None else lags.path.steady_state_gain
-        return FeedforwardTiming(min(ff, 5.0), min(ref, 5.0), gain)
-
-    def _initial_curvature(self, m: Measurement, steering_kappa: float) -> float:
-        """kappa(0) of Eq. 3 (see ClothoidConfig.initial_curvature)."""
-        mode = self.config.initial_curvature
-        if mode == "yaw-rate" and m.speed_mps > MIN_SPEED_MPS:
-            return m.yaw_rate_rad_s / m.speed_mps
-        if mode == "steering":
-            return steering_kappa
-        return self._kappa_cmd
+        ff, ref, gain = sk.feedforward_timing(
+            speed_mps, self._params, self._lags, self._measured_lags, self._lag_speeds, self._schedule,
+            self._schedule_speeds, np.empty(4),
+        )  # fmt: skip
+        return FeedforwardTiming(ff, ref, gain)
 
     @property
     def _prediction_horizon_s(self) -> float:
         """How far ahead the pose is predicted (s): prediction_time_s plus the known delay."""
         return self.config.prediction_time_s + self.config.known_delay_s
 
-    def _start_pose(self, m: Measurement, kappa0: float) -> tuple[float, float, float]:
-        """(x, y, heading) the clothoid starts from: the rear axle, heading along its course (or body yaw), moved
-        ahead by prediction_time_s + known_delay_s on the current curvature (Figure 2, step 5)."""
-        cfg = self.config
-        heading = m.yaw_rad
-        if cfg.heading == "course" and m.vx_mps > MIN_SPEED_MPS:
-            heading += math.atan2(m.vy_mps, m.vx_mps)
-        horizon = self._prediction_horizon_s
-        if horizon > 0.0:
-            return along_arc(m.x_m, m.y_m, heading, kappa0, m.speed_mps * horizon)
-        return m.x_m, m.y_m, heading
-
-    def _floor_band(self, speed_mps: float) -> int:
-        """The speed band whose floor applies this step: the nearest, but a lower one only once the speed is
-        FLOOR_BAND_HYSTERESIS_KMH below the held band's lower edge."""
-        x = speed_mps * 3.6 / FLOOR_SPEED_BAND_KMH
-        band, held = max(1, round(x)), self._held_band
-        if held is not None and band < held and x > held - 0.5 - FLOOR_BAND_HYSTERESIS_KMH / FLOOR_SPEED_BAND_KMH:
-            band = held
-        self._held_band = band
-        return band
-
-    def _lookahead(self, path: ReferencePath, foot_index: float, cte_m: float, pose, kappa0: float, speed_mps: float):
-        """(lookahead m, the adaptive search's choice m, the floor m, the ceiling m, number of candidates
-        evaluated)."""
-        cfg = self.config
-        floor = self._band_floor_m(self._floor_band(speed_mps))
-        floor = max(floor, cfg.min_lookahead_m, cfg.min_preview_time_s * speed_mps)
-        top = max(cfg.max_lookahead_m, floor)
-        if cfg.lookahead_mode == "fixed":
-            return cfg.fixed_lookahead_m, cfg.fixed_lookahead_m, floor, top, 0
-        if cfg.max_target_turn_deg > 0.0:  # the geometric ceiling (ClothoidConfig.max_target_turn_deg)
-            ceiling = turn_limited_lookahead(
-                path.x_m, path.y_m, path.heading_rad, path.closed, foot_index, pose[0], pose[1],
-                math.radians(cfg.max_target_turn_deg), top,
-            )  # fmt: skip
-            top = max(floor, ceiling)
-        if cfg.lookahead_mode == "speed":
-            lookahead = min(max(cfg.lookahead_gain_s * speed_mps, floor), top)
-            return lookahead, lookahead, floor, top, 0
-        threshold = cfg.frechet_threshold_m + (abs(cte_m) if cfg.threshold_mode == "excess" else 0.0)
-        x, y, heading = pose
-        chosen, evaluations = adaptive_search(
-            path.x_m, path.y_m, path.closed, foot_index, x, y, heading, kappa0, floor, top,
-            cfg.lookahead_step_m, threshold, cfg.tolerance_x_m, cfg.tolerance_y_m, cfg.max_curvature_rate_1pm2,
-            cfg.frechet_point_spacing_m, self._buffers, self._scores,
-        )  # fmt: skip
-        lookahead = self._choice.step(chosen, floor, top, speed_mps * self._dt)
-        return lookahead, chosen, floor, top, evaluations
-
     def _command(self, measurement: Measurement, path: ReferencePath) -> float:
-        cfg, g, m = self.config, self.geometry, measurement
-        steering_kappa = math.tan(m.steer_wheel_rad / g.steering_ratio) / g.wheelbase_m
-        if self._kappa_cmd is None:  # first step: continue from the vehicle's current steering
-            self._kappa_cmd = steering_kappa
-            self._lead_filter(m.speed_mps).reset(m.steer_wheel_rad)
-        kappa_max, rate_max = self.limits.at_speed(m.speed_mps)
-        kappa0 = min(max(self._initial_curvature(m, steering_kappa), -kappa_max), kappa_max)
-
-        # Sections 2 and 3: the lookahead, then the hyper-clothoid to the target (Eq. 3).
-        pose = self._start_pose(m, kappa0)
-        foot = self._tracker.update(pose[0], pose[1])
-        foot_index = foot.s_m / path.spacing_m
-        lookahead, searched, floor, ceiling, evaluations = self._lookahead(
-            path, foot_index, foot.cte_m, pose, kappa0, m.speed_mps
-        )
-        frechet, kdot, length, tx, ty, ex, ey, status = evaluate_candidate(
-            path.x_m, path.y_m, path.closed, foot_index, *pose, kappa0, lookahead, cfg.max_curvature_rate_1pm2,
-            cfg.frechet_point_spacing_m, self._buffers,
-        )  # fmt: skip
-        clothoid_kdot = reference_kdot = feedforward_kdot = kdot
-        if cfg.path_feedforward:  # path_feedforward.py: feedback relative to the path's own clothoid, plus its rate
-            kdot, reference_kdot, feedforward_kdot = two_degree_of_freedom_rate(
-                kdot, path, self._here.update(m.x_m, m.y_m), (tx, ty), m.speed_mps, self._prediction_horizon_s,
-                self.feedforward_timing(m.speed_mps), cfg.feedforward_window_m,
+        m = measurement
+        while True:  # once, unless the step asks for a floor or a lead filter Python makes (step_kernel.py)
+            command, status = sk.clothoid_step(
+                m.t_s, m.x_m, m.y_m, m.vx_mps, m.vy_mps, m.yaw_rad, m.yaw_rate_rad_s, m.steer_wheel_rad, self._params,
+                self._state, path.x_m, path.y_m, path.heading_rad, path.curvature_1pm, path.closed,
+                self._tracker.state, self._here.state, self._limits, self._limit_speeds, self._lags,
+                self._measured_lags, self._lag_speeds, self._schedule, self._schedule_speeds, self._floor_table,
+                self._filter_table, self._buffers, self._scores, self._scratch, self._diag,
             )  # fmt: skip
-
-        # Figure 2: kappa' x V integrated to curvature, under the rate and curvature limits (section 4).
-        rate = min(max(kdot * m.speed_mps, -rate_max), rate_max)
-        self._kappa_cmd = min(max(self._kappa_cmd + rate * self._dt, -kappa_max), kappa_max)
-        road_wheel = math.atan(g.wheelbase_m * self._kappa_cmd)  # Ackermann: tan(phi) = L kappa
-        steer = road_wheel * g.steering_ratio
-        command = self.saturate(self._lead_filter(m.speed_mps).step(steer))  # Eq. 6
-        self._diag[:] = (  # in the order of DIAGNOSTIC_KEYS
-            lookahead,
-            searched,
-            floor,
-            ceiling,
-            frechet,
-            kdot,
-            clothoid_kdot,
-            reference_kdot,
-            feedforward_kdot,
-            length,
-            math.hypot(ex - tx, ey - ty),
-            float(status),
-            float(evaluations),
-            kappa0,
-            self._kappa_cmd,
-            steer,
-        )
-        return command
+            if status == sk.STEP_DONE:
+                return command
+            need = int(self._state[sk.S_NEED])
+            if status == sk.NEED_FLOOR:
+                self._floor_table[need] = self._band_floor_m(need)
+            else:
+                params = self.filter_schedule.at_speed(float(need))
+                self._filter_table[need] = DiscreteLeadFilter(params, self._dt).coefficients

@@ -15,7 +15,7 @@ the curvature rate the steering-wheel rate limit allows at small angles, (rate /
 
 from __future__ import annotations
 
-import bisect
+import functools
 import itertools
 import math
 from dataclasses import dataclass
@@ -23,6 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.constants import g as G_MPS2  # standard gravity, 9.80665 m/s^2
 
+from controllers.clothoid.speed_tables import table_row
 from workbench.base.errors import WorkbenchInputError, require_positive, value_text
 from workbench.vehicles.geometry import VehicleGeometry
 
@@ -64,15 +65,19 @@ class CurvatureLimits:
             raise WorkbenchInputError(f"{self.source}: speed_kmh must increase strictly; got [{speeds}]")
 
     def at_speed(self, speed_mps: float) -> tuple[float, float]:
-        """(max curvature 1/m, max curvature rate 1/(m s)) at this speed, interpolated."""
-        v, speeds = speed_mps * 3.6, self.speeds_kmh  # np.interp's clamped linear interpolation, without its
-        i = bisect.bisect_right(speeds, v)  # per-call overhead (a scalar, every controller step)
-        if i == 0 or i == len(speeds):
-            j = 0 if i == 0 else len(speeds) - 1
-            return self.max_curvature_1pm[j], self.max_curvature_rate_1pm_s[j]
-        f = (v - speeds[i - 1]) / (speeds[i] - speeds[i - 1])
-        k, r = self.max_curvature_1pm, self.max_curvature_rate_1pm_s
-        return k[i - 1] + f * (k[i] - k[i - 1]), r[i - 1] + f * (r[i] - r[i - 1])
+        """(max curvature 1/m, max curvature rate 1/(m s)) at this speed (m/s), interpolated."""
+        speeds, rows = self.table
+        out = np.empty(2)
+        table_row(speeds, rows, speed_mps * 3.6, False, out)
+        kappa, rate = out.tolist()
+        return kappa, rate
+
+    @functools.cached_property
+    def table(self) -> tuple[np.ndarray, np.ndarray]:
+        """(speeds km/h (n,), rows (n, 2): max curvature, max curvature rate): the table as
+        `speed_tables.table_row` reads it (the compiled step too)."""
+        rows = np.column_stack([self.max_curvature_1pm, self.max_curvature_rate_1pm_s]).astype(float)
+        return np.array(self.speeds_kmh, dtype=float), rows
 
     @classmethod
     def default_for(

@@ -4,6 +4,7 @@ speed, interpolated between the speeds it was designed for. Its file format is `
 from __future__ import annotations
 
 import bisect
+import functools
 import itertools
 import math
 from collections.abc import Mapping
@@ -11,7 +12,10 @@ from dataclasses import dataclass, field
 from types import MappingProxyType
 from typing import Any
 
+import numpy as np
+
 from controllers.clothoid.lead_filter import LeadFilterParams
+from controllers.clothoid.speed_tables import table_row
 from workbench.base.errors import WorkbenchInputError, require_in_range
 
 PARAM_KEYS = ("omega_z_rad_s", "psi", "omega_p_rad_s")
@@ -68,7 +72,14 @@ class FilterSchedule:
             return self.params[0]
         if i == len(speeds):
             return self.params[-1]
-        t = (speed_kmh - speeds[i - 1]) / (speeds[i] - speeds[i - 1])
-        lo, hi = self.params[i - 1], self.params[i]
-        values = ((getattr(lo, k), getattr(hi, k)) for k in PARAM_KEYS)
-        return LeadFilterParams(*(min(max(a + t * (b - a), min(a, b)), max(a, b)) for a, b in values))
+        table_speeds, rows = self.table
+        out = np.empty(len(PARAM_KEYS))
+        table_row(table_speeds, rows, float(speed_kmh), True, out)  # kept between its neighbours' values
+        return LeadFilterParams(*out.tolist())
+
+    @functools.cached_property
+    def table(self) -> tuple[np.ndarray, np.ndarray]:
+        """(speeds km/h (n,), parameters (n, 3) in PARAM_KEYS order): the schedule as `speed_tables.table_row`
+        reads it (the compiled step's feed-forward timing too)."""
+        rows = [[getattr(p, k) for k in PARAM_KEYS] for p in self.params]
+        return np.array(self.speeds_kmh, dtype=float), np.array(rows, dtype=float).reshape(-1, len(PARAM_KEYS))

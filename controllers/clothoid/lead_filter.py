@@ -24,6 +24,7 @@ from typing import Protocol
 
 import control
 import numpy as np
+from numba import njit
 from scipy import optimize, signal
 
 from workbench.base.errors import WorkbenchInputError, require_in_range, require_positive, value_text
@@ -124,6 +125,22 @@ class LeadFilterParams:
         return self.peak_gain
 
 
+@njit(cache=True)
+def lead_step(coefficients: np.ndarray, x: np.ndarray, u: float) -> float:  # pragma: no cover - compiled
+    """One sample of the discretised Eq. 6 (`DiscreteLeadFilter`): advance the state x (3) with input u in place and
+    return the output y[k] = C x[k] + D u[k]. coefficients: `DiscreteLeadFilter.coefficients`, the difference form
+    that is exact at steady state."""
+    b1, a21, b2, a31, a32, b3, c1, c2, d = (
+        coefficients[0], coefficients[1], coefficients[2], coefficients[3], coefficients[4], coefficients[5],
+        coefficients[6], coefficients[7], coefficients[8],
+    )  # fmt: skip
+    x1, x2, x3 = x[0], x[1], x[2]
+    x[0] = x1 + b1 * (u - x1)
+    x[1] = x2 + a21 * (x1 - x2) + b2 * (u - x2)
+    x[2] = x3 + a31 * (x1 - x3) + a32 * (x2 - x3) + b3 * (u - x3)
+    return x3 + c1 * (x1 - x3) + c2 * (x2 - x3) + d * (u - x3)
+
+
 class SteeringFilter(Protocol):
     """What the controller needs of a filter: reset to a steady input, advance one sample."""
 
@@ -185,11 +202,11 @@ class DiscreteLeadFilter:
                 f"the lead filter cannot be discretised accurately at dt_s = {value_text(dt_s)} s: A = {a.tolist()}, "
                 f"row sums of [A B] and [C D] {sums.tolist()} (must be 1)"
             )
-        self._coeffs = tuple(float(v) for v in (*rows[0], *rows[1], *rows[2], c[0, 0], c[0, 1], d[0, 0]))
-        self._x = (0.0, 0.0, 0.0)
+        self._coeffs = np.array([*rows[0], *rows[1], *rows[2], c[0, 0], c[0, 1], d[0, 0]], dtype=float)
+        self._x = np.zeros(3)
         # The realisation step() implements: each diagonal entry of A and the last weight of C are what makes its
         # row sum to 1, so the steady state and the DC gain of 1 are exact, not subject to cont2discrete's rounding.
-        b1, a21, b2, a31, a32, b3, c1, c2, d0 = self._coeffs
+        b1, a21, b2, a31, a32, b3, c1, c2, d0 = self._coeffs.tolist()
         self.state_space: tuple[tuple[tuple[float, ...], ...], tuple[float, ...], tuple[float, ...], float] = (
             ((1.0 - b1, 0.0, 0.0), (a21, 1.0 - a21 - b2, 0.0), (a31, a32, 1.0 - a31 - a32 - b3)),
             (b1, b2, b3),
@@ -203,37 +220,36 @@ class DiscreteLeadFilter:
 
         I - A is formed from the difference-form coefficients directly: 1 - A_ii would lose the digits of the
         poles' distance from 1 (about wp dt), which the output weights (about (wp / wz)^2) then amplify."""
-        b1, a21, b2, a31, a32, b3, c1, c2, d = self._coeffs
+        b1, a21, b2, a31, a32, b3, c1, c2, d = self._coeffs.tolist()
         i_minus_a = np.array([[b1, 0.0, 0.0], [-a21, a21 + b2, 0.0], [-a31, -a32, a31 + a32 + b3]])
         x1, x2, x3 = np.linalg.solve(i_minus_a, np.array([b1, b2, b3]))
         return float(x3 + c1 * (x1 - x3) + c2 * (x2 - x3) + d * (1.0 - x3))
 
     @property
     def state(self) -> tuple[float, float, float]:
-        return self._x
+        x1, x2, x3 = self._x.tolist()
+        return x1, x2, x3
+
+    @property
+    def coefficients(self) -> np.ndarray:
+        """The nine numbers `lead_step` runs on (b1, a21, b2, a31, a32, b3, c1, c2, d), a copy."""
+        return self._coeffs.copy()
 
     def reset(self, u0: float = 0.0) -> None:
         """Steady state for the constant input u0: the output is u0 until the input changes. (Every state of the
         lag chain settles at the input; the bilinear map keeps the state coordinates.)"""
         u0 = float(u0)
-        self._x = (u0, u0, u0)
+        self._x[:] = u0
 
     def continue_from(self, other: DiscreteLeadFilter) -> DiscreteLeadFilter:
         """Take over the state of `other` (a filter of other parameters: a speed schedule moving on). The states
         are the same physical signals (the lag chain), so the switch is bumpless at steady state."""
-        self._x = other._x
+        self._x[:] = other._x
         return self
 
     def step(self, u: float) -> float:
-        """Advance one sample with input u; return the output y[k] = C x[k] + D u[k]."""
-        b1, a21, b2, a31, a32, b3, c1, c2, d = self._coeffs
-        x1, x2, x3 = self._x
-        self._x = (
-            x1 + b1 * (u - x1),
-            x2 + a21 * (x1 - x2) + b2 * (u - x2),
-            x3 + a31 * (x1 - x3) + a32 * (x2 - x3) + b3 * (u - x3),
-        )
-        return x3 + c1 * (x1 - x3) + c2 * (x2 - x3) + d * (u - x3)
+        """Advance one sample with input u; return the output y[k] = C x[k] + D u[k] (`lead_step`)."""
+        return lead_step(self._coeffs, self._x, float(u))
 
 
 class PassThroughFilter:

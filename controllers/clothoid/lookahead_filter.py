@@ -16,7 +16,11 @@ L / V. So:
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
+
+import numpy as np
+from numba import njit
 
 from controllers.config_checks import check_number, check_optional_number
 
@@ -41,36 +45,55 @@ class LookaheadFilterSettings:
         require_rate("max_shrink_m_per_m", self.max_shrink_m_per_m)
 
 
-class LookaheadFilter:
-    """The lookahead actually used, from the search's choice step by step (module docstring)."""
+@njit(cache=True)
+def filtered_lookahead(
+    state: np.ndarray,
+    choice_m: float,
+    floor_m: float,
+    ceiling_m: float,
+    distance_m: float,
+    hysteresis_m: float,
+    max_growth_m_per_m: float,
+    max_shrink_m_per_m: float,
+) -> float:  # pragma: no cover - compiled
+    """The lookahead (m) for this step (module docstring): choice_m filtered, within [floor_m, ceiling_m];
+    distance_m: travelled since the last step (m); the rates NaN when unlimited; state: [the lookahead, the floor]
+    of the last step (NaN before the first), updated."""
+    current, last_floor = state[0], state[1]
+    if not math.isnan(current) and not math.isnan(last_floor) and floor_m < last_floor:
+        current = max(current - (last_floor - floor_m), floor_m)  # a falling floor takes the lookahead down
+    state[1] = floor_m
+    if math.isnan(current) or abs(choice_m - current) <= hysteresis_m:
+        target = choice_m if math.isnan(current) else current
+    else:
+        target = choice_m
+    if not math.isnan(current):
+        if target > current and not math.isnan(max_growth_m_per_m):
+            target = min(target, current + max_growth_m_per_m * distance_m)
+        elif target < current and not math.isnan(max_shrink_m_per_m):
+            target = max(target, current - max_shrink_m_per_m * distance_m)
+    state[0] = min(max(target, floor_m), max(ceiling_m, floor_m))
+    return state[0]
 
-    __slots__ = ("_current", "_floor", "settings")
+
+class LookaheadFilter:
+    """The lookahead actually used, from the search's choice step by step (module docstring; `filtered_lookahead`
+    with its state here)."""
+
+    __slots__ = ("_rates", "_state", "settings")
 
     def __init__(self, settings: LookaheadFilterSettings) -> None:
         self.settings = settings
-        self._current: float | None = None
-        self._floor: float | None = None
+        growth, shrink = settings.max_growth_m_per_m, settings.max_shrink_m_per_m
+        self._rates = (math.nan if growth is None else growth, math.nan if shrink is None else shrink)
+        self._state = np.full(2, np.nan)
 
     def reset(self) -> None:
-        self._current = None
-        self._floor = None
+        self._state[:] = np.nan
 
     def step(self, choice_m: float, floor_m: float, ceiling_m: float, distance_m: float) -> float:
         """The lookahead (m) for this step: choice_m filtered, within [floor_m, ceiling_m]; distance_m: travelled
         since the last step (m)."""
-        s = self.settings
-        current = self._current
-        if current is not None and self._floor is not None and floor_m < self._floor:
-            current = max(current - (self._floor - floor_m), floor_m)  # a falling floor takes the lookahead down
-        self._floor = floor_m
-        if current is None or abs(choice_m - current) <= s.hysteresis_m:
-            target = choice_m if current is None else current
-        else:
-            target = choice_m
-        if current is not None:
-            if target > current and s.max_growth_m_per_m is not None:
-                target = min(target, current + s.max_growth_m_per_m * distance_m)
-            elif target < current and s.max_shrink_m_per_m is not None:
-                target = max(target, current - s.max_shrink_m_per_m * distance_m)
-        self._current = min(max(target, floor_m), max(ceiling_m, floor_m))
-        return self._current
+        return filtered_lookahead(
+            self._state, choice_m, floor_m, ceiling_m, distance_m, self.settings.hysteresis_m, *self._rates
+        )

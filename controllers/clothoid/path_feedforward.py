@@ -28,13 +28,16 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import numpy as np
+from numba import njit
+
 from controllers.clothoid.clothoid_fit import fit_kernel
 from controllers.clothoid.pose_prediction import along_arc
 from workbench.base.errors import require_in_range
-from workbench.base.path import Projection, ReferencePath
+from workbench.base.path_search import value_at
 
 #: Saturation of the reference fit's kappa' (1/m^2): far above any path's, so the fit is never clipped.
-_REFERENCE_KDOT_MAX = 1e6
+REFERENCE_KDOT_MAX = 1e6
 
 
 @dataclass(frozen=True)
@@ -53,41 +56,49 @@ class FeedforwardTiming:
         require_in_range("steady_state_gain", self.steady_state_gain, 0.05, 20.0)
 
 
-def path_curvature_rate(path: ReferencePath, s_m: float, window_m: float) -> float:
-    """dkappa/ds (1/m^2) of the path at s, averaged over [s - window / 2, s + window / 2]."""
-    half = 0.5 * window_m
-    return (path.curvature(s_m + half) - path.curvature(s_m - half)) / window_m
-
-
-def reference_pose(
-    path: ReferencePath, here: Projection, speed_mps: float, prediction_time_s: float, reference_lead_s: float
-) -> tuple[float, float, float, float]:
-    """(x, y, heading, curvature) of the reference: the path's pose reference_lead_s ahead of the foot point, moved
-    over the rest of the prediction time on the path's curvature there, by the chord of that arc (as the vehicle's
-    own prediction)."""
-    lead = min(reference_lead_s, prediction_time_s)
-    s_ref = here.s_m + speed_mps * lead
-    if lead > 0.0:
-        x, y = path.position(s_ref)
-        heading, kappa = path.heading(s_ref), path.curvature(s_ref)
-    else:
-        x, y, heading, kappa = here.x_m, here.y_m, here.heading_rad, here.curvature_1pm
-    return (*along_arc(float(x), float(y), heading, kappa, speed_mps * (prediction_time_s - lead)), kappa)
-
-
+@njit(cache=True)
 def two_degree_of_freedom_rate(
     vehicle_kdot: float,
-    path: ReferencePath,
-    here: Projection,
-    target_xy: tuple[float, float],
+    path_x: np.ndarray,
+    path_y: np.ndarray,
+    path_heading: np.ndarray,
+    path_curvature: np.ndarray,
+    spacing: float,
+    length: float,
+    closed: bool,
+    here: np.ndarray,
+    target_x: float,
+    target_y: float,
     speed_mps: float,
     prediction_time_s: float,
-    timing: FeedforwardTiming,
+    feedforward_time_s: float,
+    reference_lead_s: float,
+    steady_state_gain: float,
     window_m: float,
-) -> tuple[float, float, float]:
-    """(kappa' to integrate, the reference's kappa', the feed-forward kappa') (1/m^2), module docstring."""
-    rx, ry, rh, rk = reference_pose(path, here, speed_mps, prediction_time_s, timing.reference_lead_s)
-    reference_kdot, *_ = fit_kernel(rx, ry, rh, rk, target_xy[0], target_xy[1], _REFERENCE_KDOT_MAX)
-    feedforward = path_curvature_rate(path, here.s_m + speed_mps * timing.feedforward_time_s, window_m)
-    feedforward /= timing.steady_state_gain
+) -> tuple[float, float, float]:  # pragma: no cover - compiled
+    """(kappa' to integrate, the reference's kappa', the feed-forward kappa') (1/m^2), module docstring. here: the
+    foot point of the vehicle's measured position (`path_search.track`'s output: s, progress, x, y, heading,
+    curvature, ...); the timings of `FeedforwardTiming`.
+
+    The reference pose: the path's pose reference_lead_s ahead of the foot point, moved over the rest of the
+    prediction time on the path's curvature there, by the chord of that arc (as the vehicle's own prediction).
+    The feed-forward: dkappa/ds of the path speed x feedforward_time_s ahead of the foot point, averaged over
+    window_m, over K."""
+    lead = min(reference_lead_s, prediction_time_s)
+    if lead > 0.0:
+        s_ref = here[0] + speed_mps * lead
+        rx = value_at(path_x, s_ref, spacing, length, closed)
+        ry = value_at(path_y, s_ref, spacing, length, closed)
+        rh = value_at(path_heading, s_ref, spacing, length, closed)
+        rk = value_at(path_curvature, s_ref, spacing, length, closed)
+    else:
+        rx, ry, rh, rk = here[2], here[3], here[4], here[5]
+    rx, ry, rh = along_arc(rx, ry, rh, rk, speed_mps * (prediction_time_s - lead))
+    reference_kdot = fit_kernel(rx, ry, rh, rk, target_x, target_y, REFERENCE_KDOT_MAX)[0]
+    s_ff, half = here[0] + speed_mps * feedforward_time_s, 0.5 * window_m
+    feedforward = (
+        value_at(path_curvature, s_ff + half, spacing, length, closed)
+        - value_at(path_curvature, s_ff - half, spacing, length, closed)
+    ) / window_m
+    feedforward /= steady_state_gain
     return vehicle_kdot - reference_kdot + feedforward, reference_kdot, feedforward

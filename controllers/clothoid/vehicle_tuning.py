@@ -6,15 +6,22 @@ vehicle); a controller config holds it (`ClothoidConfig.tuning`), so the control
 from __future__ import annotations
 
 import bisect
+import functools
 import itertools
 import math
 from dataclasses import dataclass
 
+import numpy as np
+
 from controllers.clothoid.curvature_limits import CurvatureLimits
 from controllers.clothoid.filter_schedule import FilterSchedule
+from controllers.clothoid.speed_tables import table_row
 from controllers.config_checks import shown_all
 from workbench.base.errors import WorkbenchInputError, value_text
 from workbench.vehicles.steering_lag import SteeringLag
+
+#: The parameters of a lag the tables hold, in their order (`VehicleTuning.lag_tables`).
+LAG_COLUMNS = ("omega_n_rad_s", "zeta", "delay_s", "steady_state_gain")
 
 
 @dataclass(frozen=True)
@@ -48,6 +55,16 @@ class VehicleTuning:
             )
         object.__setattr__(self, "measured_lags", measured)
 
+    @functools.cached_property
+    def lag_tables(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(speeds km/h (n,), lags (n, 4), measured lags (n, 4) or (0, 4) without): each lag's LAG_COLUMNS, as
+        `speed_tables.table_row` reads them (the compiled step's feed-forward timing too)."""
+
+        def rows(lags: tuple[tuple[float, SteeringLag], ...]) -> np.ndarray:
+            return np.array([[getattr(lag, k) for k in LAG_COLUMNS] for _, lag in lags], dtype=float).reshape(-1, 4)
+
+        return np.array(self.lag_speeds_kmh, dtype=float), rows(self.lags), rows(self.measured_lags)
+
     @property
     def lag_speeds_kmh(self) -> tuple[float, ...]:
         return tuple(speed for speed, _ in self.lags)
@@ -56,7 +73,8 @@ class VehicleTuning:
         """The lag (to the path curvature) at speed_kmh (km/h): omega_n, zeta, delay and K interpolated linearly in
         speed between the identified speeds, clamped beyond the ends (the identified lag itself at an identified
         speed)."""
-        return _interpolated(self.lags, speed_kmh, "lags", self.source)
+        speeds, lags, _ = self.lag_tables
+        return _interpolated(self.lags, speed_kmh, "lags", self.source, speeds, lags)
 
     def measured_lag_at(self, speed_kmh: float) -> SteeringLag | None:
         """The lag to the measured curvature (yaw rate / speed) at speed_kmh, interpolated as `lag_at`; None when the
@@ -64,7 +82,8 @@ class VehicleTuning:
         if not self.measured_lags:
             _check_speed(speed_kmh)
             return None
-        return _interpolated(self.measured_lags, speed_kmh, "measured lags", self.source)
+        speeds, _, measured = self.lag_tables
+        return _interpolated(self.measured_lags, speed_kmh, "measured lags", self.source, speeds, measured)
 
 
 def _check_speed(speed_kmh: float) -> None:
@@ -86,8 +105,16 @@ def _checked_lags(name: str, value: object) -> tuple[tuple[float, SteeringLag], 
     return lags
 
 
-def _interpolated(lags: tuple[tuple[float, SteeringLag], ...], speed_kmh: float, what: str, source: str) -> SteeringLag:
-    """The lag of `lags` at speed_kmh, each parameter interpolated linearly in speed, clamped beyond the ends."""
+def _interpolated(
+    lags: tuple[tuple[float, SteeringLag], ...],
+    speed_kmh: float,
+    what: str,
+    source: str,
+    table_speeds: np.ndarray,
+    rows: np.ndarray,
+) -> SteeringLag:
+    """The lag of `lags` at speed_kmh, each parameter interpolated linearly in speed (`speed_tables.table_row` on
+    the table (table_speeds, rows) of `lags`), clamped beyond the ends: an identified lag itself at its speed."""
     _check_speed(speed_kmh)
     speeds = tuple(speed for speed, _ in lags)
     i = bisect.bisect_left(speeds, speed_kmh)
@@ -95,17 +122,14 @@ def _interpolated(lags: tuple[tuple[float, SteeringLag], ...], speed_kmh: float,
         return lags[i][1]
     if i == 0 or i == len(speeds):
         return lags[0 if i == 0 else -1][1]
-    (s0, lo), (s1, hi) = lags[i - 1], lags[i]
-    t = (speed_kmh - s0) / (s1 - s0)
-
-    def mix(name: str) -> float:
-        a, b = getattr(lo, name), getattr(hi, name)
-        return a + t * (b - a)
-
+    out = np.empty(len(LAG_COLUMNS))
+    table_row(table_speeds, rows, float(speed_kmh), False, out)
+    omega_n, zeta, delay, gain = out.tolist()
     return SteeringLag(
-        mix("omega_n_rad_s"),
-        mix("zeta"),
-        mix("delay_s"),
-        steady_state_gain=mix("steady_state_gain"),
-        source=f"interpolated at {speed_kmh:g} km/h between the {what} at {s0:g} and {s1:g} km/h ({source})",
+        omega_n,
+        zeta,
+        delay,
+        steady_state_gain=gain,
+        source=f"interpolated at {speed_kmh:g} km/h between the {what} at {speeds[i - 1]:g} and {speeds[i]:g} km/h "
+        f"({source})",
     )

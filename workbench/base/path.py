@@ -29,6 +29,7 @@ from workbench.base.path_search import (
     closest_in_window,
     first_beyond,
     track,
+    value_at,
 )
 from workbench.base.waypoints import Waypoints
 
@@ -247,10 +248,8 @@ class ReferencePath:
         return np.clip(s_m, 0.0, self.length_m)
 
     def _interp(self, values: np.ndarray, s_m: float | np.ndarray) -> float | np.ndarray:
-        if isinstance(s_m, float | int):
-            position = self.wrap_s(s_m) / self.spacing_m
-            i = min(int(position), values.size - 2)
-            return float(values[i] + (position - i) * (values[i + 1] - values[i]))
+        if isinstance(s_m, float | int):  # the per-step case, compiled (`path_search.value_at`)
+            return value_at(values, float(s_m), self.spacing_m, self.length_m, self.closed)
         return np.interp(self.wrap_s(s_m), self.s_m, values)
 
     def position(self, s_m: float | np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -350,6 +349,11 @@ class PathTracker:
         if initial_s_m is not None:
             self.state[TRACK_S] = float(self.path.wrap_s(initial_s_m))
         self.state[TRACK_PROGRESS] = 0.0 if initial_s_m is None else float(initial_s_m)
+
+    @property
+    def extent_m(self) -> float:
+        """The diagonal of the path's bounding box (m): a move longer than this searches the whole path."""
+        return self._extent_m
 
     @property
     def progress_m(self) -> float:

@@ -161,3 +161,13 @@ def track(
             past_end = max(along if at_end else -along, 0.0)
     out[0], out[1], out[2], out[3], out[4] = s_new, state[TRACK_PROGRESS], fx, fy, h
     out[5], out[6], out[7], out[8], out[9] = k, cte, 1.0 if at_end else 0.0, past_end, math.hypot(cte, along)
+
+
+@njit(cache=True)
+def value_at(values: np.ndarray, s: float, spacing: float, length: float, closed: bool) -> float:
+    """A per-sample quantity of the path (x, y, heading, curvature, ...) at arc length s (m), interpolated linearly
+    between samples: s taken modulo the length on a loop, clipped to [0, length] on an open path."""
+    s = s % length if closed else min(max(s, 0.0), length)
+    position = s / spacing
+    i = min(int(position), values.size - 2)
+    return values[i] + (position - i) * (values[i + 1] - values[i])

@@ -13,7 +13,6 @@ import pytest
 from controllers.base import Measurement
 from controllers.clothoid import ClothoidConfig, ClothoidController, LeadFilterParams
 from controllers.clothoid.loop_analysis import LoopSettings, PlantLags, lookahead_floor, loop_margins
-from controllers.clothoid.pose_prediction import along_arc
 from tuning.own_tuning import tuned_controller, tuning_for
 from workbench.base.clothoid_chain import ClothoidChain
 from workbench.base.errors import WorkbenchInputError
@@ -73,8 +72,19 @@ def test_the_pose_is_predicted_over_the_known_delay_too() -> None:
     plain = ClothoidController(CAR.geometry, ClothoidConfig(tuning=CAR_TUNING))
     controller.reset(BEND_PATH, PERIOD)
     plain.reset(BEND_PATH, PERIOD)
+    # the clothoid starts where a controller predicting over prediction_time_s + known_delay_s puts it
+    fixed = {"tuning": CAR_TUNING, "lookahead_mode": "fixed", "path_feedforward": False}
+    delayed = ClothoidController(CAR.geometry, ClothoidConfig(known_delay_s=0.15, **fixed))
+    longer = ClothoidController(CAR.geometry, ClothoidConfig(prediction_time_s=0.35, **fixed))
     m = Measurement(0.0, 3.0, 0.4, 8.0, 0.0, 0.1, 0.2, 0.0)
-    assert controller._start_pose(m, 0.025) == pytest.approx(along_arc(3.0, 0.4, 0.1, 0.025, 8.0 * 0.35), abs=1e-12)
+    for c in (delayed, longer):
+        c.reset(BEND_PATH, PERIOD)
+        c.step(m, BEND_PATH)
+    assert delayed.diagnostics["clothoid_curvature_rate_1pm2"] != 0.0
+    floors = ("lookahead_floor_m", "lookahead_ceiling_m")  # the delayed loop's floor is longer
+    assert {k: v for k, v in delayed.diagnostics.items() if k not in floors} == {
+        k: v for k, v in longer.diagnostics.items() if k not in floors
+    }
     timing, plain_timing = controller.feedforward_timing(8.0), plain.feedforward_timing(8.0)
     assert timing.feedforward_time_s == pytest.approx(plain_timing.feedforward_time_s + 0.15, abs=1e-12)
     assert controller.loop_settings(30.0).known_delay_s == 0.15

@@ -14,6 +14,7 @@ from controllers.clothoid import (
     ClothoidConfig,
     ClothoidController,
     CurvatureLimits,
+    DiscreteLeadFilter,
     FilterSchedule,
     LeadFilterParams,
 )
@@ -152,7 +153,9 @@ def test_filter_file_is_read_and_a_schedule_follows_speed(tmp_path: Path) -> Non
     assert controller.filter_schedule.params == (slow, fast)
     controller.reset(STRAIGHT, 0.02)
     controller.step(_m(10.0, 0.0, 0.0, 50.0 / 3.6), STRAIGHT)
-    assert controller._filter.params == schedule.at_speed(50.0)
+    # the step runs the schedule's filter of its whole km/h, discretised at the period
+    made = DiscreteLeadFilter(schedule.at_speed(50.0), 0.02).coefficients
+    assert np.array_equal(controller._filter_table[50], made) and np.isnan(controller._filter_table[49, 0])
     # Without a file: the tuning's (the truck's shipped schedule), none without a tuning, and never DEFAULT_FILTER,
     # the truck's old filter, for another vehicle.
     own = tuned_controller("clothoid", TRUCK).filter_schedule

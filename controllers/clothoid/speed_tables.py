@@ -1,0 +1,34 @@
+"""Tables against speed, each column interpolated linearly and clamped beyond the ends: the curvature limits
+(`curvature_limits.py`), the lead filter's schedule (`filter_schedule.py`) and the identified lags
+(`vehicle_tuning.py`). One compiled lookup serves them all, from Python and from the compiled step
+(`step_kernel.py`) alike, so that both read the same numbers.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+
+@njit(cache=True)
+def table_row(speeds: np.ndarray, rows: np.ndarray, speed: float, clip: bool, out: np.ndarray) -> None:
+    """Row `speed` of the table (rows[i] at speeds[i], speeds increasing strictly) into out: a listed speed's row
+    as it stands, the first or last row beyond the ends, else each column a + t (b - a) between its neighbours;
+    with clip, kept within [min(a, b), max(a, b)] against rounding (a schedule's ranges are then kept exactly)."""
+    n = speeds.size
+    i = 0  # bisect_left: the first speed >= speed
+    while i < n and speeds[i] < speed:
+        i += 1
+    if i < n and speeds[i] == speed:
+        out[:] = rows[i]
+        return
+    if i == 0 or i == n:
+        out[:] = rows[0 if i == 0 else n - 1]
+        return
+    t = (speed - speeds[i - 1]) / (speeds[i] - speeds[i - 1])
+    for k in range(out.size):
+        a, b = rows[i - 1, k], rows[i, k]
+        value = a + t * (b - a)
+        if clip:
+            value = min(max(value, min(a, b)), max(a, b))
+        out[k] = value
