@@ -253,6 +253,7 @@ class ClothoidController(Controller):
         self._buffers = np.empty((4, MAX_CURVE_POINTS))
         top = max(cfg.max_lookahead_m, MAX_FLOOR_LOOKAHEAD_M)
         self._scores = np.empty(candidate_count(cfg.min_lookahead_m, top, cfg.lookahead_step_m))
+        self._results = np.empty((self._scores.size, 8))  # each candidate's evaluation (lookahead.adaptive_search)
         self._floors: dict[int, float] = {}  # per speed band, for the sample time _floors_dt
         self._floors_dt: float | None = None
         self._state = np.empty(sk.STATE_SIZE)
@@ -268,6 +269,7 @@ class ClothoidController(Controller):
         self._dt = float(sample_time_s)
         self._tracker: PathTracker = path.tracker(0.0)
         self._here: PathTracker = path.tracker(0.0)
+        self._kept = np.empty(path.x_m.size + 1)  # the path's distances from the start pose, one step's search
         self._state[:] = np.nan
         self._state[sk.S_HELD_BAND] = self._state[sk.S_FILTER_KMH] = -1.0
         self._floor_table[:] = np.nan
@@ -389,7 +391,8 @@ class ClothoidController(Controller):
                 self._state, path.x_m, path.y_m, path.heading_rad, path.curvature_1pm, path.closed,
                 self._tracker.state, self._here.state, self._limits, self._limit_speeds, self._lags,
                 self._measured_lags, self._lag_speeds, self._schedule, self._schedule_speeds, self._floor_table,
-                self._filter_table, self._buffers, self._scores, self._scratch, self._diag,
+                self._filter_table, self._buffers, self._scores, self._results, self._kept, self._scratch,
+                self._diag,
             )  # fmt: skip
             if status == sk.STEP_DONE:
                 return command

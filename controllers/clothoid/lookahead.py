@@ -20,6 +20,7 @@ best point. Everything here is compiled with numba: a step's whole search costs 
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -28,10 +29,12 @@ from numba import njit
 from controllers.clothoid.clothoid_fit import FIT_UNREACHABLE, fit_kernel, sample_kernel
 from controllers.clothoid.frechet import frechet_kernel
 from workbench.base.path import ReferencePath
-from workbench.base.path_search import first_beyond
+from workbench.base.path_search import first_beyond_kept
 
 #: Most points per sampled curve (the Fréchet cost grows with its square).
 MAX_CURVE_POINTS = 64
+#: `kept` for a single evaluation: no distances kept (`path_search.first_beyond_kept`).
+_NOTHING_KEPT = np.empty(0)
 
 
 @njit(cache=True)
@@ -80,14 +83,16 @@ def evaluate_candidate(
     kdot_max: float,
     point_spacing_m: float,
     buffers: np.ndarray,
+    kept: np.ndarray,
 ) -> tuple[float, float, float, float, float, float, float, int]:  # pragma: no cover - compiled
     """Fit and score one lookahead distance.
 
     Returns (frechet_m, kdot, length_m, target_x, target_y, end_x, end_y, status); buffers is a (4, MAX) work
-    array for the sampled clothoid (rows 0, 1) and reference (rows 2, 3).
+    array for the sampled clothoid (rows 0, 1) and reference (rows 2, 3); kept: the path's distances from
+    (px, py) kept between the candidates of one search (`path_search.first_beyond_kept`; empty: none).
     """
     n_seg = path_x.size - 1
-    target_index = first_beyond(path_x, path_y, px, py, foot_index, lookahead_m, closed)
+    target_index = first_beyond_kept(path_x, path_y, px, py, foot_index, lookahead_m, closed, kept)
     if target_index < 0.0:  # the open path ends nearer than the lookahead: aim beyond it, on its last tangent
         target_index = float(n_seg) + _beyond_end(path_x, path_y, px, py, lookahead_m)
     tx, ty = _point_at_index(path_x, path_y, target_index, closed)
@@ -104,6 +109,18 @@ def evaluate_candidate(
         buffers[3, k] = ry
     frechet = frechet_kernel(buffers[0, :n], buffers[1, :n], buffers[2, :n], buffers[3, :n])
     return frechet, kdot, length, tx, ty, ex, ey, status
+
+
+@njit(cache=True)
+def evaluated(
+    scores: np.ndarray, results: np.ndarray, min_lookahead_m: float, step_m: float, lookahead_m: float
+) -> int:  # pragma: no cover - compiled
+    """The candidate of the last `adaptive_search` (from min_lookahead_m by step_m) that was evaluated at exactly
+    lookahead_m, whose results[k] `evaluate_candidate` would return again for it; -1 if none."""
+    k = round((lookahead_m - min_lookahead_m) / step_m)
+    if 0 <= k < scores.size and not math.isnan(scores[k]) and min_lookahead_m + k * step_m == lookahead_m:
+        return k
+    return -1
 
 
 @njit(cache=True)
@@ -126,19 +143,24 @@ def adaptive_search(
     point_spacing_m: float,
     buffers: np.ndarray,
     scores: np.ndarray,
+    results: np.ndarray,
+    kept: np.ndarray,
 ) -> tuple[float, int]:  # pragma: no cover - compiled
     """The chosen lookahead (m) and the number of candidates evaluated; scores[k] holds candidate k's Fréchet
-    distance (NaN where not evaluated), with candidate k at min + k step."""
+    distance (NaN where not evaluated), with candidate k at min + k step, and results[k] (scores.size, 8) all that
+    `evaluate_candidate` returned for it (`evaluated`)."""
     count = max(1, min(candidate_count(min_lookahead_m, max_lookahead_m, step_m), scores.size))
     scores[:] = np.nan
     evaluations = 0
 
     def admissible(k: int) -> bool:
-        fd, _, _, tx, ty, ex, ey, status = evaluate_candidate(
+        fd, kdot, length, tx, ty, ex, ey, status = evaluate_candidate(
             path_x, path_y, closed, foot_index, px, py, theta, kappa0, min_lookahead_m + k * step_m,
-            kdot_max, point_spacing_m, buffers,
+            kdot_max, point_spacing_m, buffers, kept,
         )  # fmt: skip
         scores[k] = fd
+        row = results[k]
+        row[0], row[1], row[2], row[3], row[4], row[5], row[6], row[7] = fd, kdot, length, tx, ty, ex, ey, status
         return (
             fd <= threshold_m
             and status != FIT_UNREACHABLE
@@ -245,7 +267,7 @@ class LookaheadEvaluator:
         fd, kdot, length, tx, ty, ex, ey, status = evaluate_candidate(
             path.x_m, path.y_m, path.closed, s_foot_m / path.spacing_m, float(x_m), float(y_m),
             float(heading_rad), float(curvature_1pm), float(lookahead_m), float(max_curvature_rate_1pm2),
-            self.point_spacing_m, self._buffers,
+            self.point_spacing_m, self._buffers, _NOTHING_KEPT,
         )  # fmt: skip
         return Candidate(lookahead_m, fd, kdot, length, (tx, ty), (ex, ey), status)
 

@@ -19,7 +19,7 @@ import numpy as np
 from numba import njit
 
 from controllers.clothoid.lead_filter import lead_step
-from controllers.clothoid.lookahead import adaptive_search, evaluate_candidate, turn_limited_lookahead
+from controllers.clothoid.lookahead import adaptive_search, evaluate_candidate, evaluated, turn_limited_lookahead
 from controllers.clothoid.lookahead_filter import filtered_lookahead
 from controllers.clothoid.path_feedforward import two_degree_of_freedom_rate
 from controllers.clothoid.pose_prediction import along_arc
@@ -129,13 +129,16 @@ def clothoid_step(
     filters: np.ndarray,
     buffers: np.ndarray,
     scores: np.ndarray,
+    results: np.ndarray,
+    kept: np.ndarray,
     scratch: np.ndarray,
     diagnostics: np.ndarray,
 ) -> tuple[float, int]:  # pragma: no cover - compiled
     """(steering-wheel command rad, status) of one step (`controller.py` documents what it does); diagnostics (16)
     in the order of controller.DIAGNOSTIC_KEYS. tracker, here: the states of the start pose's and the measured
     position's path trackers; floors (FLOOR_ROWS) and filters (FILTER_ROWS, 9: `DiscreteLeadFilter.coefficients`)
-    NaN where not made yet; scratch: SCRATCH_SIZE floats."""
+    NaN where not made yet; buffers, scores, results, kept: the search's work arrays (`lookahead.py`; kept: at least
+    the path's sample count + 1); scratch: SCRATCH_SIZE floats."""
     p = params
     speed = math.hypot(vx_mps, vy_mps)  # Measurement.speed_mps
     spacing, length = p[P_PATH_SPACING], p[P_PATH_LENGTH]
@@ -188,12 +191,13 @@ def clothoid_step(
         p[P_TRACKER_WINDOW], tracker, px, py, foot,
     )  # fmt: skip
     foot_index, cte = foot[0] / spacing, foot[6]
+    kept[0] = 0.0  # a new start pose: no distances of the path from it kept yet
 
     state[S_HELD_BAND] = band
     floor = max(floors[band], p[P_MIN_LOOKAHEAD], p[P_MIN_PREVIEW] * speed)
     top = max(p[P_MAX_LOOKAHEAD], floor)
     mode = int(p[P_LOOKAHEAD_MODE])
-    evaluations = 0
+    evaluations, reused = 0, -1
     if mode == MODE_FIXED:
         lookahead = searched = p[P_FIXED_LOOKAHEAD]
     else:
@@ -208,16 +212,23 @@ def clothoid_step(
             threshold = p[P_FRECHET_THRESHOLD] + (abs(cte) if p[P_EXCESS] != 0.0 else 0.0)
             searched, evaluations = adaptive_search(
                 path_x, path_y, closed, foot_index, px, py, ph, kappa0, floor, top, p[P_LOOKAHEAD_STEP], threshold,
-                p[P_TOLERANCE_X], p[P_TOLERANCE_Y], p[P_KDOT_MAX], p[P_POINT_SPACING], buffers, scores,
+                p[P_TOLERANCE_X], p[P_TOLERANCE_Y], p[P_KDOT_MAX], p[P_POINT_SPACING], buffers, scores, results,
+                kept,
             )  # fmt: skip
             lookahead = filtered_lookahead(
                 state[S_LOOKAHEAD : S_LOOKAHEAD + 2], searched, floor, top, speed * p[P_DT], p[P_HYSTERESIS],
                 p[P_MAX_GROWTH], p[P_MAX_SHRINK],
             )  # fmt: skip
-    frechet, kdot, clothoid_length, tx, ty, ex, ey, status = evaluate_candidate(
-        path_x, path_y, closed, foot_index, px, py, ph, kappa0, lookahead, p[P_KDOT_MAX], p[P_POINT_SPACING],
-        buffers,
-    )  # fmt: skip
+            reused = evaluated(scores, results, floor, p[P_LOOKAHEAD_STEP], lookahead)
+    if reused >= 0:  # the search evaluated this very lookahead: the same fit again
+        row = results[reused]
+        frechet, kdot, clothoid_length, tx, ty, ex, ey = row[0], row[1], row[2], row[3], row[4], row[5], row[6]
+        status = int(row[7])
+    else:
+        frechet, kdot, clothoid_length, tx, ty, ex, ey, status = evaluate_candidate(
+            path_x, path_y, closed, foot_index, px, py, ph, kappa0, lookahead, p[P_KDOT_MAX], p[P_POINT_SPACING],
+            buffers, kept,
+        )  # fmt: skip
     clothoid_kdot = reference_kdot = feedforward_kdot = kdot
     if p[P_FEEDFORWARD] != 0.0:  # path_feedforward.py: feedback relative to the path's own clothoid, plus its rate
         track(

@@ -63,7 +63,18 @@ def first_beyond(
     """Fractional sample index of the first point at or after index `start` at least `distance` from (px, py).
 
     Walks forward at most one lap; returns -1.0 when no such point exists (the end of an open path is nearer)."""
+    return first_beyond_kept(x, y, px, py, start, distance, closed, np.empty(0))
+
+
+@njit(cache=True)
+def first_beyond_kept(
+    x: np.ndarray, y: np.ndarray, px: float, py: float, start: float, distance: float, closed: bool, kept: np.ndarray
+) -> float:  # pragma: no cover - compiled
+    """`first_beyond`, keeping the distances it computes for the next call from the same (px, py) and `start`
+    (the lookahead search's candidates): kept[0] is how many are kept, kept[1 + k] the distance of sample
+    int(start) + 1 + k. Set kept[0] = 0 for a new point; an empty `kept` keeps nothing."""
     n_seg = x.size - 1
+    known = int(kept[0]) if kept.size > 0 else 0
     i0 = int(start)
     frac0 = start - i0
     # The starting point itself (interpolated).
@@ -77,7 +88,16 @@ def first_beyond(
     for j in range(i0 + 1, last + 1):
         i = j % n_seg if closed else j
         bx, by = x[i], y[i]
-        if math.hypot(bx - px, by - py) >= distance:
+        k = j - i0 - 1
+        if k < known:
+            d = kept[1 + k]
+        else:
+            d = math.hypot(bx - px, by - py)
+            if 1 + k < kept.size:
+                kept[1 + k] = d
+                known = k + 1
+                kept[0] = known
+        if d >= distance:
             # The circle of radius `distance` crosses segment A-B: solve |A + u (B - A) - P| = distance for u.
             dx, dy = bx - ax, by - ay
             ex, ey = ax - px, ay - py
