@@ -19,8 +19,9 @@ O(n m) time, O(min(n, m)) memory (one rolling row, no recursion). The hot loop c
 monotone, so the same cells win) and takes one sqrt at the end, recomputing with hypot where squares would
 underflow or overflow (distances below 1e-140 or above 1e140 m).
 
-`discrete_frechet` is the checked public entry point; `frechet_kernel` and `frechet_with_early_exit` are the
-compiled kernels for callers inside numba code (the lookahead search), which must pass finite float64 arrays.
+`discrete_frechet` is the checked public entry point; `frechet_kernel`, `frechet_below` (cut short above a limit)
+and `frechet_with_early_exit` are the compiled kernels for callers inside numba code (the lookahead search), which
+must pass finite float64 arrays.
 """
 
 from __future__ import annotations
@@ -119,18 +120,25 @@ def frechet_kernel(px: np.ndarray, py: np.ndarray, qx: np.ndarray, qy: np.ndarra
 
 
 @njit(cache=True)
+def frechet_below(
+    px: np.ndarray, py: np.ndarray, qx: np.ndarray, qy: np.ndarray, limit: float
+) -> float:  # pragma: no cover - compiled
+    """frechet_kernel(px, py, qx, qy) exactly, or inf as soon as it is known to exceed `limit` (inf: never): the
+    search of a least distance or of a threshold skips the rest of a curve that cannot win. The early exit is
+    taken only for limits in [1e-140, 1e140] m, where it runs the full computation's very arithmetic."""
+    if not _SQ_LOW <= limit * limit <= _SQ_HIGH:
+        limit = np.inf
+    d = _frechet_limited(px, py, qx, qy, limit)
+    return np.inf if d < 0.0 else d
+
+
+@njit(cache=True)
 def frechet_with_early_exit(
     px: np.ndarray, py: np.ndarray, qx: np.ndarray, qy: np.ndarray, threshold: float
 ) -> bool:  # pragma: no cover - compiled
-    """Whether frechet_kernel(px, py, qx, qy) <= threshold, stopping at the first DP row whose every cell
-    exceeds the threshold. For thresholds in [1e-140, 1e140] m it runs the very arithmetic of the full computation,
-    so the answer is exactly `frechet_kernel(...) <= threshold`; False for a NaN or negative threshold or an
-    empty curve.
-    """
-    if not threshold >= 0.0:
-        return False
-    d = _frechet_limited(px, py, qx, qy, threshold)
-    return d >= 0.0 and d <= threshold
+    """Whether frechet_kernel(px, py, qx, qy) <= threshold, exactly, stopping at the first DP row whose every
+    cell exceeds the threshold (`frechet_below`); False for a NaN or negative threshold or an empty curve."""
+    return threshold >= 0.0 and frechet_below(px, py, qx, qy, threshold) <= threshold
 
 
 def _as_curve(name: str, curve: object) -> np.ndarray:

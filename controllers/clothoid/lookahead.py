@@ -27,7 +27,7 @@ import numpy as np
 from numba import njit
 
 from controllers.clothoid.clothoid_fit import FIT_UNREACHABLE, fit_kernel, sample_kernel
-from controllers.clothoid.frechet import frechet_kernel
+from controllers.clothoid.frechet import frechet_below
 from workbench.base.path import ReferencePath
 from workbench.base.path_search import first_beyond_kept
 
@@ -84,12 +84,14 @@ def evaluate_candidate(
     point_spacing_m: float,
     buffers: np.ndarray,
     kept: np.ndarray,
+    limit_m: float,
 ) -> tuple[float, float, float, float, float, float, float, int]:  # pragma: no cover - compiled
     """Fit and score one lookahead distance.
 
     Returns (frechet_m, kdot, length_m, target_x, target_y, end_x, end_y, status); buffers is a (4, MAX) work
     array for the sampled clothoid (rows 0, 1) and reference (rows 2, 3); kept: the path's distances from
-    (px, py) kept between the candidates of one search (`path_search.first_beyond_kept`; empty: none).
+    (px, py) kept between the candidates of one search (`path_search.first_beyond_kept`; empty: none); frechet_m
+    is inf once it is known to exceed limit_m (`frechet.frechet_below`; inf: always the distance itself).
     """
     n_seg = path_x.size - 1
     target_index = first_beyond_kept(path_x, path_y, px, py, foot_index, lookahead_m, closed, kept)
@@ -107,7 +109,7 @@ def evaluate_candidate(
         rx, ry = _point_at_index(path_x, path_y, foot_index + span * k / (n - 1), closed)
         buffers[2, k] = rx
         buffers[3, k] = ry
-    frechet = frechet_kernel(buffers[0, :n], buffers[1, :n], buffers[2, :n], buffers[3, :n])
+    frechet = frechet_below(buffers[0, :n], buffers[1, :n], buffers[2, :n], buffers[3, :n], limit_m)
     return frechet, kdot, length, tx, ty, ex, ey, status
 
 
@@ -118,8 +120,8 @@ def evaluated(
     """The candidate of the last `adaptive_search` (from min_lookahead_m by step_m) that was evaluated at exactly
     lookahead_m, whose results[k] `evaluate_candidate` would return again for it; -1 if none."""
     k = round((lookahead_m - min_lookahead_m) / step_m)
-    if 0 <= k < scores.size and not math.isnan(scores[k]) and min_lookahead_m + k * step_m == lookahead_m:
-        return k
+    if 0 <= k < scores.size and math.isfinite(scores[k]) and min_lookahead_m + k * step_m == lookahead_m:
+        return k  # evaluated in full (a score cut short is inf)
     return -1
 
 
@@ -147,16 +149,17 @@ def adaptive_search(
     kept: np.ndarray,
 ) -> tuple[float, int]:  # pragma: no cover - compiled
     """The chosen lookahead (m) and the number of candidates evaluated; scores[k] holds candidate k's Fréchet
-    distance (NaN where not evaluated), with candidate k at min + k step, and results[k] (scores.size, 8) all that
-    `evaluate_candidate` returned for it (`evaluated`)."""
+    distance (NaN where not evaluated, inf where it was cut short: more than the threshold in the bisection, more
+    than the least so far in the fallback's scan, so that it could not change the choice), with candidate k at
+    min + k step, and results[k] (scores.size, 8) all that `evaluate_candidate` returned for it (`evaluated`)."""
     count = max(1, min(candidate_count(min_lookahead_m, max_lookahead_m, step_m), scores.size))
     scores[:] = np.nan
     evaluations = 0
 
-    def admissible(k: int) -> bool:
+    def admissible(k: int, limit: float) -> bool:
         fd, kdot, length, tx, ty, ex, ey, status = evaluate_candidate(
             path_x, path_y, closed, foot_index, px, py, theta, kappa0, min_lookahead_m + k * step_m,
-            kdot_max, point_spacing_m, buffers, kept,
+            kdot_max, point_spacing_m, buffers, kept, limit,
         )  # fmt: skip
         scores[k] = fd
         row = results[k]
@@ -170,15 +173,15 @@ def adaptive_search(
 
     top = count - 1
     evaluations += 1
-    if admissible(top):
+    if admissible(top, np.inf):  # the ends in full: the fallback below may need their distances
         return min_lookahead_m + top * step_m, evaluations
     evaluations += 1
-    if admissible(0):
+    if admissible(0, np.inf):
         lo, hi = 0, top  # lo qualifies, hi does not: bisect (Fréchet distance grows with the lookahead)
         while hi - lo > 1:
             mid = (lo + hi) // 2
             evaluations += 1
-            if admissible(mid):
+            if admissible(mid, threshold_m):
                 lo = mid
             else:
                 hi = mid
@@ -188,13 +191,13 @@ def adaptive_search(
     best = 0
     for k in range(stride, count, stride):
         evaluations += 1
-        admissible(k)
+        admissible(k, scores[best])
         if scores[k] < scores[best]:
             best = k
     for k in range(max(0, best - stride + 1), min(count, best + stride)):
         if np.isnan(scores[k]):
             evaluations += 1
-            admissible(k)
+            admissible(k, scores[best])
         if scores[k] < scores[best]:
             best = k
     return min_lookahead_m + best * step_m, evaluations
@@ -267,7 +270,7 @@ class LookaheadEvaluator:
         fd, kdot, length, tx, ty, ex, ey, status = evaluate_candidate(
             path.x_m, path.y_m, path.closed, s_foot_m / path.spacing_m, float(x_m), float(y_m),
             float(heading_rad), float(curvature_1pm), float(lookahead_m), float(max_curvature_rate_1pm2),
-            self.point_spacing_m, self._buffers, _NOTHING_KEPT,
+            self.point_spacing_m, self._buffers, _NOTHING_KEPT, np.inf,
         )  # fmt: skip
         return Candidate(lookahead_m, fd, kdot, length, (tx, ty), (ex, ey), status)
 

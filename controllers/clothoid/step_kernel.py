@@ -227,7 +227,7 @@ def clothoid_step(
     else:
         frechet, kdot, clothoid_length, tx, ty, ex, ey, status = evaluate_candidate(
             path_x, path_y, closed, foot_index, px, py, ph, kappa0, lookahead, p[P_KDOT_MAX], p[P_POINT_SPACING],
-            buffers, kept,
+            buffers, kept, np.inf,
         )  # fmt: skip
     clothoid_kdot = reference_kdot = feedforward_kdot = kdot
     if p[P_FEEDFORWARD] != 0.0:  # path_feedforward.py: feedback relative to the path's own clothoid, plus its rate

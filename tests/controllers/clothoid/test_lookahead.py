@@ -73,7 +73,7 @@ def test_bisection_equals_brute_force_where_the_distance_is_monotone(s: float, c
     assert k >= 0 and results[k, 0] == scores[k]
     again = evaluate_candidate(
         BEND.x_m, BEND.y_m, BEND.closed, s / BEND.spacing_m, *pose, kappa, chosen, KDOT_MAX, 0.5,
-        np.empty((4, MAX_CURVE_POINTS)), np.empty(0),
+        np.empty((4, MAX_CURVE_POINTS)), np.empty(0), np.inf,
     )  # fmt: skip
     assert tuple(results[k]) == tuple(float(v) for v in again)
     assert evaluated(scores, results, 5.0, 0.5, chosen + 0.25) == -1  # off the grid: not evaluated
