@@ -12,7 +12,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
-from controllers.clothoid.frechet import discrete_frechet, frechet_kernel, frechet_with_early_exit
+from controllers.clothoid.frechet import discrete_frechet, frechet_below, frechet_kernel, frechet_with_early_exit
 from workbench.base.errors import WorkbenchInputError
 
 # The kernel returns sqrt of one pairwise squared distance; references computed another way (hypot, scipy's
@@ -218,6 +218,8 @@ def check_early_exit_agrees(P: np.ndarray, Q: np.ndarray, threshold: float) -> N
     qx, qy = columns(Q)
     d = frechet_kernel(px, py, qx, qy)
     assert frechet_with_early_exit(px, py, qx, qy, threshold) == (d <= threshold)
+    # cut short only where it exceeds the limit, else the distance itself, bit for bit
+    assert frechet_below(px, py, qx, qy, threshold) == (d if d <= threshold else math.inf)
 
 
 @settings(max_examples=100, deadline=None)
