@@ -1,5 +1,6 @@
-"""Stanley (Thrun et al. 2006, the DARPA Grand Challenge winner): heading error plus a cross-track term at the
-front axle, phi = (psi_path - psi) + atan(k e / (k_soft + v)), with e the front axle's signed CTE.
+"""Stanley (Thrun et al. 2006, the DARPA Grand Challenge winner): heading error plus a front-axle cross-track term.
+
+The law: phi = (psi_path - psi) + atan(k e / (k_soft + v)), with e the front axle's signed CTE.
 
 The front-axle position is the measured rear-axle position moved one wheelbase along the heading. A path-curvature
 feedforward, atan(L kappa), is optional (off by default, as in the original law).

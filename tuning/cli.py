@@ -14,6 +14,9 @@ Every input file and output file is checked before any work (`workbench.base.inp
 a missing or unreadable input, a folder where a file is wanted, a parent that is a file, an unwritable folder or
 file are refused.
 
+`tuning --version` (as `workbench --version`: `workbench.base.version`) prints the installed distribution's
+version and, run from a git checkout, its commit.
+
 Exit codes: 0 done; 2 bad input (one line on stderr naming the value and what is allowed).
 """
 
@@ -22,13 +25,18 @@ from __future__ import annotations
 import argparse
 import math
 import sys
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
+from functools import partial
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 from workbench.base.errors import WorkbenchInputError
+from workbench.base.version import VersionAction
 
 if TYPE_CHECKING:
+    from tqdm import tqdm
+
     from tuning.lag_fit import SteeringGeometry
     from workbench.vehicles.base import VehicleGeometry, VehicleModel
 
@@ -100,6 +108,7 @@ def _parser(command: str | None = None) -> argparse.ArgumentParser:
     """The parser. `command` (the one being run, "" for none) limits the options built, and the modules their
     defaults are read from, to that command's; None: every command's."""
     parser = argparse.ArgumentParser(prog="tuning", description="Identify vehicle lag and tune controller filters.")
+    parser.add_argument("--version", action=VersionAction)
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
     gen = sub.add_parser(
@@ -447,8 +456,8 @@ def _design_lead(args: argparse.Namespace) -> int:
     print(design.summary())
     for t in traces:
         print(
-            f"  {t.name}: RMS error against the kinematic curvature, over its range: lagged {t.nrmse_lagged:.4f}, "
-            f"compensated {t.nrmse_compensated:.4f}"
+            f"  {t.name}: NRMSE (normalised RMS error: against the kinematic curvature, over its range): "
+            f"lagged {t.nrmse_lagged:.4f}, compensated {t.nrmse_compensated:.4f}"
         )
     print(f"wrote {out}")
     if args.plot or traces:
@@ -513,19 +522,29 @@ def _schedule(args: argparse.Namespace) -> int:
             f"--compare needs --nominal-speed, one of the --speeds {speeds}, for the fixed filter to compare with "
             f"(default {PAPER_SPEED_KMH:g} km/h, the paper's, when it is one of them)"
         )
-    result = identify_schedule(
-        vehicle,
-        speeds,
-        lat_accel_g=args.lat_accel_g,
-        fit_options=LagFitOptions(fit_delay=args.delay),
-        max_lead_gain=args.max_lead_gain,
-        max_cascade_peak_db=args.max_cascade_peak_db,
-        drop_refused=args.drop_refused,
-        progress=lambda line: print(f"tuning schedule: {line}", file=sys.stderr, flush=True),
-        design=args.design,
-        controller_rate_hz=args.controller_rate_hz,
-        prediction_time_s=args.prediction_time_s,
-    )
+    with _progress_bar(len(speeds), "speed", "tuning schedule") as bar:
+        bar.set_postfix_str(f"{speeds[0]:g} km/h")
+
+        def progress(line: str) -> None:
+            """One call per speed (`identify_schedule`): its line above the bar, the bar on to the next speed."""
+            bar.write(f"tuning schedule: {line}", file=sys.stderr)
+            bar.update(1)
+            if bar.n < len(speeds):
+                bar.set_postfix_str(f"{speeds[bar.n]:g} km/h")
+
+        result = identify_schedule(
+            vehicle,
+            speeds,
+            lat_accel_g=args.lat_accel_g,
+            fit_options=LagFitOptions(fit_delay=args.delay),
+            max_lead_gain=args.max_lead_gain,
+            max_cascade_peak_db=args.max_cascade_peak_db,
+            drop_refused=args.drop_refused,
+            progress=progress,
+            design=args.design,
+            controller_rate_hz=args.controller_rate_hz,
+            prediction_time_s=args.prediction_time_s,
+        )
     if compare_speeds and nominal not in result.speeds_kmh:
         raise WorkbenchInputError(f"--compare: the nominal speed {nominal:g} km/h was dropped from the schedule")
     result.write(_prepare(out), nominal_speed_kmh=nominal)
@@ -539,7 +558,13 @@ def _schedule(args: argparse.Namespace) -> int:
         files: dict[str, Path | None] = dict(fixed_and_scheduled_filters(vehicle, result, nominal))
         fixed_label = next(label for label in files if label != "scheduled")
         files["no filter"] = None
-        rows = compare_closed_loop(lambda: _vehicle(args), files, compare_speeds, args.compare_scenario)
+        runs = [(speed, label) for speed in compare_speeds for label in files]
+        rows, fresh_vehicle = [], partial(_vehicle, args)
+        with _progress_bar(len(runs), "run", "closed loop") as bar:
+            for speed, label in runs:  # one run at a time, for the bar: compare_closed_loop's order
+                bar.set_postfix_str(f"{label} at {speed:g} km/h")
+                rows += compare_closed_loop(fresh_vehicle, {label: files[label]}, [speed], args.compare_scenario)
+                bar.update(1)
         print(f"clothoid controller (default options) on {args.compare_scenario} ({vehicle.name}):")
         print("speed_kmh  filter            completed  max_abs_cte_m  rms_cte_m  max_steer_rate_deg_s  driven_kmh")
         for row in rows:
@@ -551,6 +576,22 @@ def _schedule(args: argparse.Namespace) -> int:
         for verdict in scheduled_against_fixed(rows, fixed_label):
             print(verdict.line())
     return 0
+
+
+@contextmanager
+def _progress_bar(total: int, unit: str, desc: str) -> Iterator[tqdm]:
+    """A progress bar on stderr, as `workbench run` and `sweep` show: only on a terminal; left on screen when the
+    work is done, taken away when it stops with an error (so that the message stands alone)."""
+    from tqdm import tqdm
+
+    bar = tqdm(total=total, unit=unit, desc=desc, leave=True, disable=not sys.stderr.isatty(), file=sys.stderr)
+    try:
+        yield bar
+    except BaseException:
+        bar.leave = False
+        raise
+    finally:
+        bar.close()
 
 
 def _add_margins_parser(sub: argparse._SubParsersAction, command: str | None = None) -> None:

@@ -3,7 +3,7 @@ the lead filter), Figure 10 (Bode of plant, compensator and cascade), the schedu
 loop's margins against lookahead (`tuning margins`).
 
 Each function draws one figure, writes it to `path` (PNG, or any format matplotlib knows by suffix) and returns
-the path.
+the path. Axis labels give their unit in parentheses, "time (s)", as the run figures do (`workbench.simulation.plots`).
 """
 
 from __future__ import annotations
@@ -47,8 +47,8 @@ def lag_fit_figure(fit: LagFit, path: str | Path) -> Path:
         ax.plot(log.t_s, log.measured_1pm, lw=1.6, label=f"actual (from {log.curvature_from})")
         ax.plot(log.t_s, log.modelled_1pm, ":", lw=2.0, label=label)
         ax.set_title(f"{log.name}: NRMSE {log.nrmse:.4f}")
-        ax.set_xlabel("time [s]")
-        ax.set_ylabel("curvature [1/m]")
+        ax.set_xlabel("time (s)")
+        ax.set_ylabel("curvature (1/m)")
         ax.grid(True, alpha=0.3)
         ax.legend(fontsize=8)
     return _save(fig, path)
@@ -78,9 +78,9 @@ def bode_figure(design: LeadDesign, path: str | Path) -> Path:
         (design.phase_frequency_rad_s, design.cascade_phase_deg),
         fontsize=8,
     )
-    mag_ax.set_ylabel("magnitude [dB]")
-    phase_ax.set_ylabel("phase [deg]")
-    phase_ax.set_xlabel("frequency [rad/s]")
+    mag_ax.set_ylabel("magnitude (dB)")
+    phase_ax.set_ylabel("phase (deg)")
+    phase_ax.set_xlabel("frequency (rad/s)")
     p = design.params
     mag_ax.set_title(
         f"lead filter ωz {p.omega_z_rad_s:.2f} rad/s, ψ {p.psi:.2f}, ωp {p.omega_p_rad_s:.2f} rad/s "
@@ -105,8 +105,8 @@ def validation_figure(traces: Sequence[ValidationTrace], path: str | Path) -> Pa
             tr.t_s, tr.compensated_1pm, ":", color="m", lw=2.0, label=f"compensated (NRMSE {tr.nrmse_compensated:.3f})"
         )
         ax.set_title(tr.name)
-        ax.set_xlabel("time [s]")
-        ax.set_ylabel("curvature [1/m]")
+        ax.set_xlabel("time (s)")
+        ax.set_ylabel("curvature (1/m)")
         ax.grid(True, alpha=0.3)
         ax.legend(fontsize=8)
     return _save(fig, path)
@@ -121,8 +121,8 @@ def rollover_figure(limits: Sequence[RolloverLimit], path: str | Path, vehicle: 
     lock = np.array([lim.limited_by == "steering lock" for lim in limits])
     if lock.any():
         ax.plot(speeds[lock], curv[lock], "s", color="C3", label="LTR < 1 at the steering lock (lock limit)")
-    ax.set_xlabel("speed [km/h]")
-    ax.set_ylabel("curvature limit [1/m]")
+    ax.set_xlabel("speed (km/h)")
+    ax.set_ylabel("curvature limit (1/m)")
     ax.set_title(f"curvature saturation limits from step steers{f' ({vehicle})' if vehicle else ''}")
     ax.grid(True, alpha=0.3)
     ax.legend()
@@ -139,11 +139,11 @@ def schedule_figure(result: ScheduleResult, path: str | Path) -> Path:
     a1.plot(speeds, [r["omega_p_rad_s"] for r in rows], "s-", label="ωp (filter)")
     a1.plot(speeds, [r["plant_bandwidth_rad_s"] for r in rows], "^--", label="plant bandwidth")
     a1.plot(speeds, [r["cascade_bandwidth_rad_s"] for r in rows], "v--", label="cascade bandwidth")
-    a1.set_ylabel("rad/s")
+    a1.set_ylabel("frequency (rad/s)")
     a2.plot(speeds, [r["zeta"] for r in rows], "o-", label="ζ (lag)")
     a2.plot(speeds, [r["psi"] for r in rows], "x:", label="ψ (filter)")
     a2.plot(speeds, [r["steady_state_gain"] for r in rows], "s-", label="steady-state gain K")
-    a2.set_xlabel("speed [km/h]")
+    a2.set_xlabel("speed (km/h)")
     for ax in (a1, a2):
         ax.grid(True, alpha=0.3)
         ax.legend(fontsize=8)

@@ -7,6 +7,12 @@ Every input file and output folder is checked before any work starts (`workbench
 a parent that is a file, an unwritable folder, and a non-empty output folder without --overwrite are refused with
 `workbench: error: ...` and exit code 2.
 
+`run` and `compare` take the same options (`_run_options`): the controllers' options, the vehicle's file and
+payload, the simulation's speed, rates and time-out, the conditions and the output. `run` steers with the clothoid
+controller, the project's subject, unless --controller names another; every controller is built with the vehicle's
+own tuning (`tuning.own_tuning.tuned_controller`). `workbench --version` prints the installed version and, run
+from a git checkout, its commit.
+
 Exit codes: 0 done; 1 a run did not complete (run, compare, fig17), a sweep run raised an error, no optimisation
 trial completed, or a study's worker died; 2 bad input; 130 interrupted.
 """
@@ -16,6 +22,7 @@ from __future__ import annotations
 import argparse
 import math
 import os
+import re
 import shutil
 import signal
 import sys
@@ -27,12 +34,14 @@ from typing import TYPE_CHECKING
 from controllers import CONTROLLERS
 from workbench.base.errors import WorkbenchInputError
 from workbench.base.output_dir import MANIFEST
+from workbench.base.version import VersionAction
 
 if TYPE_CHECKING:
     from workbench.apps.comparison import Comparison
     from workbench.apps.studies import StudySpec
     from workbench.apps.studies.backends import Backend
     from workbench.base.output_dir import OutputDir
+    from workbench.simulation.run_config import SimulationConfig
 
 # Heavy modules (the simulator, the scenarios' paths, plotting, the controllers' solvers, the studies' backends)
 # are imported inside the command that needs them, so that `workbench --help` and `workbench scenarios` start
@@ -41,6 +50,12 @@ if TYPE_CHECKING:
 EXIT_INPUT_ERROR = 2
 EXIT_RUN_FAILED = 1
 EXIT_INTERRUPTED = 130
+#: The controller `workbench run` steers with unless --controller names another: the project's subject.
+DEFAULT_CONTROLLER = "clothoid"
+#: The vehicle `workbench run` steers without --vehicle or --vehicle-file.
+DEFAULT_VEHICLE = "kinematic-bicycle"
+#: compare's `--controller-config NAME=FILE.toml` and `--set NAME:KEY=VALUE`: a controller name's shape.
+_CONTROLLER_NAME = re.compile(r"[A-Za-z][A-Za-z0-9_-]*")
 
 #: The input-file options of the commands (argparse dest -> what the message calls it).
 INPUT_FILES = {
@@ -62,6 +77,7 @@ def _parser(command: str | None = None) -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="workbench", description="Design, tune and compare lateral (steering) controllers."
     )
+    parser.add_argument("--version", action=VersionAction)
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
     scen = sub.add_parser("scenarios", help="list the named scenarios")
@@ -75,33 +91,15 @@ def _parser(command: str | None = None) -> argparse.ArgumentParser:
 
     run = sub.add_parser("run", help="simulate one controller on one vehicle along one scenario")
     run.add_argument("scenario", help="a scenario name (see `workbench scenarios`) or a waypoint CSV file")
-    run.add_argument("--controller", default="pure-pursuit", help="controller name (default: pure-pursuit)")
     run.add_argument(
-        "--controller-config",
-        type=Path,
-        metavar="FILE.toml",
-        help="controller options: a TOML file with a [<controller name>] table (see `workbench controllers --show`)",
+        "--controller",
+        default=DEFAULT_CONTROLLER,
+        metavar="NAME",
+        help=f"controller name (default: {DEFAULT_CONTROLLER}, with the vehicle's own tuning; see `workbench "
+        "controllers`)",
     )
-    run.add_argument(
-        "--set",
-        action="append",
-        default=[],
-        metavar="KEY=VALUE",
-        help="a controller option, over the config file (repeatable), e.g. --set frechet_threshold_m=0.3",
-    )
-    run.add_argument("--vehicle", default=None, help="vehicle model (default: kinematic-bicycle)")
-    run.add_argument("--vehicle-file", type=Path, help="a vehicle TOML file (see `workbench vehicles --show`)")
-    run.add_argument("--payload-kg", type=float, help="payload of vehicles that carry one (tractor-semitrailer)")
-    run.add_argument("--speed", type=float, default=30.0, metavar="KMH", help="target speed, km/h (default 30)")
-    run.add_argument("--out", type=Path, required=True, metavar="DIR", help="output directory")
-    run.add_argument("--track", type=Path, help="track CSV for the zandvoort scenario")
-    run.add_argument("--laps", type=int, default=1, help="laps of a closed path (default 1)")
-    run.add_argument("--controller-rate-hz", type=float, default=50.0, help="controller rate (default 50 Hz)")
-    run.add_argument("--plant-rate-hz", type=float, default=1000.0, help="plant integration rate (default 1 kHz)")
-    run.add_argument("--lat-accel-g", type=float, default=0.3, help="speed-profile lateral bound (default 0.3 g)")
-    _conditions_options(run)
-    run.add_argument("--no-plots", action="store_true", help="write the trace and metrics only")
-    _overwrite_option(run)
+    run.add_argument("--vehicle", metavar="NAME", help=f"vehicle model (default: {DEFAULT_VEHICLE})")
+    _run_options(run, several=False)
 
     cmp = sub.add_parser("compare", help="run several controllers (and vehicles) on one scenario; write a report")
     cmp.add_argument("scenario", help="a scenario name (see `workbench scenarios`) or a waypoint CSV file")
@@ -112,17 +110,12 @@ def _parser(command: str | None = None) -> argparse.ArgumentParser:
         help=f"comma-separated controller names ({', '.join(CONTROLLERS)})",
     )
     cmp.add_argument(
-        "--vehicle", required=True, metavar="NAME[,NAME...]", help="vehicle preset(s); each controller runs on each"
+        "--vehicle",
+        metavar="NAME[,NAME...]",
+        help="vehicle preset(s) or vehicle TOML file(s); each controller runs on each (give this, --vehicle-file or "
+        "both)",
     )
-    cmp.add_argument(
-        "--controller-config",
-        type=Path,
-        metavar="FILE.toml",
-        help="controller options: a TOML file with a table per controller name",
-    )
-    cmp.add_argument("--out", type=Path, required=True, metavar="DIR", help="output directory")
-    _sim_options(cmp)
-    _overwrite_option(cmp)
+    _run_options(cmp, several=True)
 
     fig = sub.add_parser(
         "fig17", help="the paper's Figure 17/18 comparison: clothoid vs NMPC, as published and each on each plant"
@@ -205,12 +198,87 @@ def _backend_options(parser: argparse.ArgumentParser, shown: bool = True) -> Non
     )
 
 
-def _sim_options(parser: argparse.ArgumentParser) -> None:
+def _run_options(parser: argparse.ArgumentParser, several: bool) -> None:
+    """The options `run` and `compare` share, built here once so that both take the same: the controllers'
+    options, the vehicle's file and payload, the simulation (speed, track, laps, rates, speed-profile bound,
+    time-out), the conditions and the output. `several` (compare): --controller-config and --set may name the
+    controller they are for, each --vehicle-file adds a vehicle and --payload-kg goes to each vehicle that carries
+    one."""
+    if several:
+        parser.add_argument(
+            "--controller-config",
+            dest="controller_configs",
+            action="append",
+            default=[],
+            metavar="[NAME=]FILE.toml",
+            help="controller options: a TOML file with a table per controller name (see `workbench controllers "
+            "--show`); NAME=FILE.toml: that controller's table from its own file (repeatable, once per controller)",
+        )
+        parser.add_argument(
+            "--set",
+            action="append",
+            default=[],
+            metavar="[NAME:]KEY=VALUE",
+            help="a controller option, over the config files (repeatable): for every controller, or with NAME: for "
+            "that one, e.g. --set clothoid:frechet_threshold_m=0.3",
+        )
+        parser.add_argument(
+            "--vehicle-file",
+            action="append",
+            default=[],
+            type=Path,
+            metavar="FILE.toml",
+            help="a vehicle TOML file, one more vehicle each controller runs on (repeatable; see `workbench vehicles "
+            "--show`)",
+        )
+        payload = "payload of the vehicles that carry one (tractor-semitrailer); the others run as they are"
+    else:
+        parser.add_argument(
+            "--controller-config",
+            type=Path,
+            metavar="FILE.toml",
+            help="controller options: a TOML file with a [<controller name>] table (see `workbench controllers "
+            "--show`)",
+        )
+        parser.add_argument(
+            "--set",
+            action="append",
+            default=[],
+            metavar="KEY=VALUE",
+            help="a controller option, over the config file (repeatable), e.g. --set frechet_threshold_m=0.3",
+        )
+        parser.add_argument(
+            "--vehicle-file",
+            type=Path,
+            metavar="FILE.toml",
+            help="a vehicle TOML file (see `workbench vehicles --show`)",
+        )
+        payload = "payload of vehicles that carry one (tractor-semitrailer)"
+    parser.add_argument("--payload-kg", type=float, metavar="KG", help=payload)
     parser.add_argument("--speed", type=float, default=30.0, metavar="KMH", help="target speed, km/h (default 30)")
-    parser.add_argument("--track", type=Path, help="track CSV for the zandvoort scenario")
-    parser.add_argument("--laps", type=int, default=1, help="laps of a closed path (default 1)")
-    parser.add_argument("--lat-accel-g", type=float, default=0.3, help="speed-profile lateral bound (default 0.3 g)")
+    parser.add_argument("--out", type=Path, required=True, metavar="DIR", help="output directory")
+    parser.add_argument("--track", type=Path, metavar="FILE", help="track CSV for the zandvoort scenario")
+    parser.add_argument("--laps", type=int, default=1, metavar="N", help="laps of a closed path (default 1)")
+    parser.add_argument(
+        "--controller-rate-hz", type=float, default=50.0, metavar="HZ", help="controller rate (default 50 Hz)"
+    )
+    parser.add_argument(
+        "--plant-rate-hz", type=float, default=1000.0, metavar="HZ", help="plant integration rate (default 1 kHz)"
+    )
+    parser.add_argument(
+        "--lat-accel-g", type=float, default=0.3, metavar="G", help="speed-profile lateral bound (default 0.3 g)"
+    )
+    parser.add_argument(
+        "--max-time-s",
+        type=float,
+        metavar="S",
+        help="stop a run after this much simulated time, status timeout (default: three times the planned time "
+        "plus 30 s)",
+    )
     _conditions_options(parser)
+    what = "trace and metrics" if not several else "traces, metrics and summary.csv, without figures or report.html"
+    parser.add_argument("--no-plots", action="store_true", help=f"write the {what} only")
+    _overwrite_option(parser)
 
 
 def _conditions_options(parser: argparse.ArgumentParser) -> None:
@@ -224,12 +292,25 @@ def _conditions_options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--seed", type=int, default=0, help="seed of the conditions' noise (default 0)")
 
 
-def _simulation_config(args: argparse.Namespace, **fields: object) -> object:
+def _simulation_config(args: argparse.Namespace, **fields: object) -> SimulationConfig:
     """The SimulationConfig of a command's options: `fields` plus the conditions and seed."""
     from workbench.simulation.conditions import load_conditions
     from workbench.simulation.simulator import SimulationConfig
 
     return SimulationConfig(**fields, conditions=load_conditions(args.conditions), seed=args.seed)
+
+
+def _run_config(args: argparse.Namespace) -> SimulationConfig:
+    """The SimulationConfig of `run`'s and `compare`'s options (`_run_options`)."""
+    return _simulation_config(
+        args,
+        speed_kmh=args.speed,
+        laps=args.laps,
+        controller_rate_hz=args.controller_rate_hz,
+        plant_rate_hz=args.plant_rate_hz,
+        max_lateral_accel_g=args.lat_accel_g,
+        max_time_s=args.max_time_s,
+    )
 
 
 def _names(text: str, what: str) -> list[str]:
@@ -240,15 +321,15 @@ def _names(text: str, what: str) -> list[str]:
 
 
 def _check_inputs(args: argparse.Namespace) -> None:
-    """Every input file the command names (INPUT_FILES, and a waypoint file given as the scenario) must be a
-    readable file: checked before any work."""
+    """Every input file the command names (INPUT_FILES, each of a repeated option; and a waypoint file given as
+    the scenario) must be a readable file: checked before any work."""
     from workbench.base.input_files import check_input_file
     from workbench.simulation.scenarios import SCENARIOS
 
     for dest, flag in INPUT_FILES.items():
         value = getattr(args, dest, None)
-        if value is not None:
-            check_input_file(value, f"{flag} {str(value)!r}" if flag.startswith("--") else f"spec file {str(value)!r}")
+        for path in value if isinstance(value, list) else [] if value is None else [value]:
+            check_input_file(path, f"{flag} {str(path)!r}" if flag.startswith("--") else f"spec file {str(path)!r}")
     scenario = getattr(args, "scenario", None)
     if scenario is not None and scenario not in SCENARIOS:
         if os.path.lexists(scenario) or Path(scenario).suffix.lower() in (".csv", ".txt"):
@@ -282,6 +363,95 @@ def _print_summary(comparison: Comparison) -> None:
             print(f"  WARNING: steering limit cycle: {spec.label} at {cycle.describe()}")
 
 
+def _controller_configs(values: Sequence[str], controllers: Sequence[str]) -> dict[str, Path]:
+    """Each controller's --controller-config file in compare: NAME=FILE.toml for that controller (the file must
+    have its [NAME] table), else the one FILE.toml given for all (a table per controller name; a controller without
+    one gets its defaults); a controller with neither is left out (its defaults). Each file is checked readable. A
+    text whose part before "=" is shaped like a name, and which is not itself a file, is taken as NAME=FILE, so
+    that a misspelt name is refused as such rather than as a missing file."""
+    from workbench.base.input_files import check_input_file, read_toml
+
+    shared: list[str] = []
+    named: dict[str, Path] = {}
+    for text in values:
+        name, sep, file = text.partition("=")
+        if not (sep and file and _CONTROLLER_NAME.fullmatch(name) and not os.path.lexists(text)):
+            shared.append(text)
+            continue
+        what = f"--controller-config {text!r}"
+        if name not in controllers:
+            raise WorkbenchInputError(f"{what}: {name!r} is not one of --controllers ({', '.join(controllers)})")
+        if name in named:
+            raise WorkbenchInputError(f"{what}: {name} has a file already ({str(named[name])!r}); give one each")
+        check_input_file(file, what)
+        if name not in read_toml(Path(file), what):
+            raise WorkbenchInputError(
+                f"{what}: the file has no [{name}] table (`workbench controllers --show {name}` writes one)"
+            )
+        named[name] = Path(file)
+    if len(shared) > 1:
+        raise WorkbenchInputError(
+            f"--controller-config: give one FILE.toml for every controller, got {len(shared)} "
+            f"({', '.join(repr(t) for t in shared)}); give each controller its own as NAME=FILE.toml"
+        )
+    for text in shared:
+        check_input_file(text, f"--controller-config {text!r}")
+    every = {c: Path(shared[0]) for c in controllers} if shared else {}
+    return every | named
+
+
+def _controller_overrides(values: Sequence[str], controllers: Sequence[str]) -> dict[str, tuple[str, ...]]:
+    """Each controller's --set overrides of compare: KEY=VALUE for every controller (each must have the option),
+    then NAME:KEY=VALUE for that one (after, so that they win)."""
+    from workbench.apps.controller_config import option_types
+
+    shared: list[str] = []
+    named: dict[str, list[str]] = {c: [] for c in controllers}
+    for text in values:
+        key, sep, value = text.partition("=")
+        name, colon, option = key.partition(":")
+        if not colon:
+            shared.append(text)
+            continue
+        if name not in controllers:
+            raise WorkbenchInputError(
+                f"--set {text!r}: {name!r} is not one of --controllers ({', '.join(controllers)})"
+            )
+        named[name].append(f"{option}{sep}{value}")
+    for text in shared:
+        key = text.partition("=")[0].strip()
+        having = [c for c in controllers if key in option_types(CONTROLLERS[c].config_type)]
+        lacking = [c for c in controllers if c not in having]
+        if having and lacking:
+            raise WorkbenchInputError(
+                f"--set {text!r} is for every controller, but {', '.join(lacking)} has no option {key!r}; give it to "
+                f"one controller as --set NAME:{text}, e.g. --set {having[0]}:{text}"
+            )
+    return {c: (*shared, *named[c]) for c in controllers}
+
+
+def _compared_vehicles(args: argparse.Namespace) -> list[tuple[str, float | None]]:
+    """compare's vehicles (--vehicle's names or files, then each --vehicle-file), each with the --payload-kg it
+    carries: the payload goes to each vehicle that carries one, and is refused when none does."""
+    from workbench.vehicles.presets import MODEL_TYPES, carries_payload, load_vehicle
+
+    vehicles = (_names(args.vehicle, "vehicle") if args.vehicle is not None else []) + [
+        str(path) for path in args.vehicle_file
+    ]
+    if not vehicles:
+        raise WorkbenchInputError("compare needs vehicles: give --vehicle NAME[,NAME...] or --vehicle-file FILE.toml")
+    if args.payload_kg is None:
+        return [(v, None) for v in vehicles]
+    carrying = [carries_payload(load_vehicle(v).name) for v in vehicles]
+    if not any(carrying):
+        carriers = [k for k in MODEL_TYPES if carries_payload(k)]
+        raise WorkbenchInputError(
+            f"--payload-kg {args.payload_kg:g}: none of the vehicles ({', '.join(vehicles)}) carries a payload; a "
+            f"payload applies to: {', '.join(carriers)}"
+        )
+    return [(v, args.payload_kg if carries else None) for v, carries in zip(vehicles, carrying, strict=True)]
+
+
 def _compare(args: argparse.Namespace) -> int:
     from workbench.apps.comparison import RunSpec, compare, warn_on_stderr
     from workbench.apps.report import ReportSection, write_report
@@ -289,23 +459,39 @@ def _compare(args: argparse.Namespace) -> int:
     from workbench.simulation.scenarios import ScenarioOptions
 
     out = OutputDir(args.out, "compare", args.overwrite)
+    controllers = _names(args.controllers, "controllers")
+    for name in controllers:
+        if name not in CONTROLLERS:
+            raise WorkbenchInputError(f"unknown controller {name!r}; choose one of {', '.join(CONTROLLERS)}")
+    configs = _controller_configs(args.controller_configs, controllers)
     _check_inputs(args)
+    overrides = _controller_overrides(args.set, controllers)
     runs = [
-        RunSpec(controller, vehicle, config_file=args.controller_config)
-        for vehicle in _names(args.vehicle, "vehicle")
-        for controller in _names(args.controllers, "controllers")
+        RunSpec(controller, vehicle, overrides[controller], configs.get(controller), payload_kg)
+        for vehicle, payload_kg in _compared_vehicles(args)
+        for controller in controllers
     ]
-    config = _simulation_config(args, speed_kmh=args.speed, laps=args.laps, max_lateral_accel_g=args.lat_accel_g)
-    comparison = compare(args.scenario, runs, config, ScenarioOptions(track_file=args.track), warn=warn_on_stderr)
+    comparison = compare(
+        args.scenario,
+        runs,
+        _run_config(args),
+        ScenarioOptions(track_file=args.track),
+        warn=warn_on_stderr,
+        progress=sys.stderr.isatty(),
+    )
     with _writing(out):
-        comparison.save(args.out)
-        report = write_report(
-            args.out / "report.html",
-            f"{comparison.scenario.name}: {', '.join(dict.fromkeys(r.controller for r in runs))}",
-            [ReportSection("Side by side", "", comparison)],
-        )
+        comparison.save(args.out, with_plots=not args.no_plots)
+        if not args.no_plots:
+            report = write_report(
+                args.out / "report.html",
+                f"{comparison.scenario.name}: {', '.join(controllers)}",
+                [ReportSection("Side by side", "", comparison)],
+            )
     _print_summary(comparison)
-    print(f"wrote {report} and summary.csv, figures and runs/ beside it")
+    if args.no_plots:
+        print(f"wrote {args.out / 'summary.csv'} and runs/ beside it")
+    else:
+        print(f"wrote {report} and summary.csv, figures and runs/ beside it")
     return 0 if all(r.completed for r in comparison.results) else EXIT_RUN_FAILED
 
 
@@ -487,7 +673,7 @@ def _run(args: argparse.Namespace) -> int:
 
     out = OutputDir(args.out, "run", args.overwrite)
     _check_inputs(args)
-    name = args.vehicle if args.vehicle or args.vehicle_file else "kinematic-bicycle"
+    name = args.vehicle if args.vehicle or args.vehicle_file else DEFAULT_VEHICLE
     vehicle = make_vehicle(name, payload_kg=args.payload_kg, vehicle_file=args.vehicle_file)
     if args.controller not in CONTROLLERS:
         make_controller(args.controller, vehicle.geometry)  # raises the unknown-name error
@@ -498,15 +684,7 @@ def _run(args: argparse.Namespace) -> int:
     scenario = make_scenario(
         args.scenario, ScenarioOptions(vehicle_width_m=vehicle.geometry.width_m, track_file=args.track)
     )
-    config = _simulation_config(
-        args,
-        speed_kmh=args.speed,
-        laps=args.laps,
-        controller_rate_hz=args.controller_rate_hz,
-        plant_rate_hz=args.plant_rate_hz,
-        max_lateral_accel_g=args.lat_accel_g,
-    )
-    simulation = Simulation(scenario, vehicle, controller, config)
+    simulation = Simulation(scenario, vehicle, controller, _run_config(args))
     for warning in simulation.warnings(f"{scenario.name}: {controller.name} on {vehicle.name}"):
         warn_on_stderr(warning)
     result = simulation.run(progress=sys.stderr.isatty())

@@ -11,7 +11,8 @@ the result with `save` (traces, metrics, summary.csv, figures) and `workbench.ap
 
 Every run is built (vehicle, scenario, controller options and files) before the first one is simulated, so a bad
 input is refused before any work, and what each run's `Simulation.warnings` says (stretches of the path the
-vehicle cannot turn, a run that may be very long) is announced first.
+vehicle cannot turn, a run that may be very long) is announced first. With `progress` one bar counts the runs
+(the current run named on it), and each run shows its metres as `workbench run` does.
 """
 
 from __future__ import annotations
@@ -25,6 +26,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 import pandas as pd
+from tqdm import tqdm
 
 from controllers import CONTROLLERS
 from tuning.own_tuning import tuned_controller
@@ -35,10 +37,12 @@ from workbench.simulation.metrics import METRIC_KEYS
 from workbench.simulation.result import SimulationResult
 from workbench.simulation.scenarios import Scenario, ScenarioOptions, make_scenario
 from workbench.simulation.simulator import Simulation, SimulationConfig
-from workbench.vehicles import VEHICLES, make_vehicle
+from workbench.vehicles import VEHICLES, load_vehicle
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
+
+    from workbench.vehicles.base import VehicleModel
 
 #: |CTE| (m) within which a run counts as converged onto the path (the fig17 scenario starts 1 m off it).
 CONVERGED_CTE_M = 0.1
@@ -53,30 +57,43 @@ FIGURES: tuple[tuple[str, str], ...] = (
 
 @dataclass(frozen=True)
 class RunSpec:
-    """One run of a comparison: a registered controller, a vehicle preset, and controller options: a TOML file
-    with a table per controller name (`config_file`, as `workbench run --controller-config`; a controller without
-    a table gets its defaults) and KEY=VALUE overrides on top (as `--set`)."""
+    """One run of a comparison: a registered controller; a vehicle, a preset name or a vehicle TOML file (as
+    `workbench run --vehicle-file`), with `payload_kg` for one that carries a payload (None: the preset's or the
+    file's); and controller options: a TOML file with a table per controller name (`config_file`, as `workbench
+    run --controller-config`; a controller without a table gets its defaults) and KEY=VALUE overrides on top (as
+    `--set`)."""
 
     controller: str
     vehicle: str
     overrides: tuple[str, ...] = ()
     config_file: Path | None = None
+    payload_kg: float | None = None
 
     def __post_init__(self) -> None:
         if self.controller not in CONTROLLERS:
             raise WorkbenchInputError(f"unknown controller {self.controller!r}; choose one of {', '.join(CONTROLLERS)}")
-        if self.vehicle not in VEHICLES:
-            raise WorkbenchInputError(f"unknown vehicle {self.vehicle!r}; choose one of {', '.join(VEHICLES)}")
+        if self.vehicle not in VEHICLES and Path(self.vehicle).suffix.lower() != ".toml":
+            raise WorkbenchInputError(
+                f"unknown vehicle {self.vehicle!r}; choose one of {', '.join(VEHICLES)} or give a vehicle TOML file"
+            )
+
+    def make_vehicle(self) -> VehicleModel:
+        """A fresh vehicle of this run (a preset or the file, with the payload if given)."""
+        return load_vehicle(self.vehicle, self.payload_kg)
 
     @property
     def label(self) -> str:
         options = f" ({', '.join(self.overrides)})" if self.overrides else ""
-        return f"{self.controller}{options} on {self.vehicle}"
+        payload = f" with {self.payload_kg:g} kg" if self.payload_kg is not None else ""
+        return f"{self.controller}{options} on {self.vehicle}{payload}"
 
     @property
     def slug(self) -> str:
-        """A directory name for the run's files."""
-        text = f"{self.controller}-{self.vehicle}" + "".join(f"-{o}" for o in self.overrides)
+        """A directory name for the run's files: controller-vehicle (a vehicle file by its name), then the options
+        and the payload when given."""
+        vehicle = self.vehicle if self.vehicle in VEHICLES else Path(self.vehicle).name
+        text = f"{self.controller}-{vehicle}" + "".join(f"-{o}" for o in self.overrides)
+        text += f"-{self.payload_kg:g}kg" if self.payload_kg is not None else ""
         return "".join(c if c.isalnum() or c in "-_." else "_" for c in text)
 
 
@@ -139,6 +156,7 @@ class Comparison:
             rows = []
             for spec, result in zip(self.specs, self.results, strict=True):
                 row = {k: v for k, v in result.metrics.to_dict().items() if k in METRIC_KEYS}
+                row["vehicle"] = spec.vehicle  # the preset or the file asked for (the metrics name the model)
                 row |= {"options": " ".join(spec.overrides), "status": result.status.value, "message": result.message}
                 row["converge_distance_m"] = converge_distance_m(result.trace["progress_m"], result.trace["cte_m"])
                 rows.append(row)
@@ -203,9 +221,9 @@ class Comparison:
             written.append(path)
         return written
 
-    def save(self, out_dir: str | Path) -> list[Path]:
-        """Write each run's trace and metrics under DIR/runs/<controller>-<vehicle>/, DIR/summary.csv and the
-        figures; return the paths."""
+    def save(self, out_dir: str | Path, with_plots: bool = True) -> list[Path]:
+        """Write each run's trace and metrics under DIR/runs/<slug>/ (`RunSpec.slug`: controller-vehicle, and the
+        options when given), DIR/summary.csv and, with_plots, the figures; return the paths."""
         out = Path(out_dir)
         written = []
         for spec, result in zip(self.specs, self.results, strict=True):
@@ -213,12 +231,27 @@ class Comparison:
         summary_path = out / "summary.csv"
         self.summary().to_csv(summary_path, index=False)
         written.append(summary_path)
-        return written + self.save_figures(out)
+        return written + (self.save_figures(out) if with_plots else [])
 
 
 def warn_on_stderr(message: str) -> None:
     """Print a warning as the CLI does: `workbench: warning: ...` on stderr."""
     print(f"workbench: warning: {message}", file=sys.stderr, flush=True)
+
+
+def _simulation(
+    spec: RunSpec, scenario: str | Scenario, scenario_options: ScenarioOptions | None, config: SimulationConfig
+) -> Simulation:
+    """The run `spec` wired: its vehicle, the scenario (sized for the vehicle when named), its tuned controller."""
+    vehicle = spec.make_vehicle()
+    if isinstance(scenario, Scenario):
+        scen = scenario
+    else:
+        options = scenario_options or ScenarioOptions()
+        scen = make_scenario(scenario, ScenarioOptions(vehicle.geometry.width_m, options.track_file))
+    config_type = CONTROLLERS[spec.controller].config_type
+    options = read_controller_config(spec.config_file, spec.controller, config_type, spec.overrides, vehicle.geometry)
+    return Simulation(scen, vehicle, tuned_controller(spec.controller, vehicle, options), config)
 
 
 def compare(
@@ -228,36 +261,46 @@ def compare(
     scenario_options: ScenarioOptions | None = None,
     reference_controller: str | None = "clothoid",
     warn: Callable[[str], None] | None = warn_on_stderr,
+    progress: bool = False,
 ) -> Comparison:
     """Simulate each run on `scenario` (a name, a waypoint file or a Scenario) with the same config. Every run is
     built first (a bad input is refused before any simulation); what a vehicle cannot follow
     and each run that may be long (`Simulation.warnings`) are announced through `warn`
-    before the first run (None: silent)."""
+    before the first run (None: silent). progress: a bar on stderr counting the runs (naming the one being
+    prepared or run), left on screen when done."""
     if not runs:
         raise WorkbenchInputError("a comparison needs at least one (controller, vehicle) run; got none")
     if len(set(runs)) != len(runs):
         raise WorkbenchInputError(f"each run may appear once; got {[r.label for r in runs]}")
-    config = config or SimulationConfig()
-    simulations = []
-    for spec in runs:
-        vehicle = make_vehicle(spec.vehicle)
-        if isinstance(scenario, Scenario):
-            scen = scenario
-        else:
-            options = scenario_options or ScenarioOptions()
-            scen = make_scenario(scenario, ScenarioOptions(vehicle.geometry.width_m, options.track_file))
-        config_type = CONTROLLERS[spec.controller].config_type
-        options = read_controller_config(
-            spec.config_file, spec.controller, config_type, spec.overrides, vehicle.geometry
+    slugs = [r.slug for r in runs]
+    if len(set(slugs)) != len(slugs):
+        twice = sorted({s for s in slugs if slugs.count(s) > 1})
+        raise WorkbenchInputError(
+            f"two runs would write to the same folder runs/{twice[0]} (vehicle files of the same name?); got "
+            f"{[r.label for r in runs]}"
         )
-        controller = tuned_controller(spec.controller, vehicle, options)
-        simulations.append(Simulation(scen, vehicle, controller, config))
-    messages: list[str] = []
-    for spec, simulation in zip(runs, simulations, strict=True):
-        messages += simulation.warnings(spec.label)
-    for message in dict.fromkeys(messages) if warn is not None else ():
-        warn(message)
-    results = [simulation.run() for simulation in simulations]
+    config = config or SimulationConfig()
+    bar = tqdm(total=len(runs), unit="run", desc="compare", leave=True, disable=not progress)
+    try:
+        simulations = []
+        for spec in runs:
+            bar.set_postfix_str(f"preparing {spec.label}")
+            simulations.append(_simulation(spec, scenario, scenario_options, config))
+        messages = [m for spec, sim in zip(runs, simulations, strict=True) for m in sim.warnings(spec.label)]
+        if warn is not None:
+            with tqdm.external_write_mode(file=sys.stderr):  # above the bar, not through it
+                for message in dict.fromkeys(messages):
+                    warn(message)
+        results = []
+        for spec, simulation in zip(runs, simulations, strict=True):
+            bar.set_postfix_str(spec.label)
+            results.append(simulation.run(progress=progress))
+            bar.update(1)
+    except BaseException:
+        bar.leave = False  # a refused input or an interrupted comparison: its message without a bar above it
+        raise
+    finally:
+        bar.close()
     return Comparison(results[0].scenario, tuple(runs), tuple(results), config, reference_controller)
 
 

@@ -31,7 +31,7 @@ def execute_runs(
     todo = list({r.run_id: r for r in runs if r.run_id not in finished}.values())
     if todo:
         backend.start()  # before the bar: tqdm's monitor thread would make forking workers unsafe
-        bar = tqdm(total=len(todo), unit="run", desc=desc, leave=False) if progress else None
+        bar = tqdm(total=len(todo), unit="run", desc=desc, leave=True) if progress else None
         try:
             for row in backend.map_runs(todo):
                 store.write(row)
