@@ -1,10 +1,16 @@
 """The side-by-side report: one self-contained HTML file (figures embedded as base64 PNG, no external links), so
 it can be mailed, archived and read offline.
 
-A report has sections; each shows one `Comparison`: a short text, its summary table (one row per controller and
-plant), a line naming each run whose steering limit-cycles (`simulation/limit_cycle.py`: frequency, steering-wheel
-amplitude, duration, start) and its four figures (Figures 17a/b and 18a/b of the paper: trajectories, CTE against
-distance, speed against distance, steering against time).
+A report has sections; each shows one `Comparison`: a short text, the course each vehicle ran (a scenario sized for
+the vehicle, e.g. the dlc's lanes and cones, differs between vehicles), its summary table (one row per controller
+and plant) with what its step-time ratio is divided by, a line naming each run whose steering limit-cycles
+(`simulation/limit_cycle.py`: frequency, steering-wheel amplitude, duration, start), its four figures (Figures
+17a/b and 18a/b of the paper: trajectories, CTE against distance, speed against distance, steering against time)
+and any further figures the section brings. Tables of text (`ReportTable`, e.g. the paper's statements beside our
+numbers) may come before the sections.
+
+The page, its tables of text and its embedded figures (`html_page`, `text_table`, `png_figure`) are also what
+`workbench paper` writes its index with.
 """
 
 from __future__ import annotations
@@ -13,15 +19,19 @@ import base64
 import html
 import io
 import math
-from collections.abc import Sequence
-from dataclasses import dataclass
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
 from datetime import UTC, datetime
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import pandas as pd
 
-from workbench.apps.comparison import FIGURES, Comparison
+from workbench.apps.comparison import CONVERGED_CTE_M, FIGURES, Comparison
 from workbench.simulation.limit_cycle import LimitCycle
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
 
 #: Summary columns shown in the report, with their headings (the CSV keeps every column).
 TABLE_COLUMNS: tuple[tuple[str, str], ...] = (
@@ -30,7 +40,7 @@ TABLE_COLUMNS: tuple[tuple[str, str], ...] = (
     ("status", "status"),
     ("max_abs_cte_m", "max |CTE| (m)"),
     ("rms_cte_m", "RMS CTE (m)"),
-    ("converge_distance_m", "converged within 0.1 m after (m)"),
+    ("converge_distance_m", f"converged within {CONVERGED_CTE_M:g} m after (m)"),
     ("max_abs_steer_wheel_deg", "max |steering wheel| (deg)"),
     ("max_abs_steer_rate_deg_s", "max |steering rate| (deg/s)"),
     ("rms_steer_rate_deg_s", "RMS steering rate (deg/s)"),
@@ -43,24 +53,54 @@ TABLE_COLUMNS: tuple[tuple[str, str], ...] = (
     ("step_time_p99_us", "step p99 (µs)"),
     ("step_time_ratio", "step time / clothoid's"),
 )
+#: Resolution of the embedded figures (dots per inch): a figure of 8 x 4.5 in is 800 x 450 pixels, shown at that
+#: size (one to a row) so that its legend reads as it was drawn.
+FIGURE_DPI = 100
 
 _STYLE = """
 body { font-family: system-ui, sans-serif; margin: 2em auto; max-width: 72em; color: #222; }
 table { border-collapse: collapse; margin: 1em 0; font-size: 0.9em; }
 th, td { border: 1px solid #bbb; padding: 0.3em 0.6em; text-align: right; }
 th { background: #eee; } td:nth-child(-n+3) { text-align: left; }
-figure { display: inline-block; margin: 0.5em; } img { max-width: 34em; }
+table.text td { text-align: left; vertical-align: top; }
+figure { display: block; margin: 1em 0; } img { max-width: 100%; }
+figcaption { font-size: 0.9em; color: #444; }
 .failed, .warning { color: #b00; }
 """
 
 
 @dataclass(frozen=True)
+class ReportFigure:
+    """A further figure of a section: its caption (plain) and what draws it (the figure is closed once embedded)."""
+
+    caption: str
+    draw: Callable[[], Figure]
+
+
+@dataclass(frozen=True)
+class ReportTable:
+    """A table of text before the sections: heading, explanatory text (plain) and its rows (every cell as text)."""
+
+    heading: str
+    text: str
+    frame: pd.DataFrame
+
+
+@dataclass(frozen=True)
 class ReportSection:
-    """heading, explanatory text (plain), and the comparison it shows."""
+    """heading, explanatory text (plain), and the comparison it shows.
+
+    summary: the table to show instead of the comparison's own `summary()` (the same rows, e.g. with ratios taken
+    from a larger comparison, or with further columns; the text then says what its step-time ratios divide by);
+    columns: the summary columns shown, with their headings; figures: further figures after the four comparison
+    figures."""
 
     heading: str
     text: str
     comparison: Comparison
+    summary: pd.DataFrame | None = None
+    columns: tuple[tuple[str, str], ...] = TABLE_COLUMNS
+    figures: tuple[ReportFigure, ...] = field(default=())
 
 
 def _cell(value: object) -> str:
@@ -71,12 +111,14 @@ def _cell(value: object) -> str:
     return html.escape(str(value))
 
 
-def _table(summary: pd.DataFrame, cycles: Sequence[LimitCycle]) -> str:
-    head = "".join(f"<th>{html.escape(title)}</th>" for _, title in TABLE_COLUMNS)
+def _table(summary: pd.DataFrame, cycles: Sequence[LimitCycle], columns: Sequence[tuple[str, str]]) -> str:
+    head = "".join(f"<th>{html.escape(title)}</th>" for _, title in columns)
     rows = []
     for (_, row), cycle in zip(summary.iterrows(), cycles, strict=True):
         cls = "" if row["status"] == "completed" else ' class="failed"'
-        values = {key: row.get(key) for key, _ in TABLE_COLUMNS} | {"limit_cycle": cycle.brief()}
+        values = {key: row.get(key) for key, _ in columns}
+        if "limit_cycle" in values:
+            values["limit_cycle"] = cycle.brief()
         cells = "".join(f"<td>{_cell(value)}</td>" for value in values.values())
         rows.append(f"<tr{cls}>{cells}</tr>")
     failed = summary[summary["status"] != "completed"]
@@ -87,18 +129,34 @@ def _table(summary: pd.DataFrame, cycles: Sequence[LimitCycle]) -> str:
     return f"<table><tr>{head}</tr>{''.join(rows)}</table>{notes}"
 
 
-def _png(comparison: Comparison, method: str) -> str:
+def text_table(frame: pd.DataFrame) -> str:
+    """A table of text cells (escaped), its columns as headings; NaN shows as a dash."""
+    head = "".join(f"<th>{html.escape(str(c))}</th>" for c in frame.columns)
+    rows = "".join(
+        "<tr>" + "".join(f"<td>{_cell(v)}</td>" for v in row) + "</tr>" for row in frame.itertuples(index=False)
+    )
+    return f"<table class='text'><tr>{head}</tr>{rows}</table>"
+
+
+def png_figure(png: bytes, caption: str) -> str:
+    """A figure element with the PNG embedded (base64) and its caption (plain) as alt text and caption."""
+    alt = html.escape(caption)
+    data = base64.b64encode(png).decode("ascii")
+    return f'<figure><img alt="{alt}" src="data:image/png;base64,{data}"><figcaption>{alt}</figcaption></figure>'
+
+
+def figure_png(fig: Figure) -> bytes:
+    """The figure as PNG at FIGURE_DPI; the figure is closed."""
     import matplotlib.pyplot as plt
 
-    ax = getattr(comparison, method)()
     buffer = io.BytesIO()
-    ax.figure.savefig(buffer, format="png", dpi=100)
-    plt.close(ax.figure)
-    return base64.b64encode(buffer.getvalue()).decode("ascii")
+    fig.savefig(buffer, format="png", dpi=FIGURE_DPI)
+    plt.close(fig)
+    return buffer.getvalue()
 
 
-def render_report(title: str, sections: Sequence[ReportSection], intro: str = "") -> str:
-    """The report as one HTML document."""
+def html_page(title: str, body: Sequence[str], intro: str = "") -> str:
+    """A whole HTML document: the title, the intro (plain), when it was generated, then the body's parts (HTML)."""
     parts = [
         "<!DOCTYPE html>",
         '<html lang="en"><head><meta charset="utf-8">',
@@ -106,42 +164,110 @@ def render_report(title: str, sections: Sequence[ReportSection], intro: str = ""
         f"<h1>{html.escape(title)}</h1>",
         f"<p>{html.escape(intro)}</p>" if intro else "",
         f"<p><small>Generated {datetime.now(UTC):%Y-%m-%d %H:%M} UTC by the lateral-control workbench.</small></p>",
+        *body,
+        "</body></html>",
     ]
-    for section in sections:
-        c = section.comparison
-        parts.append(f"<h2>{html.escape(section.heading)}</h2>")
-        if section.text:
-            parts.append(f"<p>{html.escape(section.text)}</p>")
-        cfg = c.config
-        parts.append(
-            f"<p>Scenario <b>{html.escape(c.scenario.name)}</b> ({html.escape(c.scenario.description)}); target "
-            f"speed {cfg.speed_kmh:g} km/h, lateral-acceleration bound {cfg.max_lateral_accel_g:g} g, controllers "
-            f"at {cfg.controller_rate_hz:g} Hz, plant at {cfg.plant_rate_hz:g} Hz.</p>"
-        )
-        cycles = c.limit_cycles()
-        parts.append(_table(c.summary(), cycles))
-        parts += [
-            f"<p class='warning'>Limit cycle: {html.escape(spec.label)} oscillates at {html.escape(cycle.describe())}"
-            ".</p>"
-            for spec, cycle in zip(c.specs, cycles, strict=True)
-            if cycle.detected
-        ]
-        for name, method in FIGURES:
-            alt = html.escape(f"{section.heading}: {name.removesuffix('.png').replace('_', ' ')}")
-            parts.append(
-                f'<figure><img alt="{alt}" src="data:image/png;base64,{_png(c, method)}"><figcaption>{alt}'
-                "</figcaption></figure>"
-            )
-    parts.append("</body></html>")
     return "\n".join(p for p in parts if p)
 
 
-def write_report(path: str | Path, title: str, sections: Sequence[ReportSection], intro: str = "") -> Path:
+def _courses(c: Comparison) -> str:
+    """The course of the runs: the scenario and its description when every vehicle ran the same one, else the
+    scenario's name and each course (its lanes and cones) with the vehicles that ran it."""
+    by_course: dict[str, list[str]] = {}
+    for spec, result in zip(c.specs, c.results, strict=True):
+        vehicles = by_course.setdefault(result.scenario.description, [])
+        if spec.vehicle not in vehicles:
+            vehicles.append(spec.vehicle)
+    name = html.escape(c.scenario.name)
+    if len(by_course) == 1:
+        return f"<p>Scenario <b>{name}</b> ({html.escape(c.scenario.description)}).</p>"
+    items = "".join(
+        f"<li>for {html.escape(', '.join(vehicles))}: {html.escape(description)}</li>"
+        for description, vehicles in by_course.items()
+    )
+    return f"<p>Scenario <b>{name}</b>, a course for each vehicle:</p><ul>{items}</ul>"
+
+
+def _ratio_note(summary: pd.DataFrame, reference: str | None) -> str:
+    """What the step-time ratio divides by: the reference controller's median on the same vehicle, and where the
+    reference did not run on a vehicle, the median of all its runs (`comparison.step_time_ratios`)."""
+    if reference is None or "step_time_ratio" not in summary or reference not in set(summary["controller"]):
+        return ""
+    own = set(summary.loc[summary["controller"] == reference, "vehicle"])
+    without = [v for v in dict.fromkeys(summary["vehicle"]) if v not in own]
+    note = f"Step time / {reference}'s: each run's median step time over the {reference} controller's on its vehicle"
+    if without:
+        note += f" (on {', '.join(without)}, where it did not run: over the median of all its runs)"
+    return f"<p><small>{html.escape(note)}.</small></p>"
+
+
+def _section(section: ReportSection) -> list[str]:
+    c = section.comparison
+    summary = c.summary() if section.summary is None else section.summary
+    cfg = c.config
+    parts = [f"<h2>{html.escape(section.heading)}</h2>"]
+    if section.text:
+        parts.append(f"<p>{html.escape(section.text)}</p>")
+    parts.append(_courses(c))
+    parts.append(
+        f"<p>Target speed {cfg.speed_kmh:g} km/h, lateral-acceleration bound {cfg.max_lateral_accel_g:g} g, "
+        f"controllers at {cfg.controller_rate_hz:g} Hz, plant at {cfg.plant_rate_hz:g} Hz.</p>"
+    )
+    cycles = c.limit_cycles()
+    parts.append(_table(summary, cycles, section.columns))
+    if section.summary is None and any(key == "step_time_ratio" for key, _ in section.columns):
+        parts.append(_ratio_note(summary, c.reference_controller))
+    parts += [
+        f"<p class='warning'>Limit cycle: {html.escape(spec.label)} oscillates at {html.escape(cycle.describe())}.</p>"
+        for spec, cycle in zip(c.specs, cycles, strict=True)
+        if cycle.detected
+    ]
+    for name, method in FIGURES:
+        caption = f"{section.heading}: {name.removesuffix('.png').replace('_', ' ')}"
+        parts.append(png_figure(figure_png(getattr(c, method)().figure), caption))
+    parts += [png_figure(figure_png(f.draw()), f"{section.heading}: {f.caption}") for f in section.figures]
+    return parts
+
+
+def render_report(
+    title: str, sections: Sequence[ReportSection], intro: str = "", tables: Sequence[ReportTable] = ()
+) -> str:
+    """The report as one HTML document: the tables of text, then the sections."""
+    body: list[str] = []
+    for table in tables:
+        body.append(f"<h2>{html.escape(table.heading)}</h2>")
+        if table.text:
+            body.append(f"<p>{html.escape(table.text)}</p>")
+        body.append(text_table(table.frame))
+    for section in sections:
+        body += _section(section)
+    return html_page(title, body, intro)
+
+
+def write_report(
+    path: str | Path,
+    title: str,
+    sections: Sequence[ReportSection],
+    intro: str = "",
+    tables: Sequence[ReportTable] = (),
+) -> Path:
     """Write the report to `path` (its directory is created); return the path."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(render_report(title, sections, intro), encoding="utf-8")
+    path.write_text(render_report(title, sections, intro, tables), encoding="utf-8")
     return path
 
 
-__all__ = ["ReportSection", "render_report", "write_report"]
+__all__ = [
+    "FIGURE_DPI",
+    "TABLE_COLUMNS",
+    "ReportFigure",
+    "ReportSection",
+    "ReportTable",
+    "figure_png",
+    "html_page",
+    "png_figure",
+    "render_report",
+    "text_table",
+    "write_report",
+]

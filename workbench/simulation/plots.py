@@ -84,11 +84,31 @@ def steering_vs_time(result: PlottedRun, ax: Axes | None = None) -> Axes:
     return ax
 
 
+#: A speed axis spans at least twice the larger of these about its curves' middle (km/h, and a fraction of the mean
+#: speed): at a constant 30 km/h the speed controller's few m/h would otherwise fill the plot like real swings.
+SPEED_AXIS_MIN_HALF_SPAN_KMH = 1.0
+SPEED_AXIS_MIN_HALF_SPAN_FRACTION = 0.05
+
+
+def _at_least_speed_span(ax: Axes) -> None:
+    """Widen the speed axis to its minimum span (centred on the curves' range) when the curves span less."""
+    speeds = np.concatenate([np.asarray(line.get_ydata(), dtype=float) for line in ax.get_lines()])
+    speeds = speeds[np.isfinite(speeds)]
+    if speeds.size == 0:
+        return
+    low, high = float(speeds.min()), float(speeds.max())
+    half = max(SPEED_AXIS_MIN_HALF_SPAN_KMH, SPEED_AXIS_MIN_HALF_SPAN_FRACTION * abs(float(speeds.mean())))
+    if high - low < 2.0 * half:
+        middle = 0.5 * (low + high)
+        ax.set_ylim(middle - half, middle + half)
+
+
 def speed_vs_distance(result: PlottedRun, ax: Axes | None = None) -> Axes:
     ax = _axes(ax)
     d = _distance(result)
     ax.plot(d, result.trace["speed_ref_mps"] * 3.6, "k--", lw=1.0, label="planned")
     ax.plot(d, result.trace["speed_mps"] * 3.6, lw=1.5, label="actual")
+    _at_least_speed_span(ax)
     ax.set(xlabel="distance along path (m)", ylabel="speed (km/h)", title="Speed")
     ax.legend(loc="best", fontsize="small")
     return ax
@@ -117,21 +137,43 @@ def save_run_plots(result: PlottedRun, out_dir: Path) -> list[Path]:
 
 
 # ---------------------------------------------------------------------------------------------- several runs
-def _draw_reference(result: PlottedRun, ax: Axes) -> None:
+#: How each course of a comparison is drawn, in turn: the reference's colour and line style, the cones' colour.
+COURSE_STYLES: tuple[tuple[str, str, str], ...] = (
+    ("k", "--", "tab:red"),
+    ("tab:gray", "-.", "tab:gray"),
+    ("tab:brown", ":", "tab:brown"),
+)
+
+
+def _draw_reference(
+    result: PlottedRun, ax: Axes, whose: str = "", style: tuple[str, str, str] = COURSE_STYLES[0]
+) -> None:
+    """The path and cones of the run's scenario; whose: the vehicles that ran it, named in the legend when a plot
+    shows several courses."""
     path = result.path
-    ax.plot(path.x_m, path.y_m, "k--", lw=1.0, label="reference")
+    suffix = f" ({whose})" if whose else ""
+    colour, line, cone_colour = style
+    ax.plot(path.x_m, path.y_m, color=colour, ls=line, lw=1.0, label=f"reference{suffix}")
     cones = result.scenario.cones_xy
     if cones is not None:
-        ax.plot(cones[:, 0], cones[:, 1], "^", color="tab:red", ms=5, label="cones")
+        ax.plot(cones[:, 0], cones[:, 1], "^", color=cone_colour, ms=5, label=f"cones{suffix}")
     width, height = np.ptp(path.x_m), np.ptp(path.y_m)
     if min(width, height) > 0.25 * max(width, height):  # true shape unless the path is long and thin (a DLC)
         ax.set_aspect("equal", adjustable="datalim")
 
 
 def trajectories(results: Sequence[PlottedRun], labels: Sequence[str], ax: Axes | None = None) -> Axes:
-    """Figure 17a: each run's rear-axle path over the reference."""
+    """Figure 17a: each run's rear-axle path over the reference and cones of the course it ran: one course when
+    every run ran the same, else each (a dlc is sized for its vehicle's width), named by the vehicles that ran it."""
     ax = _axes(ax)
-    _draw_reference(results[0], ax)
+    courses: dict[str, tuple[PlottedRun, list[str]]] = {}
+    for result in results:
+        _, vehicles = courses.setdefault(result.scenario.description, (result, []))
+        if result.vehicle not in vehicles:
+            vehicles.append(result.vehicle)
+    for k, (first, vehicles) in enumerate(courses.values()):
+        whose = ", ".join(vehicles) if len(courses) > 1 else ""
+        _draw_reference(first, ax, whose, COURSE_STYLES[k % len(COURSE_STYLES)])
     for result, label in zip(results, labels, strict=True):
         ax.plot(result.trace["x_m"], result.trace["y_m"], lw=1.3, label=label)
     ax.set(xlabel="x (m)", ylabel="y (m)", title=f"{results[0].scenario.name}: tracked trajectories (rear axle)")
@@ -156,6 +198,7 @@ def speed_comparison(results: Sequence[PlottedRun], labels: Sequence[str], ax: A
     ax.plot(_distance(results[0]), results[0].trace["speed_ref_mps"] * 3.6, "k--", lw=1.0, label="planned")
     for result, label in zip(results, labels, strict=True):
         ax.plot(_distance(result), result.trace["speed_mps"] * 3.6, lw=1.3, label=label)
+    _at_least_speed_span(ax)
     ax.set(xlabel="distance along path (m)", ylabel="speed (km/h)", title="Speed")
     ax.legend(loc="best", fontsize="small")
     return ax

@@ -1,16 +1,22 @@
-"""`workbench paper`: every figure file is written, and the table puts our numbers beside the paper's."""
+"""`workbench paper`: every figure file is written, the table puts our numbers beside the paper's, and report.html
+shows every figure under the paper's caption, self-contained; a progress line counts the steps."""
 
 from __future__ import annotations
 
+import base64
+import html
+import re
 from pathlib import Path
 
 import pandas as pd
 import pytest
 
 from workbench.apps.cli import main
-from workbench.apps.paper import PAPER_REPORTS, TRACKING_FIGURES
+from workbench.apps.paper import PAPER_FIGURES, PAPER_REPORTS, TRACKING_FIGURES, figure_number
 
 TRACK = Path(__file__).resolve().parents[4] / "shared" / "tracks" / "Zandvoort_track.csv"
+#: The steps the progress line counts: four figure groups, a run per scenario, then Figures 11-16 and the report.
+STEPS = {False: 4 + 2 + 1, True: 4 + 3 + 1}
 
 
 @pytest.mark.parametrize("with_track", [False, True])
@@ -18,9 +24,11 @@ def test_paper_writes_every_figure_and_the_table(with_track: bool, tmp_path: Pat
     monkeypatch.delenv("WORKBENCH_ZANDVOORT_CSV", raising=False)
     if with_track and not TRACK.is_file():
         pytest.skip(f"TUMFTM Zandvoort_track.csv not found at {TRACK} (third-party data kept outside the repo)")
+    monkeypatch.setattr("sys.stderr.isatty", lambda: True)  # a terminal: the CLI shows its progress line
     args = ["paper", "--out", str(tmp_path)] + (["--track", str(TRACK)] if with_track else [])
     assert main(args) == 0
-    out = capsys.readouterr().out
+    captured = capsys.readouterr()
+    out = captured.out
     expected = ["fig04b", "fig05b", "fig06", "fig07", "fig08", "fig09", "fig10"]
     expected += [f"fig{n}{suffix}_{scenario}" for n, scenario, _, suffix in TRACKING_FIGURES]
     written = {p.stem for p in tmp_path.glob("*.png")}
@@ -37,3 +45,22 @@ def test_paper_writes_every_figure_and_the_table(with_track: bool, tmp_path: Pat
     assert 12 < table.loc["figure8 speed at the largest curvature rate", "ours"] < 22  # mph; the paper: about 17
     assert pd.isna(table.loc["zandvoort max |CTE|", "ours"]) != with_track
     assert ("skipped: Figures 15-16" in out) != with_track
+    assert f"paper:   0%|          | 0/{STEPS[with_track]} " in captured.err
+    for step in ("Figures 4b-5b", "Figures 8-10", "figure8 run", "dlc run", "Figures 11-16 and report.html"):
+        assert step in captured.err
+    assert ("zandvoort run" in captured.err) == with_track
+
+    # report.html: every PNG written, embedded, under its figure's caption; nothing outside the file
+    report = (tmp_path / "report.html").read_text(encoding="utf-8")
+    pngs = sorted(tmp_path.glob("*.png"))
+    sources = re.findall(r'src="([^"]*)"', report)
+    assert len(sources) == len(pngs) and all(s.startswith("data:image/png;base64,") for s in sources)
+    assert {base64.b64decode(s.split(",", 1)[1]) for s in sources} == {p.read_bytes() for p in pngs}
+    assert all(h.startswith("#") for h in re.findall(r"href='([^']*)'", report))  # links within the page only
+    for number in {figure_number(p) for p in pngs}:
+        caption, said = PAPER_FIGURES[number]
+        assert f"<h2 id='fig{number}'>Figure {number}</h2>" in report
+        assert html.escape(caption) in report and html.escape(said) in report
+    assert ("Figure 15</h2>" in report) == with_track and ("Skipped: Figures 15-16" in report) != with_track
+    for quantity, (reported, _) in PAPER_REPORTS.items():  # under its figure (if drawn), our number beside it
+        assert (html.escape(f"{quantity}: {reported}") in report) == (with_track or "zandvoort" not in quantity)
