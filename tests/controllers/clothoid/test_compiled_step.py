@@ -1,14 +1,14 @@
 """The compiled step (`step_kernel.py`) against the Python step it replaced: the recorded runs of
-tests/controllers/clothoid/replay (`cases.py`, recorded with the Python step of commit b614e88) replayed through
+tests/controllers/clothoid/replay (`replay_cases.py`, recorded with the Python step of commit b614e88) replayed through
 today's controller, measurement by measurement, give the same commands and diagnostics to 1e-12."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
+from replay_cases import CASES, ZANDVOORT_CSV
 
 from controllers.base import Measurement
-from tests.controllers.clothoid.replay.cases import CASES, ZANDVOORT_CSV
 
 #: Agreement asked of the replay: absolute, and relative to each diagnostic's own scale.
 TOLERANCE = 1e-12

@@ -1,7 +1,7 @@
 """Recorded clothoid-controller runs that `test_compiled_step.py` replays: each case names a scenario, a vehicle,
-the conditions and the controller's options; `record.py` ran it through the Python step of commit b614e88 (before
-issue 19 compiled the step) and stored, per step, the measurement the controller saw, the command it returned and
-its diagnostics (`<name>.npz`). Between them they take every branch of the step: each lookahead mode, each
+the conditions and the controller's options; `record_replays.py` ran it through the Python step of commit b614e88
+(before issue 19 compiled the step) and stored, per step, the measurement the controller saw, the command it returned
+and its diagnostics (`replay/<name>.npz`). Between them they take every branch of the step: each lookahead mode, each
 initial curvature and heading, both threshold modes, with and without feed-forward, lead filter, tuning, ceiling,
 known delay and noise."""
 
@@ -20,7 +20,7 @@ from workbench.simulation.scenarios import ScenarioOptions, make_scenario
 from workbench.simulation.simulator import Simulation, SimulationConfig
 from workbench.vehicles import make_vehicle
 
-HERE = Path(__file__).resolve().parent
+HERE = Path(__file__).resolve().parent / "replay"
 ZANDVOORT_CSV = HERE.parents[4] / "shared" / "tracks" / "Zandvoort_track.csv"
 
 

@@ -1,4 +1,4 @@
-"""Records the replay cases (`cases.py`): python tests/controllers/clothoid/replay/record.py [NAME ...].
+"""Records the replay cases (`replay_cases.py`): python tests/controllers/clothoid/record_replays.py [NAME ...].
 
 Each case is simulated with the controller's step wrapped to record what it saw and returned; the file holds
 `measurements` (n, 8: t, x, y, vx, vy, yaw, yaw rate, steering wheel), `commands` (n,), `diagnostics` (n, k) and
@@ -10,8 +10,7 @@ from __future__ import annotations
 import sys
 
 import numpy as np
-
-from tests.controllers.clothoid.replay.cases import CASES, ZANDVOORT_CSV
+from replay_cases import CASES, ZANDVOORT_CSV
 
 
 def record(case) -> None:
