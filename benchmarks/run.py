@@ -1,9 +1,9 @@
-"""Speed benchmarks: controller steps, path projection, plant integration and whole simulations.
+"""Speed benchmarks: controller steps, path projection, plant integration, whole simulations and a whole command.
 
 Prints a table and writes JSON (median, p99, real-time factor). Goals live here, not in timed tests; each entry
 names its goal, and `--check` exits non-zero when a goal is missed.
 
-    python benchmarks/run.py [--out benchmarks/results/latest.json] [--track ZANDVOORT.csv] [--check]
+    python benchmarks/run.py [--out benchmarks/results/latest.json] [--track ZANDVOORT.csv] [--cli-runs 3] [--check]
 """
 
 from __future__ import annotations
@@ -13,13 +13,17 @@ import json
 import os
 import platform
 import resource
+import statistics
+import subprocess
 import sys
+import tempfile
 import time
 from collections.abc import Callable
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 
 from controllers import CONTROLLERS
 from controllers.base import Controller, Measurement
@@ -177,6 +181,47 @@ def bench_simulator_overhead(vehicle_name: str, plant_us: float, goal_us: float 
     )
 
 
+#: Issue 19's goal for the whole command: the loaded truck's Zandvoort lap under pure pursuit, `workbench run` in a
+#: fresh process with its plots, at least this many times real time.
+CLI_LAP_GOAL_RTF = 150.0
+
+
+def bench_cli_lap(track: Path, runs: int = 3) -> Entry:
+    """The loaded truck's Zandvoort lap under pure pursuit as a person runs it, `workbench run ... --overwrite` with
+    its plots: the wall time of the whole process (start-up, simulation, trace, metrics and plots; the median of
+    `runs` after one untimed run that leaves numba's caches warm) against the simulated time."""
+    name = "zandvoort: pure-pursuit on tractor-semitrailer, `workbench run` end to end with plots"
+    workbench = Path(sys.executable).parent / "workbench"  # the console script, run by this interpreter
+    with tempfile.TemporaryDirectory(prefix="bench-cli-") as tmp:
+        out = Path(tmp) / "lap"
+        argv = [
+            sys.executable, str(workbench), "run", "zandvoort", "--controller", "pure-pursuit",
+            "--vehicle", "tractor-semitrailer", "--track", str(track), "--out", str(out), "--overwrite",
+        ]  # fmt: skip
+        walls = []
+        for k in range(runs + 1):
+            start = time.perf_counter()
+            done = subprocess.run(argv, capture_output=True, text=True, check=False)
+            wall = time.perf_counter() - start
+            if done.returncode != 0:
+                return Entry(name, note=f"failed (exit {done.returncode}): {done.stderr.strip()[-300:]}")
+            if k:  # the first run warms the caches
+                walls.append(wall)
+        simulated = float(pd.read_parquet(out / "trace.parquet", columns=["t_s"])["t_s"].iloc[-1])
+        plots = len(list(out.glob("*.png")))
+    wall = statistics.median(walls)
+    rtf = simulated / wall
+    return Entry(
+        name,
+        real_time_factor=rtf,
+        wall_s=wall,
+        simulated_s=simulated,
+        goal=f"real-time factor >= {CLI_LAP_GOAL_RTF:g} (issue 19)",
+        goal_met=rtf >= CLI_LAP_GOAL_RTF,
+        note=f"median of {runs} runs, {min(walls):.2f}-{max(walls):.2f} s wall; {plots} plots",
+    )
+
+
 def step_ratios(entries: list[Entry], scenarios: list[str], goal: float = 20.0) -> list[Entry]:
     """Per scenario, the NMPC's and the LTV-MPC's step medians over the clothoid controller's, on the truck, from
     the runs of this benchmark (issue 19's goal: NMPC / clothoid >= 20)."""
@@ -210,8 +255,11 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", type=Path, default=Path(__file__).parent / "results" / "latest.json")
     parser.add_argument("--track", type=Path, default=None, help="Zandvoort CSV (default: env or ../shared)")
+    parser.add_argument("--cli-runs", type=int, default=3, metavar="N", help="timed runs of the command (default 3)")
     parser.add_argument("--check", action="store_true", help="exit 1 if a goal is missed")
     args = parser.parse_args(argv)
+    if args.cli_runs < 1:
+        parser.error("--cli-runs must be >= 1")
     track = args.track or (Path(os.environ[ZANDVOORT_ENV]) if os.environ.get(ZANDVOORT_ENV) else DEFAULT_TRACK)
     options = ScenarioOptions(track_file=track if track.is_file() else None)
     scenarios = ["dlc", "figure8", "fig17"] + (["zandvoort"] if options.track_file else [])
@@ -233,6 +281,8 @@ def main(argv: list[str] | None = None) -> int:
         # 19's: >= 500x.
         goal = 500.0 if name == "zandvoort" else None
         entries.append(bench_run(name, "pure-pursuit", "tractor-semitrailer", options, goal_rtf=goal))
+    if options.track_file:  # issue 19's: the same lap >= 150x real time as a command, start-up and plots included
+        entries.append(bench_cli_lap(options.track_file, args.cli_runs))
 
     # Issue 4's goals: the clothoid controller's step (adaptive search included) median <= 100 us; the loaded truck
     # at 30 km/h within 0.2 m on figure8 and zandvoort and 0.1 m on the dlc; the lead filter helps on the dlc.

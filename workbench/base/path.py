@@ -28,6 +28,7 @@ from workbench.base.path_search import (
     TRACK_STATE_SIZE,
     closest_in_window,
     first_beyond,
+    slope_at,
     track,
     value_at,
 )
@@ -276,9 +277,8 @@ class ReferencePath:
         """
         if self.speed_mps is None:
             return None
-        if isinstance(s_m, float | int):
-            i = min(int(self.wrap_s(s_m) / self.spacing_m), self.speed_mps.size - 2)
-            return float((self.speed_mps[i + 1] - self.speed_mps[i]) / self.spacing_m)
+        if isinstance(s_m, float | int):  # the per-step case, compiled (`path_search.slope_at`)
+            return slope_at(self.speed_mps, float(s_m), self.spacing_m, self.length_m, self.closed)
         i = np.minimum((self.wrap_s(np.asarray(s_m, dtype=float)) / self.spacing_m).astype(int), self.s_m.size - 2)
         return np.diff(self.speed_mps)[i] / self.spacing_m
 

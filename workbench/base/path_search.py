@@ -191,3 +191,12 @@ def value_at(values: np.ndarray, s: float, spacing: float, length: float, closed
     position = s / spacing
     i = min(int(position), values.size - 2)
     return values[i] + (position - i) * (values[i + 1] - values[i])
+
+
+@njit(cache=True)
+def slope_at(values: np.ndarray, s: float, spacing: float, length: float, closed: bool) -> float:
+    """d(values)/ds at arc length s (per m): the slope of `value_at`'s interpolation, constant between two samples,
+    the segment ahead at a sample."""
+    s = s % length if closed else min(max(s, 0.0), length)
+    i = min(int(s / spacing), values.size - 2)
+    return (values[i + 1] - values[i]) / spacing

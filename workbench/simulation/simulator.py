@@ -13,13 +13,14 @@ the end point, never the sideways offset from the end's tangent alone.
 from __future__ import annotations
 
 import math
+import operator
 import time
 
 import numpy as np
 from tqdm import tqdm
 
 from workbench.base.errors import WorkbenchInputError
-from workbench.base.path import ReferencePath, wrap_angle
+from workbench.base.path import ReferencePath
 from workbench.simulation.control_interface import (
     COMMAND_REJECTED,
     MEASUREMENT_REJECTED,
@@ -32,6 +33,21 @@ from workbench.simulation.scenarios import Scenario
 from workbench.simulation.sensing import ActuatorModel, SensorModel
 from workbench.simulation.speed_control import PISpeedController, PISpeedGains
 from workbench.simulation.speed_profile import G_MPS2, SpeedLimits, plan_speed_profile
+from workbench.simulation.step_kernel import (
+    FOOT_AT_END,
+    FOOT_DISTANCE,
+    FOOT_PAST_END,
+    FOOT_PROGRESS,
+    FOOT_S,
+    PROJECTED_NOT_FINITE,
+    PROJECTED_OFF_PATH,
+    PROJECTED_PAST_END,
+    SIGNALS,
+    finish_step,
+    path_table,
+    project_pose,
+    run_settings,
+)
 from workbench.vehicles.base import VehicleModel
 
 #: Spacing (m) of the points the speed profile is planned on (the paper plans on its waypoints).
@@ -39,6 +55,9 @@ SPEED_PLAN_SPACING_M = 1.0
 #: A run that may take more controller steps than this before its time-out is announced with a warning (at 50 Hz
 #: about 83 simulated minutes; a dlc at 30 km/h may take 5 700, a Zandvoort lap 79 000).
 LONG_RUN_STEPS = 250_000
+#: The first seven of a vehicle's outputs (`STANDARD_OUTPUTS`: x, y, yaw, vx, vy, yaw rate, steering-wheel angle),
+#: what the measurement holds: indexed, as numpy scalars, at half the cost of unpacking a slice.
+_MEASURED = operator.itemgetter(0, 1, 2, 3, 4, 5, 6)
 #: Trace columns besides the vehicle's outputs, estimated generously for the trace-size warning: the simulator's
 #: 11 signals and up to 29 controller diagnostics (`ctrl_*`).
 EXTRA_TRACE_COLUMNS = 40
@@ -152,6 +171,9 @@ class Simulation:
         return math.ceil(self.max_time_s * self.config.controller_rate_hz) + 1
 
     def run(self, progress: bool = False) -> SimulationResult:
+        """Simulate until the run ends (the module docstring says how); `progress` shows the metres covered on a bar.
+        The simulator's own work at each step is compiled (`step_kernel`): Python calls the plant, the conditions'
+        models and the controller, and builds the measurement."""
         cfg, path, vehicle, controller = self.config, self.path, self.vehicle, self.controller
         dt = 1.0 / cfg.controller_rate_hz
         total_length = self.total_length_m
@@ -172,9 +194,12 @@ class Simulation:
         if getattr(vehicle, "road_friction", 1.0) != friction:
             vehicle.set_road_friction(friction)
         seen = not conditions.is_ideal
-        speed_controller = PISpeedController(PISpeedGains())
+        speed_gains = PISpeedGains()
+        settings = run_settings(  # the kernels' constants and the PI speed controller's state
+            tracker, cfg.max_past_end_m, cfg.max_abs_cte_m, total_length, dt, cfg.speed_feedforward, speed_gains
+        )
 
-        log = _TraceLog(vehicle.output_names, controller.diagnostic_names, max_steps)
+        log = _TraceLog(vehicle.output_names, controller.diagnostic_names, max_steps, seen)
         diagnostics = controller.diagnostic_values  # the controller's own array, rewritten by each step
         measurement_rejected = controller.diagnostic_names.index(MEASUREMENT_REJECTED)
         command_rejected = controller.diagnostic_names.index(COMMAND_REJECTED)
@@ -182,44 +207,39 @@ class Simulation:
         steer_cmd = accel_cmd = applied_cmd = 0.0
         held, first_held = 0, ""  # steps whose measurement the controller's screen rejected (it held its command)
         bar = tqdm(total=round(total_length), unit="m", delay=2.0, disable=not progress, leave=False)
+        # The hot loop's names, looked up once; the compiled per-step work (`step_kernel`) reads the path's samples
+        # from one table and writes the tracker's arrays and the trace's table in place.
+        outputs, advance, step_controller = vehicle.outputs, vehicle.advance, controller.step
+        clock, hypot, isfinite, measured = time.perf_counter, math.hypot, math.isfinite, _MEASURED
+        samples, track_state, foot = path_table(path), tracker.state, tracker.out
+        substeps = cfg.substeps
+        table = log.table
         t = 0.0
         for step in range(max_steps):
-            out = vehicle.outputs(state, applied_cmd, accel_cmd)
-            x, y, yaw, vx, vy, yaw_rate, steer_wheel = out[:7]
+            out = outputs(state, applied_cmd, accel_cmd)
+            x, y, yaw, vx, vy, yaw_rate, steer_wheel = measured(out)
             if step == 0 and actuator is not None:
                 actuator.reset(float(steer_wheel))
-            foot = tracker.update(x, y)
-            if road_varies:  # foot.s_m is the arc length on the path, within a lap on a closed one
-                friction = road.friction_at(foot.s_m)
+            where = project_pose(x, y, samples, track_state, foot, settings)
+            if where == PROJECTED_NOT_FINITE:
+                tracker.update(x, y)  # raises the tracker's own error
+            if road_varies:  # the foot point's arc length on the path, within a lap on a closed one
+                friction = road.friction_at(float(foot[FOOT_S]))
                 vehicle.set_road_friction(friction)
-            if foot.past_end_m > cfg.max_past_end_m:
-                end = "end" if foot.at_end else "start"
-                status = Status.LEFT_PATH
-                message = (
-                    f"went {foot.past_end_m:.1f} m past the {end} of the path (max_past_end_m = "
-                    f"{cfg.max_past_end_m:g} m) at t = {t:.2f} s, {foot.distance_m:.1f} m from it"
-                )
-                break
-            if foot.distance_m > cfg.max_abs_cte_m:
-                status = Status.LEFT_PATH
-                message = (
-                    f"|CTE| = {foot.distance_m:.1f} m exceeds max_abs_cte_m = {cfg.max_abs_cte_m:g} m at t = {t:.2f} s"
-                )
-                break
-            if (foot.at_end and not path.closed) or foot.progress_m >= total_length:
-                status, message = Status.COMPLETED, "completed"
+            if where:
+                status, message = _projection_end(where, foot.tolist(), t, cfg)
                 break
             measurement = Measurement(t, x, y, vx, vy, yaw, yaw_rate, steer_wheel)
             if sensors is not None:
                 measurement = sensors.measure(measurement)
-            start = time.perf_counter()
+            start = clock()
             try:
-                steer_cmd = controller.step(measurement, path)
+                steer_cmd = step_controller(measurement, path)
             except Exception as exc:  # reported in the result, never hidden
                 status, message = Status.CONTROLLER_FAILED, f"{controller.name} raised {type(exc).__name__}: {exc}"
                 break
-            step_time = time.perf_counter() - start
-            if diagnostics[command_rejected] or not math.isfinite(steer_cmd):
+            step_time = clock() - start
+            if diagnostics[command_rejected] or not isfinite(steer_cmd):
                 status = Status.CONTROLLER_FAILED
                 message = f"{controller.name} computed a non-finite steering command at t = {t:.2f} s"
                 break
@@ -227,39 +247,36 @@ class Simulation:
                 if not held:
                     first_held = f"first at t = {t:.2f} s: {controller.rejection}"
                 held += 1
-            speed = math.hypot(vx, vy)
-            speed_ref = float(path.speed(foot.s_m))
-            # The reference changes at d(v_ref)/dt = dv_ref/ds * ds/dt, fed forward so braking for a corner is
-            # on time; without it a PI lags a braking ramp by ~0.76 x the deceleration in m/s.
-            speed_ref_rate = speed * path.speed_gradient(foot.s_m) if cfg.speed_feedforward else 0.0
-            accel_cmd = speed_controller.step(speed_ref, speed, dt, speed_ref_rate)
-            log.append(
-                t,
-                out,
-                steer_cmd,
-                accel_cmd,
-                speed,
-                speed_ref,
-                foot,
-                float(wrap_angle(yaw - foot.heading_rad)),
-                step_time,
-                diagnostics,
+            speed = hypot(vx, vy)
+            if step == log.capacity:
+                table = log.grow()
+            # The speed reference and its rate fed forward (d(v_ref)/dt = dv_ref/ds * ds/dt, so braking for a
+            # corner is on time; without it a PI lags a braking ramp by ~0.76 x the deceleration in m/s), the PI
+            # speed command and the trace's row.
+            accel_cmd = finish_step(
+                table, step, t, out, steer_cmd, speed, step_time, diagnostics, foot, samples, settings
             )
+            if accel_cmd != accel_cmd:  # NaN: a speed, reference or rate not finite; the Python controller says so
+                s_m = float(foot[FOOT_S])
+                rate = speed * path.speed_gradient(s_m) if cfg.speed_feedforward else 0.0
+                PISpeedController(speed_gains).step(float(path.speed(s_m)), speed, dt, rate)
+            log.n = step + 1
             if actuator is None:
-                state = vehicle.advance(state, steer_cmd, accel_cmd, dt, cfg.substeps)
+                state = advance(state, steer_cmd, accel_cmd, dt, substeps)
                 applied_cmd = steer_cmd
             else:
-                for substeps, applied_cmd in actuator.segments(steer_cmd):
-                    state = vehicle.advance(state, applied_cmd, accel_cmd, dt * substeps / cfg.substeps, substeps)
+                for segment_substeps, applied_cmd in actuator.segments(steer_cmd):
+                    state = advance(state, applied_cmd, accel_cmd, dt * segment_substeps / substeps, segment_substeps)
             if seen:
                 log.seen(measurement, applied_cmd, friction)
             t += dt
-            if not math.isfinite(state.sum()):  # a NaN or an infinity in any state makes the sum one
-                bad = [n for n, v in zip(vehicle.state_names, state, strict=False) if not math.isfinite(v)]
+            if not isfinite(sum(state.tolist())):  # a NaN or an infinity in any state makes the sum one
+                bad = [n for n, v in zip(vehicle.state_names, state, strict=False) if not isfinite(v)]
                 status = Status.DIVERGED
                 message = f"the {vehicle.name} state diverged at t = {t:.2f} s (non-finite: {', '.join(bad)})"
                 break
-            bar.update(round(foot.progress_m) - bar.n)
+            if progress:
+                bar.update(round(float(foot[FOOT_PROGRESS])) - bar.n)
         bar.close()
         if held:
             message += (
@@ -277,6 +294,23 @@ class Simulation:
         )
 
 
+def _projection_end(where: int, foot: list[float], t: float, cfg: SimulationConfig) -> tuple[Status, str]:
+    """How the run ends at a projection that ends it (`step_kernel.project_pose`'s code, the tracker's output as
+    a list): the status and the message."""
+    distance = foot[FOOT_DISTANCE]
+    if where == PROJECTED_PAST_END:
+        end = "end" if foot[FOOT_AT_END] == 1.0 else "start"
+        return Status.LEFT_PATH, (
+            f"went {foot[FOOT_PAST_END]:.1f} m past the {end} of the path (max_past_end_m = "
+            f"{cfg.max_past_end_m:g} m) at t = {t:.2f} s, {distance:.1f} m from it"
+        )
+    if where == PROJECTED_OFF_PATH:
+        return Status.LEFT_PATH, (
+            f"|CTE| = {distance:.1f} m exceeds max_abs_cte_m = {cfg.max_abs_cte_m:g} m at t = {t:.2f} s"
+        )
+    return Status.COMPLETED, "completed"
+
+
 def _duration_text(seconds: float) -> str:
     if seconds < 120:
         return f"{seconds:.0f} s"
@@ -288,64 +322,9 @@ def _duration_text(seconds: float) -> str:
 
 
 class _TraceLog:
-    """Columns for the trace, one row per controller step; they double when full, so memory follows the steps
-    actually run, not the time-out's capacity."""
-
-    def __init__(self, output_names: tuple[str, ...], diagnostic_names: tuple[str, ...], capacity: int) -> None:
-        self.output_names = output_names
-        self.diagnostic_names = diagnostic_names
-        self.capacity = min(capacity, 1 << 14)
-        self.outputs = np.empty((self.capacity, len(output_names)))
-        self.signals = np.empty((self.capacity, len(self.SIGNALS)))
-        self.diagnostics = np.empty((self.capacity, len(diagnostic_names)))
-        self.seen_columns: np.ndarray | None = None
-        self.n = 0
-
-    def _grow(self) -> None:
-        def doubled(column: np.ndarray) -> np.ndarray:
-            return np.concatenate((column, np.full((self.capacity, *column.shape[1:]), np.nan)))
-
-        self.outputs = doubled(self.outputs)
-        self.signals = doubled(self.signals)
-        self.diagnostics = doubled(self.diagnostics)
-        if self.seen_columns is not None:
-            self.seen_columns = doubled(self.seen_columns)
-        self.capacity *= 2
-
-    SIGNALS = (
-        "t_s",
-        "steer_wheel_cmd_rad",
-        "accel_cmd_mps2",
-        "speed_mps",
-        "speed_ref_mps",
-        "path_s_m",
-        "progress_m",
-        "cte_m",
-        "heading_error_rad",
-        "path_curvature_1pm",
-        "step_time_s",
-    )
-
-    def append(self, t, out, steer_cmd, accel_cmd, speed, speed_ref, foot, heading_error, step_time, diagnostics):
-        i = self.n
-        if i == self.capacity:
-            self._grow()
-        self.outputs[i] = out
-        self.signals[i] = (
-            t,
-            steer_cmd,
-            accel_cmd,
-            speed,
-            speed_ref,
-            foot.s_m,
-            foot.progress_m,
-            foot.signed_distance_m,
-            heading_error,
-            foot.curvature_1pm,
-            step_time,
-        )
-        self.diagnostics[i] = diagnostics
-        self.n += 1
+    """The trace as one table, one row per controller step (`step_kernel.finish_step` writes a row's time, the
+    plant's outputs, the simulator's signals and the controller's diagnostics; `seen` the columns after them); it
+    doubles when full, so memory follows the steps actually run, not the time-out's capacity. `n` rows are kept."""
 
     #: What the controller saw and what reached the plant, logged when the conditions are not ideal: the
     #: measurement's fields (seen_*), the steering command applied at the end of the step (after the actuator's
@@ -362,11 +341,32 @@ class _TraceLog:
         "road_friction",
     )
 
+    def __init__(
+        self, output_names: tuple[str, ...], diagnostic_names: tuple[str, ...], capacity: int, seen: bool = False
+    ) -> None:
+        #: The table's columns, in the trace's order (a signal named like an output, `path_curvature_1pm`, takes
+        #: the output's place in the trace: `to_dict`).
+        self.columns = (
+            "t_s",
+            *output_names,
+            *SIGNALS,
+            *(f"ctrl_{name}" for name in diagnostic_names),
+            *(self.SEEN if seen else ()),
+        )
+        self.seen_offset = len(self.columns) - (len(self.SEEN) if seen else 0)
+        self.capacity = min(capacity, 1 << 14)
+        self.table = np.empty((self.capacity, len(self.columns)))
+        self.n = 0
+
+    def grow(self) -> np.ndarray:
+        """Double the capacity (the new rows NaN); the new table."""
+        self.table = np.concatenate((self.table, np.full_like(self.table, np.nan)))
+        self.capacity *= 2
+        return self.table
+
     def seen(self, m: Measurement, applied_cmd: float, friction: float) -> None:
-        """The seen columns of the row `append` just wrote."""
-        if self.seen_columns is None:
-            self.seen_columns = np.full((self.capacity, len(self.SEEN)), np.nan)
-        self.seen_columns[self.n - 1] = (
+        """The seen columns of the last row kept."""
+        self.table[self.n - 1, self.seen_offset :] = (
             m.x_m,
             m.y_m,
             m.yaw_rad,
@@ -379,11 +379,8 @@ class _TraceLog:
         )
 
     def to_dict(self) -> dict[str, np.ndarray]:
+        """One array per column (a column named like an earlier one replaces it, in its place); the seen columns
+        only once a row has them."""
         n = self.n
-        trace = {"t_s": self.signals[:n, 0].copy()}
-        trace.update({name: self.outputs[:n, k].copy() for k, name in enumerate(self.output_names)})
-        trace.update({name: self.signals[:n, k].copy() for k, name in enumerate(self.SIGNALS) if k > 0})
-        trace.update({f"ctrl_{key}": self.diagnostics[:n, k].copy() for k, key in enumerate(self.diagnostic_names)})
-        if self.seen_columns is not None:
-            trace.update({name: self.seen_columns[:n, k].copy() for k, name in enumerate(self.SEEN)})
-        return trace
+        columns = self.columns if n else self.columns[: self.seen_offset]
+        return {name: self.table[:n, k].copy() for k, name in enumerate(columns)}

@@ -11,6 +11,9 @@ of s^2 + kp s + ki: for the default gains it peaks at 0.76 a after 2.2 s (1.5 m/
 ramp), and the braking before a corner is often over sooner, so the vehicle enters the corner too fast. With the rate
 fed forward the error obeys e'' + kp e' + ki e = 0 whatever the reference does (within the saturation): a
 reference followed from zero error is followed exactly.
+
+`pi_speed_step` is the same law compiled, its gains and integrator in an array (`pi_state`), for the simulator's
+per-step kernel (`workbench.simulation.step_kernel`): the same arithmetic in the same order, so the same commands.
 """
 
 from __future__ import annotations
@@ -18,7 +21,15 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import numpy as np
+from numba import njit
+
 from workbench.base.errors import WorkbenchInputError, require_in_range, require_positive
+
+#: Layout of `pi_state`'s array: the gains (kp 1/s, ki 1/s^2), the saturation (m/s^2, both positive) and the
+#: integrated speed error (m).
+PI_KP, PI_KI, PI_MAX_ACCEL, PI_MAX_DECEL, PI_INTEGRAL = 0, 1, 2, 3, 4
+PI_STATE_SIZE = 5
 
 
 @dataclass(frozen=True)
@@ -100,3 +111,36 @@ class PISpeedController:
             return -g.max_decel_mps2
         self._integral_m = candidate
         return command
+
+
+def pi_state(gains: PISpeedGains | None = None) -> np.ndarray:
+    """The array `pi_speed_step` runs on (layout PI_*): `gains` (the defaults when None), the integrator at zero."""
+    if gains is None:
+        gains = PISpeedGains()
+    if not isinstance(gains, PISpeedGains):
+        raise WorkbenchInputError(f"gains must be a PISpeedGains; got {gains!r}")
+    state = np.zeros(PI_STATE_SIZE)
+    state[PI_KP], state[PI_KI] = gains.kp_per_s, gains.ki_per_s2
+    state[PI_MAX_ACCEL], state[PI_MAX_DECEL] = gains.max_accel_mps2, gains.max_decel_mps2
+    return state
+
+
+@njit(cache=True)
+def pi_speed_step(
+    state: np.ndarray, speed_ref_mps: float, speed_mps: float, dt_s: float, speed_ref_rate_mps2: float
+) -> float:  # pragma: no cover - compiled
+    """`PISpeedController.step` on `state` (`pi_state`): the acceleration command (m/s^2), the integrator advanced
+    in place. The inputs are not checked: the caller passes finite speeds and rate and a finite dt_s > 0."""
+    error = speed_ref_mps - speed_mps
+    candidate = state[PI_INTEGRAL] + error * dt_s
+    command = speed_ref_rate_mps2 + state[PI_KP] * error + state[PI_KI] * candidate
+    if command > state[PI_MAX_ACCEL]:
+        if error <= 0.0:  # the error is already pulling the command back inside: keep integrating
+            state[PI_INTEGRAL] = candidate
+        return state[PI_MAX_ACCEL]
+    if command < -state[PI_MAX_DECEL]:
+        if error >= 0.0:
+            state[PI_INTEGRAL] = candidate
+        return -state[PI_MAX_DECEL]
+    state[PI_INTEGRAL] = candidate
+    return command

@@ -15,12 +15,14 @@ from controllers import PurePursuit
 from controllers.base import Controller, Measurement
 from workbench.base.clothoid_chain import ClothoidChain
 from workbench.base.errors import WorkbenchInputError
-from workbench.base.path import ReferencePath
+from workbench.base.path import ReferencePath, wrap_angle
+from workbench.simulation.conditions import CONDITIONS
 from workbench.simulation.result import Status
 from workbench.simulation.scenarios import Scenario, make_scenario
 from workbench.simulation.simulator import Simulation, SimulationConfig
-from workbench.simulation.speed_control import PISpeedGains
+from workbench.simulation.speed_control import PISpeedController, PISpeedGains
 from workbench.simulation.speed_profile import G_MPS2
+from workbench.simulation.step_kernel import SIGNALS
 from workbench.vehicles import KinematicBicycle
 
 
@@ -272,3 +274,73 @@ def test_a_path_speed_of_zero_is_refused_before_the_run(first_only: bool) -> Non
     vehicle = KinematicBicycle()
     with pytest.raises(WorkbenchInputError, match=r"straight: the path's speed must be > 0 m/s .* 0 m/s at s = 0\.0 m"):
         Simulation(_scenario(path.with_speed(speed)), vehicle, PurePursuit(vehicle.geometry))
+
+
+def test_the_logged_signals_are_the_ones_recomputed_from_the_trace() -> None:
+    """Every signal the compiled per-step work logs, recomputed in Python from the trace's own columns, equal to the
+    last bit: the projection of the logged position by a fresh tracker, the planned speed and the Python PI
+    controller's command, the wrapped heading error; the command and diagnostics are the controller's for the
+    logged measurement. The run is long enough (18 850 steps) for the trace's table to grow."""
+    path = _circle(25.0)
+    config = SimulationConfig(controller_rate_hz=200.0, laps=5)
+    result = _run(_scenario(path, offset=0.4), config)
+    assert result.status is Status.COMPLETED
+    trace, planned = result.trace, result.path
+    n = trace["t_s"].size
+    assert n > 1 << 14
+    dt = 1.0 / config.controller_rate_hz
+    tracker, speed_control = planned.tracker(0.0), PISpeedController(PISpeedGains())
+    controller = PurePursuit(KinematicBicycle().geometry)
+    controller.reset(planned, dt)
+    t = 0.0
+    for i in range(n):
+        x, y, yaw, vx, vy = (trace[k][i] for k in ("x_m", "y_m", "yaw_rad", "vx_mps", "vy_mps"))
+        foot = tracker.update(x, y)
+        speed = math.hypot(vx, vy)
+        speed_ref = planned.speed(foot.s_m)
+        accel = speed_control.step(speed_ref, speed, dt, speed * planned.speed_gradient(foot.s_m))
+        measurement = Measurement(t, x, y, vx, vy, yaw, trace["yaw_rate_rad_s"][i], trace["steer_wheel_rad"][i])
+        expected = {
+            "t_s": t,
+            "steer_wheel_cmd_rad": controller.step(measurement, planned),
+            "accel_cmd_mps2": accel,
+            "speed_mps": speed,
+            "speed_ref_mps": speed_ref,
+            "path_s_m": foot.s_m,
+            "progress_m": foot.progress_m,
+            "cte_m": foot.signed_distance_m,
+            "heading_error_rad": float(wrap_angle(yaw - foot.heading_rad)),
+            "path_curvature_1pm": foot.curvature_1pm,
+            **{f"ctrl_{k}": v for k, v in controller.diagnostics.items()},
+        }
+        logged = {key: float(trace[key][i]) for key in expected}
+        assert logged == expected, i
+        t += dt
+
+
+def test_the_trace_holds_the_time_the_outputs_the_signals_the_diagnostics_and_what_was_seen() -> None:
+    """In that order; a signal named like an output (`path_curvature_1pm`) in the output's place; the seen columns
+    only under conditions that are not ideal, and only once a step was logged."""
+    vehicle = KinematicBicycle()
+    straight = ClothoidChain().straight(40.0).to_path("straight")
+    controller = PurePursuit(vehicle.geometry)
+    columns = [
+        "t_s",
+        *dict.fromkeys((*vehicle.output_names, *SIGNALS)),
+        *(f"ctrl_{name}" for name in ("lookahead_m", "target_s_m", "curvature_cmd_1pm")),
+        "ctrl_measurement_rejected",
+        "ctrl_command_rejected",
+    ]
+    seen = [
+        "seen_x_m", "seen_y_m", "seen_yaw_rad", "seen_vx_mps", "seen_vy_mps", "seen_yaw_rate_rad_s",
+        "seen_steer_wheel_rad", "applied_steer_wheel_cmd_rad", "road_friction",
+    ]  # fmt: skip
+    ideal = Simulation(_scenario(straight), vehicle, controller).run()
+    assert list(ideal.trace) == columns
+    automotive = SimulationConfig(conditions=CONDITIONS["automotive"])
+    noisy = Simulation(_scenario(straight), vehicle, controller, automotive).run()
+    assert list(noisy.trace) == columns + seen
+    assert np.isfinite(noisy.to_pandas()[seen].to_numpy()).all()
+    off = Simulation(_scenario(straight, offset=10.0), vehicle, controller, replace(automotive, max_abs_cte_m=5.0))
+    left = off.run()
+    assert left.status is Status.LEFT_PATH and list(left.trace) == columns and left.trace["t_s"].size == 0

@@ -6,9 +6,17 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from workbench.base.errors import WorkbenchInputError
-from workbench.simulation.speed_control import PISpeedController, PISpeedGains
+from workbench.simulation.speed_control import (
+    PI_INTEGRAL,
+    PISpeedController,
+    PISpeedGains,
+    pi_speed_step,
+    pi_state,
+)
 
 DT_S = 0.01
 
@@ -245,3 +253,38 @@ def test_step_rejects_a_non_finite_reference_rate(rate: float) -> None:
     with pytest.raises(WorkbenchInputError, match=r"speed_ref_rate_mps2 must be finite; got -?(nan|inf)"):
         controller.step(1.0, 1.0, DT_S, rate)
     assert controller.integral_m == 0.0
+
+
+_speeds = st.floats(0.0, 40.0)
+_rates = st.floats(-6.0, 6.0)
+#: (speed_ref, speed, dt, rate) of a step: references and speeds far apart drive the command into both saturations,
+#: near ones keep it inside.
+_steps = st.tuples(_speeds, _speeds, st.floats(1e-4, 0.2), _rates)
+
+
+@settings(max_examples=150, deadline=None)
+@given(
+    gains=st.builds(
+        PISpeedGains,
+        kp_per_s=st.floats(0.05, 5.0),
+        ki_per_s2=st.floats(0.0, 2.0),
+        max_accel_mps2=st.floats(0.1, 6.0),
+        max_decel_mps2=st.floats(0.1, 10.0),
+    ),
+    steps=st.lists(_steps, min_size=1, max_size=60),
+)
+def test_the_compiled_step_is_the_python_controller_bit_for_bit(gains: PISpeedGains, steps: list) -> None:
+    """The simulator's kernel (`pi_speed_step` on `pi_state`) gives the Python controller's commands and integrator,
+    equal to the last bit, along any sequence of steps, saturated or not."""
+    python, compiled = PISpeedController(gains), pi_state(gains)
+    for speed_ref, speed, dt, rate in steps:
+        assert pi_speed_step(compiled, speed_ref, speed, dt, rate) == python.step(speed_ref, speed, dt, rate)
+        assert compiled[PI_INTEGRAL] == python.integral_m
+
+
+def test_pi_state_starts_from_the_gains_and_a_zero_integrator() -> None:
+    gains = PISpeedGains(kp_per_s=0.5, ki_per_s2=0.1, max_accel_mps2=1.5, max_decel_mps2=3.0)
+    assert pi_state(gains).tolist() == [0.5, 0.1, 1.5, 3.0, 0.0]
+    assert pi_state().tolist() == pi_state(PISpeedGains()).tolist()
+    with pytest.raises(WorkbenchInputError, match="gains must be a PISpeedGains"):
+        pi_state({"kp_per_s": 1.0})  # type: ignore[arg-type]

@@ -189,3 +189,23 @@ def test_the_single_track_equivalent_has_the_vehicles_geometry(name: str) -> Non
     assert model.name in equivalent.source
     if equivalent.single_track is not None:
         assert equivalent.single_track.wheelbase_m == pytest.approx(geometry.wheelbase_m, rel=1e-9)
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_the_inputs_are_clipped_as_min_and_max_clip_them(name: str) -> None:
+    """The plant's inputs (`_inputs`, written out as comparisons for speed) are min(max(value, low), high) of the
+    road-wheel command and the acceleration, to the sign of a zero and a NaN passed through."""
+    model = vehicle(name)
+    g, p = model.geometry, model.params
+    lim = g.max_road_wheel_angle_rad
+    steers = [-math.inf, -10.0, -lim * g.steering_ratio, -0.1, -0.0, 0.0, 1e-300, 0.3, lim * g.steering_ratio, math.nan]
+    accels = [-math.inf, -50.0, -p.max_decel_mps2, -0.5, -0.0, 0.0, 0.7, p.max_accel_mps2, 50.0, math.inf, math.nan]
+
+    def same(a: float, b: float) -> bool:
+        return (math.isnan(a) and math.isnan(b)) or (a == b and math.copysign(1.0, a) == math.copysign(1.0, b))
+
+    for steer in steers:
+        for accel in accels:
+            delta, realised = model._inputs(steer, accel)
+            assert same(delta, min(max(steer / g.steering_ratio, -lim), lim)), (steer, delta)
+            assert same(realised, min(max(accel, -p.max_decel_mps2), p.max_accel_mps2)), (accel, realised)
