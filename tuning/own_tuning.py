@@ -31,43 +31,31 @@ import time
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from controllers.clothoid.controller import ClothoidConfig
-from controllers.clothoid.vehicle_tuning import VehicleTuning
-from tuning.preset_tuning import (
-    PRESET_TUNING_OPTIONS,
-    SECONDS_PER_SPEED,
-    PresetTuningOptions,
-    options_dict,
-    tuning_commands,
-    write_tuning_files,
-)
-from tuning.tuning_dirs import (
-    LEAD_FILE,
-    LIMITS_FILE,
-    MANIFEST_FILE,
-    VEHICLE_FILE,
-    cache_dir,
-    canonical_vehicle_toml,
-    params_sha256,
-    read_vehicle_tuning,
-    shipped_index,
-)
 from workbench.base.errors import WorkbenchInputError
 from workbench.vehicles.base import VehicleModel
 
-if TYPE_CHECKING:
+if TYPE_CHECKING:  # the clothoid controller and the tuning tools (python-control, SciPy: ~2 s to import) are
+    # imported where a tuning is looked up, not by every run that imports this module (pure pursuit's)
     from controllers.base import Controller
+    from controllers.clothoid.vehicle_tuning import VehicleTuning
+    from tuning.preset_tuning import PresetTuningOptions
 
 
 def cache_key(vehicle: VehicleModel, options: PresetTuningOptions) -> str:
     """Name of the vehicle's cache directory: sha256 of its canonical parameters and of the tuning options resolved
     for it (so that changed options make a new tuning rather than reuse one made with the old)."""
+    from tuning.preset_tuning import options_dict
+    from tuning.tuning_dirs import canonical_vehicle_toml
+
     text = canonical_vehicle_toml(vehicle) + json.dumps(options_dict(options, vehicle.name), sort_keys=True)
     return hashlib.sha256(text.encode("utf-8")).hexdigest()
 
 
 def shipped_tuning_dir(vehicle: VehicleModel, options: PresetTuningOptions | None = None) -> Path | None:
     """The shipped tuning made for exactly this vehicle (payload aside) and these options, or None."""
+    from tuning.preset_tuning import PRESET_TUNING_OPTIONS, options_dict
+    from tuning.tuning_dirs import params_sha256, shipped_index
+
     options = options or PRESET_TUNING_OPTIONS
     key = (params_sha256(vehicle), json.dumps(options_dict(options, vehicle.name), sort_keys=True))
     return shipped_index().get(key)
@@ -75,6 +63,8 @@ def shipped_tuning_dir(vehicle: VehicleModel, options: PresetTuningOptions | Non
 
 def _stale_preset_hint(vehicle: VehicleModel) -> str:
     """When a shipped tuning was made for this vehicle with other options: how to bring it up to date."""
+    from tuning.tuning_dirs import params_sha256, shipped_index
+
     digest = params_sha256(vehicle)
     for (params_digest, _), directory in shipped_index().items():
         if params_digest == digest:
@@ -87,6 +77,8 @@ def _stale_preset_hint(vehicle: VehicleModel) -> str:
 
 def manual_instructions(vehicle: VehicleModel, options: PresetTuningOptions, vehicle_file: str) -> str:
     """The `tuning` commands that make this vehicle's files by hand, and the options that then use them."""
+    from tuning.preset_tuning import tuning_commands
+    from tuning.tuning_dirs import LEAD_FILE, LIMITS_FILE
 
     commands = tuning_commands(vehicle, ["--vehicle-file", vehicle_file], options.for_model(vehicle.name))
     return (
@@ -101,12 +93,15 @@ def generate_vehicle_tuning(vehicle: VehicleModel, directory: str | Path, option
     """Make the vehicle's tuning in `directory` (which must not exist yet) by the tuning chain, atomically: in a
     temporary sibling directory renamed to `directory` when complete. If another process completed it first, its
     files are kept. Returns `directory`."""
+    from tuning.tuning_dirs import MANIFEST_FILE, VEHICLE_FILE, canonical_vehicle_toml
 
     target = Path(directory)
     target.parent.mkdir(parents=True, exist_ok=True)
     work = Path(tempfile.mkdtemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent))
     try:
         (work / VEHICLE_FILE).write_text(canonical_vehicle_toml(vehicle), encoding="utf-8")
+        from tuning.preset_tuning import write_tuning_files
+
         write_tuning_files(vehicle, work, options, vehicle_args=["--vehicle-file", VEHICLE_FILE], preset=None)
         try:
             os.rename(work, target)
@@ -121,6 +116,8 @@ def generate_vehicle_tuning(vehicle: VehicleModel, directory: str | Path, option
 def _estimate_s(vehicle: VehicleModel, options: PresetTuningOptions) -> float:
 
     resolved = options.for_model(vehicle.name)
+    from tuning.preset_tuning import SECONDS_PER_SPEED
+
     return SECONDS_PER_SPEED.get(vehicle.name, 60.0) * len(resolved.schedule_speeds_kmh)
 
 
@@ -132,6 +129,16 @@ def tuning_for(vehicle: VehicleModel, options: PresetTuningOptions | None = None
     """The tuning the clothoid controller uses for `vehicle` (module docstring): the shipped files of the preset it
     equals (payload aside), else its own from the cache, generated there on first use. options: the tuning options
     (default `tuning.preset_tuning.PRESET_TUNING_OPTIONS`, those the shipped files were made with)."""
+    from tuning.preset_tuning import PRESET_TUNING_OPTIONS
+    from tuning.tuning_dirs import (
+        MANIFEST_FILE,
+        VEHICLE_FILE,
+        cache_dir,
+        canonical_vehicle_toml,
+        params_sha256,
+        read_vehicle_tuning,
+    )
+
     options = options or PRESET_TUNING_OPTIONS
     shipped = shipped_tuning_dir(vehicle, options)
     if shipped is not None:
@@ -178,7 +185,9 @@ def tuning_for(vehicle: VehicleModel, options: PresetTuningOptions | None = None
 def with_vehicle_tuning(config: object, vehicle: VehicleModel) -> object:
     """`config` with the vehicle's own tuning (`tuning_for`) when it is a ClothoidConfig without one; any other
     config as it is."""
-    if isinstance(config, ClothoidConfig) and config.tuning is None:
+    # A ClothoidConfig exists only once its module is imported: a run of another controller does not import it.
+    clothoid = sys.modules.get("controllers.clothoid.controller")
+    if clothoid is not None and isinstance(config, clothoid.ClothoidConfig) and config.tuning is None:
         return dataclasses.replace(config, tuning=tuning_for(vehicle))
     return config
 

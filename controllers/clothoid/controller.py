@@ -29,7 +29,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import ClassVar
+from typing import TYPE_CHECKING, ClassVar
 
 import numpy as np
 from scipy.constants import g as G_MPS2  # standard gravity, 9.80665 m/s^2
@@ -41,7 +41,6 @@ from controllers.clothoid.filter_schedule import FilterSchedule
 from controllers.clothoid.lead_filter import DiscreteLeadFilter
 from controllers.clothoid.lookahead import MAX_CURVE_POINTS, candidate_count
 from controllers.clothoid.lookahead_filter import require_rate
-from controllers.clothoid.loop_analysis import LoopSettings, PlantLags, lookahead_floor
 from controllers.clothoid.path_feedforward import FeedforwardTiming
 from controllers.clothoid.vehicle_tuning import VehicleTuning
 from controllers.config_checks import (
@@ -54,6 +53,9 @@ from controllers.config_checks import (
 from workbench.base.errors import WorkbenchInputError, value_text
 from workbench.base.path import PathTracker, ReferencePath
 from workbench.vehicles.base import VehicleGeometry
+
+if TYPE_CHECKING:  # the loop analysis (python-control, ~0.9 s to import) only where floors are computed
+    from controllers.clothoid.loop_analysis import LoopSettings, PlantLags
 
 LOOKAHEAD_MODES = ("adaptive", "fixed", "speed")
 INITIAL_CURVATURE = ("yaw-rate", "command", "steering")
@@ -330,12 +332,16 @@ class ClothoidController(Controller):
 
     def plant_lags(self, speed_kmh: float) -> PlantLags | None:
         """The vehicle's identified lags at this speed (None without a tuning)."""
+        from controllers.clothoid.loop_analysis import PlantLags
+
         if self.tuning is None:
             return None
         return PlantLags(self.tuning.lag_at(speed_kmh), self.tuning.measured_lag_at(speed_kmh))
 
     def loop_settings(self, speed_kmh: float) -> LoopSettings:
         """What the controller does at this speed, for `loop_analysis`."""
+        from controllers.clothoid.loop_analysis import LoopSettings
+
         lead = self.filter_schedule.at_speed(speed_kmh) if self.filter_schedule is not None else None
         return LoopSettings(self._dt, self.config.prediction_time_s, lead=lead, known_delay_s=self.config.known_delay_s)
 
@@ -355,6 +361,8 @@ class ClothoidController(Controller):
             if lags is None or (cfg.min_phase_margin_deg <= 0.0 and cfg.min_gain_margin_db <= 0.0):
                 floor = cfg.min_lookahead_m
             else:
+                from controllers.clothoid.loop_analysis import lookahead_floor  # python-control: imported when used
+
                 v = speed_kmh / 3.6
                 kappa_max, _ = self.limits.at_speed(v)
                 arc = min(kappa_max, FLOOR_ARC_LATERAL_ACCEL_G * G_MPS2 / v**2)

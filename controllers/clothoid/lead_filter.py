@@ -20,14 +20,15 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Protocol
+from typing import TYPE_CHECKING, Protocol
 
-import control
 import numpy as np
 from numba import njit
-from scipy import optimize, signal
 
 from workbench.base.errors import WorkbenchInputError, require_in_range, require_positive, value_text
+
+if TYPE_CHECKING:  # python-control and SciPy's signal and optimize are imported where used: they take ~0.9 s
+    import control
 
 #: Sane ranges of the corner frequencies (rad/s) and of the zero damping psi (exclusive of 0).
 OMEGA_RANGE_RAD_S = (0.01, 1000.0)
@@ -80,6 +81,8 @@ class LeadFilterParams:
 
     def transfer_function(self) -> control.TransferFunction:
         """Eq. 6 as a python-control transfer function (input and output in the same unit, e.g. rad)."""
+        import control
+
         wz, psi, wp = self.omega_z_rad_s, self.psi, self.omega_p_rad_s
         gain = wp**3 / wz**2
         return control.tf([gain, gain * 2 * psi * wz, gain * wz**2], [1.0, 3 * wp, 3 * wp**2, wp**3])
@@ -108,6 +111,8 @@ class LeadFilterParams:
         if gains[i] <= 1.0:
             return 1.0
         lo, hi = log_w[max(i - 1, 0)], log_w[min(i + 1, len(log_w) - 1)]
+        from scipy import optimize
+
         res = optimize.minimize_scalar(
             lambda x: -float(self.gain_at(math.exp(x))), bounds=(lo, hi), method="bounded", options={"xatol": 1e-10}
         )
@@ -186,6 +191,8 @@ class DiscreteLeadFilter:
         a_c = wp * np.array([[-1.0, 0.0, 0.0], [1.0, -1.0, 0.0], [0.0, 1.0, -1.0]])
         b_c = np.array([[wp], [0.0], [0.0]])
         c_c = np.array([[r * r, -2.0 * r * r + 2.0 * psi * r, r * r - 2.0 * psi * r + 1.0]])
+        from scipy import signal
+
         a, b, c, d, _ = signal.cont2discrete((a_c, b_c, c_c, np.zeros((1, 1))), step, method="bilinear")
         self.poles: np.ndarray = np.linalg.eigvals(a)
         if not (np.all(np.isfinite(a)) and np.all(np.abs(self.poles) < 1.0)):
