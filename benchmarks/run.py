@@ -308,6 +308,8 @@ def main(argv: list[str] | None = None) -> int:
     for name in scenarios:
         entries.append(bench_run(name, "nmpc", "tractor-semitrailer", options))
         entries.append(bench_run(name, "lmpc", "tractor-semitrailer", options))
+    if options.track_file:  # issue 19: a Zandvoort lap's real-time factor for every controller
+        entries.append(bench_run("zandvoort", "stanley", "tractor-semitrailer", options))
     entries += step_ratios(entries, scenarios)
     peak_mb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0  # KiB on Linux
 

@@ -126,7 +126,7 @@ class Controller(ABC):
             return self._held_command
         command = float(self._command(screened, path))
         own = self._own
-        if not (math.isfinite(command) and (n == 0 or math.isfinite(own.sum()))):  # a NaN or inf makes the sum one
+        if not (math.isfinite(command) and math.isfinite(sum(own.tolist()))):  # a NaN or inf makes the sum one
             self.rejection = "the controller's command or diagnostics were not finite"
             report[n], report[n + 1] = 0.0, 1.0
             return self._held_command
