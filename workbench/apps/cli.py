@@ -710,6 +710,8 @@ def _run(args: argparse.Namespace) -> int:
     if cycle.detected:
         print(f"  WARNING: steering limit cycle at {cycle.describe()}")
     print(f"  controller step median {fmt(m.step_time_median_us, 'us')}, p99 {fmt(m.step_time_p99_us, 'us')}")
+    if m.min_track_margin_m is not None:  # a path with track widths (a TUMFTM track)
+        print(f"  least track margin {fmt(m.min_track_margin_m, 'm')}" + (" (LEFT THE TRACK)" if m.left_track else ""))
     print(f"  wrote {len(written)} files to {args.out}")
     if not result.completed:
         print(f"workbench: run did not complete: {result.message} (partial trace kept in {args.out})", file=sys.stderr)

@@ -1,9 +1,9 @@
 """Reference paths parameterised by arc length, and a closest-point tracker that follows the vehicle's progress.
 
 A `ReferencePath` is immutable: uniformly spaced samples (default every 0.1 m) of position, heading and curvature
-along the arc length s. It is built either from waypoints, through an interpolating quintic spline re-parameterised
-by its own arc length (so heading and curvature are continuous and accurate even when the waypoints are unevenly
-spaced), or from exact samples of a
+along the arc length s (and, when its waypoints gave them, the planned speed and the track's widths). It is built
+either from waypoints, through an interpolating quintic spline re-parameterised by its own arc length (so heading
+and curvature are continuous and accurate even when the waypoints are unevenly spaced), or from exact samples of a
 known geometry (clothoid chains, see `workbench.base.clothoid_chain`).
 
 A `PathTracker` answers "where on the path is the vehicle?" step after step. It searches only a window around the
@@ -144,6 +144,8 @@ class ReferencePath:
 
     Arrays hold `n` samples at s = 0, ds, ..., length; for a closed loop the last sample repeats the first (with
     its heading advanced by the loop's total turning), so interpolation needs no special case at the seam.
+    width_right_m, width_left_m: the track's extent to the right and left of the path at each sample (m), or None
+    when the path has no track around it (both or neither).
     """
 
     def __init__(
@@ -156,12 +158,17 @@ class ReferencePath:
         closed: bool,
         speed_mps: np.ndarray | None = None,
         name: str = "path",
+        *,
+        width_right_m: np.ndarray | None = None,
+        width_left_m: np.ndarray | None = None,
     ) -> None:
         self.x_m = np.ascontiguousarray(x_m, dtype=float)
         self.y_m = np.ascontiguousarray(y_m, dtype=float)
         self.heading_rad = np.ascontiguousarray(heading_rad, dtype=float)
         self.curvature_1pm = np.ascontiguousarray(curvature_1pm, dtype=float)
         self.speed_mps = None if speed_mps is None else np.ascontiguousarray(speed_mps, dtype=float)
+        self.width_right_m = None if width_right_m is None else np.ascontiguousarray(width_right_m, dtype=float)
+        self.width_left_m = None if width_left_m is None else np.ascontiguousarray(width_left_m, dtype=float)
         self.spacing_m = float(spacing_m)
         self.closed = bool(closed)
         self.name = name
@@ -169,6 +176,11 @@ class ReferencePath:
         self.length_m = float(self.s_m[-1])
         for label, arr in (("heading", self.heading_rad), ("curvature", self.curvature_1pm)):
             if arr.shape != self.x_m.shape:
+                raise WorkbenchInputError(f"{name}: {label} has {arr.size} samples, positions have {self.x_m.size}")
+        if (self.width_right_m is None) != (self.width_left_m is None):
+            raise WorkbenchInputError(f"{name}: give both track widths (right and left) or neither")
+        for label, arr in (("right track width", self.width_right_m), ("left track width", self.width_left_m)):
+            if arr is not None and arr.shape != self.x_m.shape:
                 raise WorkbenchInputError(f"{name}: {label} has {arr.size} samples, positions have {self.x_m.size}")
 
     # ------------------------------------------------------------------ construction
@@ -179,7 +191,7 @@ class ReferencePath:
         """Fit a quintic spline through the waypoints, parameterised by arc length, and sample it every spacing_m.
 
         Closed loops use a periodic spline, so heading and curvature are continuous across the seam too. A speed
-        given at the waypoints is interpolated linearly in arc length.
+        and track widths given at the waypoints are interpolated linearly in arc length.
         """
         require_positive("spacing_m", spacing_m)
         x, y = waypoints.x_m, waypoints.y_m
@@ -208,13 +220,14 @@ class ReferencePath:
         if waypoints.closed:  # make the seam sample exact
             x_u[-1], y_u[-1], curvature[-1] = x_u[0], y_u[0], curvature[0]
 
-        speed_u = None
-        if waypoints.speed_mps is not None:
-            v = waypoints.speed_mps
-            if waypoints.closed:
-                v = np.append(v, v[0])
-            s_knots = np.interp(t_knots, t_fine, s_fine)
-            speed_u = np.interp(s_uniform, s_knots, v)
+        s_knots = np.interp(t_knots, t_fine, s_fine)
+
+        def along_path(values: np.ndarray | None) -> np.ndarray | None:
+            """Values given at the waypoints, linear in arc length at the samples (the loop closed)."""
+            if values is None:
+                return None
+            return np.interp(s_uniform, s_knots, np.append(values, values[0]) if waypoints.closed else values)
+
         return cls(
             x_u,
             y_u,
@@ -222,8 +235,10 @@ class ReferencePath:
             curvature,
             length / n_intervals,
             waypoints.closed,
-            speed_u,
+            along_path(waypoints.speed_mps),
             name=name or waypoints.source,
+            width_right_m=along_path(waypoints.width_right_m),
+            width_left_m=along_path(waypoints.width_left_m),
         )
 
     @classmethod
@@ -288,8 +303,34 @@ class ReferencePath:
         if speed.shape != self.x_m.shape:
             raise WorkbenchInputError(f"{self.name}: speed has {speed.size} samples, the path has {self.x_m.size}")
         return ReferencePath(
-            self.x_m, self.y_m, self.heading_rad, self.curvature_1pm, self.spacing_m, self.closed, speed, self.name
+            self.x_m,
+            self.y_m,
+            self.heading_rad,
+            self.curvature_1pm,
+            self.spacing_m,
+            self.closed,
+            speed,
+            self.name,
+            width_right_m=self.width_right_m,
+            width_left_m=self.width_left_m,
         )
+
+    # ------------------------------------------------------------------ the track around the path
+    @property
+    def has_widths(self) -> bool:
+        """Whether the path carries the track's widths (its edges are known)."""
+        return self.width_right_m is not None
+
+    def track_edges(self) -> tuple[tuple[np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray]] | None:
+        """((x, y) of the left edge, (x, y) of the right edge) at the path's samples (m): each sample moved across
+        the path by its width; None when the path has no widths. Where a width exceeds the radius of a bend the
+        inner edge loops back on itself, as the offset of a curve does."""
+        if self.width_right_m is None or self.width_left_m is None:
+            return None
+        normal_x, normal_y = -np.sin(self.heading_rad), np.cos(self.heading_rad)  # to the left
+        left = (self.x_m + self.width_left_m * normal_x, self.y_m + self.width_left_m * normal_y)
+        right = (self.x_m - self.width_right_m * normal_x, self.y_m - self.width_right_m * normal_y)
+        return left, right
 
     def s_at_arc_distance(self, s_m: float, distance_m: float) -> float:
         """The arc length `distance_m` further along the path from s (wrapped on loops, clipped at an end)."""

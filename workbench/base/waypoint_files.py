@@ -5,7 +5,11 @@ ignoring surrounding spaces (and a leading ``#``):
 
 - x/y, metres: ``x``/``x_m`` and ``y``/``y_m``. A header starting with ``#`` is the TUMFTM racetrack-database
   convention (``# x_m,y_m,w_tr_right_m,w_tr_left_m``, or ``# x_m,y_m`` for race lines): a closed loop whose
-  last point is not repeated. Other columns (track widths, ...) are ignored.
+  last point is not repeated.
+- optional track widths, metres: ``w_tr_right_m``/``w_right_m`` and ``w_tr_left_m``/``w_left_m`` (TUMFTM's names
+  first), the distances from each point to the track's right and left edges; both or neither, finite and in
+  [0, `MAX_TRACK_HALF_WIDTH_M`]. Kept in the waypoints (and the path, scenario, metrics and figures after them).
+  Other columns are ignored.
 - GPS, degrees (WGS84): ``lat``/``latitude``/``lat_deg`` and ``lon``/``lng``/``longitude``/``lon_deg``,
   projected to east/north metres centred on the first point (see `geodetic_to_local_en`). If a file has
   both x/y and latitude/longitude columns, x/y are used.
@@ -28,7 +32,7 @@ from numpy.typing import ArrayLike
 from pyproj import CRS, Transformer
 
 from workbench.base.errors import WorkbenchInputError, require_in_range
-from workbench.base.waypoints import MIN_WAYPOINT_SPACING_M, Waypoints
+from workbench.base.waypoints import MAX_TRACK_HALF_WIDTH_M, MIN_WAYPOINT_SPACING_M, Waypoints
 
 X_NAMES = ("x", "x_m")
 Y_NAMES = ("y", "y_m")
@@ -36,6 +40,8 @@ LAT_NAMES = ("lat", "latitude", "lat_deg")
 LON_NAMES = ("lon", "lng", "longitude", "lon_deg")
 SPEED_MPS_NAMES = ("v", "v_mps", "speed_mps")
 SPEED_KMH_NAMES = ("v_kmh", "speed_kmh")
+WIDTH_RIGHT_NAMES = ("w_tr_right_m", "w_right_m")
+WIDTH_LEFT_NAMES = ("w_tr_left_m", "w_left_m")
 KMH_PER_MPS = 3.6
 
 
@@ -72,11 +78,13 @@ def read_waypoints(path: str | os.PathLike[str]) -> Waypoints:
         if _normalise(speed_col) in SPEED_KMH_NAMES:
             speed = speed / KMH_PER_MPS
 
+    right, left = _track_widths(table, name)
     closed = str(table.columns[0]).lstrip().startswith("#")
     if np.hypot(x[-1] - x[0], y[-1] - y[0]) < MIN_WAYPOINT_SPACING_M:
         x, y, speed = x[:-1], y[:-1], None if speed is None else speed[:-1]
+        right, left = (None, None) if right is None or left is None else (right[:-1], left[:-1])
         closed = True
-    return Waypoints(x, y, speed_mps=speed, closed=closed, source=name)
+    return Waypoints(x, y, speed_mps=speed, closed=closed, source=name, width_right_m=right, width_left_m=left)
 
 
 def geodetic_to_local_en(
@@ -158,6 +166,32 @@ def _refuse_unknown_speed_unit(table: pd.DataFrame, file_name: str) -> None:
                 f"{file_name}: column {str(column).strip()!r} looks like a speed, but its unit is not known; name it "
                 f"one of {SPEED_MPS_NAMES} (m/s) or {SPEED_KMH_NAMES} (km/h)"
             )
+
+
+def _track_widths(table: pd.DataFrame, file_name: str) -> tuple[np.ndarray | None, np.ndarray | None]:
+    """The right and left track widths (m), or (None, None) without width columns; one without the other, a
+    blank, non-numeric, NaN, negative or implausibly large entry raises naming the column and line."""
+    right_col, left_col = _find(table, WIDTH_RIGHT_NAMES, file_name), _find(table, WIDTH_LEFT_NAMES, file_name)
+    if right_col is None and left_col is None:
+        return None, None
+    if right_col is None or left_col is None:
+        found, wanted = (right_col, WIDTH_LEFT_NAMES) if left_col is None else (left_col, WIDTH_RIGHT_NAMES)
+        raise WorkbenchInputError(
+            f"{file_name}: column {str(found).strip()!r} gives one track width but no column gives the other "
+            f"(one of {wanted}); give both edges' distances from the centre line, or neither"
+        )
+    widths = []
+    for column in (right_col, left_col):
+        values = _numbers(table, column, file_name)
+        bad = np.flatnonzero((values < 0.0) | (values > MAX_TRACK_HALF_WIDTH_M))
+        if bad.size:
+            i = int(bad[0])
+            raise WorkbenchInputError(
+                f"{file_name}: column {column!r}, line {table.index[i] + 2}: {float(values[i])!r} m is outside the "
+                f"allowed range [0, {MAX_TRACK_HALF_WIDTH_M:g}] m (the distance from the centre line to the edge)"
+            )
+        widths.append(values)
+    return widths[0], widths[1]
 
 
 def _require_rows(table: pd.DataFrame, file_name: str) -> None:

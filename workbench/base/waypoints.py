@@ -1,4 +1,4 @@
-"""Waypoints: the raw (x, y[, speed]) points a reference path is built from, validated once."""
+"""Waypoints: the raw (x, y[, speed][, track widths]) points a reference path is built from, validated once."""
 
 from __future__ import annotations
 
@@ -20,6 +20,9 @@ MAX_TURN_AT_WAYPOINT_DEG = 150.0
 #: the two segments beside it): a 0.5 m radius, tighter than a 1/10-scale research car's (F1TENTH: 0.33 m
 #: wheelbase, 0.42 rad lock, 0.74 m). Tighter spots are zig-zags or noise in the waypoints.
 MAX_WAYPOINT_CURVATURE_1PM = 2.0
+#: A track edge lies at most this far from the centre line (m): far beyond any road or race track (Zandvoort's widest
+#: is 8.3 m); a larger value is a unit or column mix-up (millimetres, coordinates).
+MAX_TRACK_HALF_WIDTH_M = 200.0
 
 
 @dataclass(frozen=True, eq=False)
@@ -28,7 +31,9 @@ class Waypoints:
 
     x_m, y_m: positions; speed_mps: optional speed at each waypoint; closed: the path returns to its first
     point after the last (the last point is *not* repeated); source: where the points came from (a file name or a
-    scenario), used in error messages and reports.
+    scenario), used in error messages and reports; width_right_m, width_left_m: optional distances (m, >= 0, both
+    or neither) from each waypoint to the track's right and left edges, across the path (TUMFTM's w_tr_right_m,
+    w_tr_left_m), so runs can be measured against the track and its edges drawn.
     """
 
     x_m: np.ndarray
@@ -36,6 +41,8 @@ class Waypoints:
     speed_mps: np.ndarray | None = None
     closed: bool = False
     source: str = "waypoints"
+    width_right_m: np.ndarray | None = None
+    width_left_m: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         x = np.asarray(self.x_m, dtype=float).ravel()
@@ -83,6 +90,39 @@ class Waypoints:
                     "speed column out to plan one)"
                 )
             object.__setattr__(self, "speed_mps", v)
+        self._check_widths(x.size)
+
+    def _check_widths(self, n: int) -> None:
+        """Both track widths or neither; each n finite values in [0, MAX_TRACK_HALF_WIDTH_M] m, stored as arrays."""
+        right, left = self.width_right_m, self.width_left_m
+        if (right is None) != (left is None):
+            given, missing = ("right", "left") if left is None else ("left", "right")
+            raise WorkbenchInputError(
+                f"{self.source}: the track's {given} width is given but not its {missing} width; give both (the "
+                "distances from the centre line to the right and left edges) or neither"
+            )
+        for side, values in (("right", right), ("left", left)):
+            if values is None:
+                continue
+            w = np.asarray(values, dtype=float).ravel()
+            if w.size != n:
+                raise WorkbenchInputError(
+                    f"{self.source}: the {side} track width has {w.size} values but there are {n} waypoints"
+                )
+            require_finite(f"{self.source}: {side} track width", w)
+            bad = np.flatnonzero((w < 0.0) | (w > MAX_TRACK_HALF_WIDTH_M))
+            if bad.size:
+                i = int(bad[0])
+                raise WorkbenchInputError(
+                    f"{self.source}: the {side} track width at waypoint {i} is {float(w[i]):g} m; it must be in "
+                    f"[0, {MAX_TRACK_HALF_WIDTH_M:g}] m (the distance from the centre line to that edge)"
+                )
+            object.__setattr__(self, f"width_{side}_m", w)
+
+    @property
+    def has_widths(self) -> bool:
+        """Whether the waypoints carry the track's widths."""
+        return self.width_right_m is not None
 
     def __len__(self) -> int:
         return int(self.x_m.size)

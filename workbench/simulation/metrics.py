@@ -2,7 +2,8 @@
 
 CTE is measured at the reference point (the tractor's rear-axle centre), signed, left of the path positive, at
 every logged (controller) step. Vehicle fields (max_ltr, max_offtracking_m) are null for vehicles that do not
-output them.
+output them; the track fields (min_track_margin_m, left_track) are null when the path has no track widths or the
+vehicle's outline is not known (`track_margin.py`).
 """
 
 from __future__ import annotations
@@ -15,6 +16,7 @@ import numpy as np
 from workbench.base.path import ReferencePath
 from workbench.simulation.limit_cycle import detect_limit_cycle, oscillation
 from workbench.simulation.speed_profile import G_MPS2
+from workbench.simulation.track_margin import VehicleOutline, track_margins, trailer_feet
 
 #: The keys of metrics.json, in order.
 METRIC_KEYS: tuple[str, ...] = (
@@ -39,6 +41,8 @@ METRIC_KEYS: tuple[str, ...] = (
     "max_offtracking_m",
     "step_time_median_us",
     "step_time_p99_us",
+    "min_track_margin_m",
+    "left_track",
 )
 
 
@@ -53,7 +57,10 @@ class Metrics:
     average, away from the trace's ends (`limit_cycle.oscillation`; None for a trace under about 2 s);
     limit_cycle, limit_cycle_hz, limit_cycle_amplitude_deg: whether the steering wheel limit-cycles, at what
     frequency and steering-wheel amplitude (`limit_cycle.detect_limit_cycle`; None when it does not);
-    max_offtracking_m: the largest lateral distance of the trailer's rear-axle centre from the path.
+    max_offtracking_m: the largest lateral distance of the trailer's rear-axle centre from the path;
+    min_track_margin_m: the least distance (m) from the vehicle's outline (the trailer's too) to an edge of the track,
+    negative when it went beyond one (`track_margin.track_margins`); left_track: whether it did; both None when the
+    path has no track widths or the outline is not known.
     """
 
     scenario: str
@@ -77,6 +84,8 @@ class Metrics:
     max_offtracking_m: float | None
     step_time_median_us: float | None
     step_time_p99_us: float | None
+    min_track_margin_m: float | None = None
+    left_track: bool | None = None
 
     def to_dict(self) -> dict[str, object]:
         return asdict(self)
@@ -93,8 +102,7 @@ def offtracking(path: ReferencePath, x_m: np.ndarray, y_m: np.ndarray) -> np.nda
 
     Sideways only (`Projection.cte_m`): a trailer starts behind an open path's start, where the distance to the
     start point would count its length as offtracking."""
-    tracker = path.tracker(None)
-    return np.array([tracker.update(float(x), float(y)).cte_m for x, y in zip(x_m, y_m, strict=True)])
+    return trailer_feet(path, np.asarray(x_m, dtype=float), np.asarray(y_m, dtype=float))[1]
 
 
 def compute_metrics(
@@ -106,8 +114,10 @@ def compute_metrics(
     vehicle: str,
     completed: bool,
     path_length_m: float,
+    outline: VehicleOutline | None = None,
 ) -> Metrics:
-    """Metrics of a trace (columns as the simulator logs them)."""
+    """Metrics of a trace (columns as the simulator logs them); outline: the vehicle's, for the track margin (None:
+    the track fields are None)."""
     t = trace["t_s"]
     n = t.size
     cte = trace["cte_m"]
@@ -117,9 +127,12 @@ def compute_metrics(
     steer_rate = np.diff(steer) / np.diff(t) if n > 1 else None
     deviation = oscillation(t, steer)
     cycle = detect_limit_cycle(t, steer)
-    off = None
+    off = trailer_s = None
     if "trailer_x_m" in trace and n:
-        off = offtracking(path, trace["trailer_x_m"], trace["trailer_y_m"])
+        trailer_s, off = trailer_feet(path, trace["trailer_x_m"], trace["trailer_y_m"])
+    margin = None
+    if outline is not None and path.has_widths and n:
+        margin = float(np.min(track_margins(path, trace, outline, trailer_s)))
     return Metrics(
         scenario=scenario,
         controller=controller,
@@ -142,4 +155,6 @@ def compute_metrics(
         max_offtracking_m=_max_abs(off),
         step_time_median_us=float(np.median(step_us)) if n else None,
         step_time_p99_us=float(np.percentile(step_us, 99)) if n else None,
+        min_track_margin_m=margin,
+        left_track=None if margin is None else margin < 0.0,
     )

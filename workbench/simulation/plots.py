@@ -148,11 +148,15 @@ COURSE_STYLES: tuple[tuple[str, str, str], ...] = (
 def _draw_reference(
     result: PlottedRun, ax: Axes, whose: str = "", style: tuple[str, str, str] = COURSE_STYLES[0]
 ) -> None:
-    """The path and cones of the run's scenario; whose: the vehicles that ran it, named in the legend when a plot
-    shows several courses."""
+    """The path, the track's edges (when the path has widths) and the cones of the run's scenario; whose: the
+    vehicles that ran it, named in the legend when a plot shows several courses."""
     path = result.path
     suffix = f" ({whose})" if whose else ""
     colour, line, cone_colour = style
+    edges = path.track_edges()
+    if edges is not None:
+        for k, (x, y) in enumerate(edges):
+            ax.plot(x, y, color=colour, lw=0.8, alpha=0.45, label=f"track edges{suffix}" if k == 0 else None)
     ax.plot(path.x_m, path.y_m, color=colour, ls=line, lw=1.0, label=f"reference{suffix}")
     cones = result.scenario.cones_xy
     if cones is not None:

@@ -18,7 +18,9 @@ if TYPE_CHECKING:
     import pandas as pd
     from matplotlib.axes import Axes
 
+    from workbench.simulation.feasibility import InfeasibleSpan
     from workbench.simulation.run_config import SimulationConfig
+    from workbench.simulation.track_margin import VehicleOutline
 
 
 class Status(StrEnum):
@@ -33,7 +35,10 @@ class Status(StrEnum):
 
 @dataclass(frozen=True, eq=False)
 class SimulationResult:
-    """trace: one array per logged signal (SI units, units in the names), one row per controller step."""
+    """trace: one array per logged signal (SI units, units in the names), one row per controller step; outline: the
+    vehicle's plan-view outline, for the track margin (None: not known, the track metrics are null);
+    infeasible_curvature: where the vehicle cannot follow the path at its planned speed (`feasibility.check_path`;
+    empty when it can, None when not checked)."""
 
     trace: dict[str, np.ndarray]
     status: Status
@@ -43,6 +48,8 @@ class SimulationResult:
     controller: str
     vehicle: str
     config: SimulationConfig
+    outline: VehicleOutline | None = None
+    infeasible_curvature: tuple[InfeasibleSpan, ...] | None = None
     _metrics: list[Metrics] = field(default_factory=list, repr=False)
 
     @property
@@ -62,6 +69,7 @@ class SimulationResult:
                     vehicle=self.vehicle,
                     completed=self.completed,
                     path_length_m=self.path.length_m * laps,
+                    outline=self.outline,
                 )
             )
         return self._metrics[0]
@@ -94,9 +102,10 @@ class SimulationResult:
         return plots.speed_vs_distance(self, ax)
 
     def save(self, out_dir: str | Path, with_plots: bool = True) -> list[Path]:
-        """Write trace.parquet, metrics.json (plus status and message) and the PNG plots; return the paths. The
-        files a run writes that are already in out_dir (an earlier run's, the plots included when with_plots is
-        False) are removed first, so the folder never holds files of two runs."""
+        """Write trace.parquet, metrics.json (the metrics, then infeasible_curvature: a list of
+        `InfeasibleSpan.to_dict`, or null when not checked, then status and message) and the PNG plots; return the
+        paths. The files a run writes that are already in out_dir (an earlier run's, the plots included when
+        with_plots is False) are removed first, so the folder never holds files of two runs."""
         from workbench.simulation import plots  # matplotlib itself only when the plots are drawn
 
         out = Path(out_dir)
@@ -105,7 +114,12 @@ class SimulationResult:
             (out / name).unlink(missing_ok=True)
         written = [out / "trace.parquet", out / "metrics.json"]
         self.to_pandas().to_parquet(written[0], index=False)
-        document = self.metrics.to_dict() | {"status": self.status.value, "message": self.message}
+        spans = self.infeasible_curvature
+        document = self.metrics.to_dict() | {
+            "infeasible_curvature": None if spans is None else [span.to_dict() for span in spans],
+            "status": self.status.value,
+            "message": self.message,
+        }
         if not self.config.conditions.is_ideal:  # an ideal run's file stays as it was before conditions existed
             document |= {"conditions": self.config.conditions.name, "seed": self.config.seed}
         written[1].write_text(json.dumps(document, indent=2) + "\n")

@@ -1,7 +1,8 @@
 """Named test scenarios: a reference path, where the vehicle starts, and what to draw around it.
 
 `make_scenario(name)` builds one by name (`figure8`, `dlc`, `fig17`, `zandvoort`) or from a waypoint file path
-(CSV with x,y[,v] columns, a TUMFTM racetrack-database CSV, or a GPS CSV with lat/lon columns).
+(CSV with x,y[,v] columns, a TUMFTM racetrack-database CSV with its track widths, or a GPS CSV with lat/lon
+columns).
 """
 
 from __future__ import annotations
@@ -23,6 +24,16 @@ if TYPE_CHECKING:
 
 #: Environment variable naming the TUMFTM Zandvoort centre-line CSV when --track is not given.
 ZANDVOORT_ENV = "WORKBENCH_ZANDVOORT_CSV"
+#: The names the Zandvoort file is looked for under when neither --track nor the environment variable gives it:
+#: the shared copy's and the database's own (tracks/Zandvoort.csv).
+ZANDVOORT_FILE_NAMES = ("Zandvoort_track.csv", "Zandvoort.csv")
+#: The folder of the current directory the Zandvoort file is looked for in.
+TRACKS_FOLDER = "tracks"
+#: The root of the checkout this module runs from (the folder with pyproject.toml), or None for an installed
+#: package: the Zandvoort file is also looked for beside it, in ../shared/tracks/.
+CHECKOUT_ROOT: Path | None = (
+    Path(__file__).resolve().parents[2] if (Path(__file__).resolve().parents[2] / "pyproject.toml").is_file() else None
+)
 #: Bounds of a run's initial error: lateral offset (m, either side) and heading error (rad, either way).
 MAX_INITIAL_OFFSET_M = 50.0
 MAX_INITIAL_HEADING_ERROR_RAD = math.pi / 2
@@ -233,31 +244,58 @@ def fig17(options: ScenarioOptions) -> Scenario:
 
 # ---------------------------------------------------------------------------------------------- Zandvoort
 def zandvoort(options: ScenarioOptions) -> Scenario:
-    """The Zandvoort centre line from the TUMFTM racetrack database (closed loop, 4316.5 m).
+    """The Zandvoort centre line and track widths from the TUMFTM racetrack database (closed loop, 4316.5 m).
 
-    The file is third-party data (LGPL-3.0) and is not shipped: pass it with --track FILE or set the environment
-    variable WORKBENCH_ZANDVOORT_CSV.
+    The file is third-party data (LGPL-3.0) and is not shipped: pass it with --track FILE, set the environment
+    variable WORKBENCH_ZANDVOORT_CSV, or keep it where `zandvoort_track_file` looks (tracks/ of the current
+    directory, ../shared/tracks/ beside the checkout).
     """
     scenario = from_file(_zandvoort_track(options), options)
     return Scenario("zandvoort", scenario.path, _zandvoort_description(options))
 
 
+def zandvoort_places() -> list[Path]:
+    """Where the Zandvoort file is looked for when neither --track nor $WORKBENCH_ZANDVOORT_CSV names it, in order:
+    each of ZANDVOORT_FILE_NAMES in tracks/ of the current directory, then in ../shared/tracks/ beside the checkout
+    (when running from one)."""
+    folders = [Path.cwd() / TRACKS_FOLDER]
+    if CHECKOUT_ROOT is not None:
+        folders.append(CHECKOUT_ROOT.parent / "shared" / "tracks")
+    return [folder / name for folder in folders for name in ZANDVOORT_FILE_NAMES]
+
+
+def zandvoort_track_file(track_file: Path | None = None) -> Path:
+    """The Zandvoort file: `track_file` (--track), else $WORKBENCH_ZANDVOORT_CSV, else the first of
+    `zandvoort_places` that exists. WorkbenchInputError when a file named by the first two does not exist, or when
+    neither names one and no place holds it (the message lists every place looked in)."""
+    named, by = (track_file, "--track") if track_file is not None else (None, "")
+    if named is None and os.environ.get(ZANDVOORT_ENV):
+        named, by = Path(os.environ[ZANDVOORT_ENV]), f"${ZANDVOORT_ENV}"
+    if named is not None:
+        if not Path(named).is_file():
+            raise WorkbenchInputError(
+                f"zandvoort: track file {str(named)!r} does not exist (named by {by}); expected {ZANDVOORT_SOURCE}"
+            )
+        return Path(named)
+    places = zandvoort_places()
+    for place in places:
+        if place.is_file():
+            return place
+    raise WorkbenchInputError(
+        f"zandvoort needs {ZANDVOORT_SOURCE}; no --track, no ${ZANDVOORT_ENV}, and none of these exists: "
+        f"{', '.join(str(p) for p in places)}; download it and pass --track FILE, set the environment variable "
+        f"{ZANDVOORT_ENV}, or put it at one of those places"
+    )
+
+
 def _zandvoort_track(options: ScenarioOptions) -> Path:
-    """The track file: --track, else $WORKBENCH_ZANDVOORT_CSV; WorkbenchInputError when neither names a file."""
-    track = options.track_file or (Path(os.environ[ZANDVOORT_ENV]) if os.environ.get(ZANDVOORT_ENV) else None)
-    if track is None:
-        raise WorkbenchInputError(
-            f"zandvoort needs {ZANDVOORT_SOURCE}; download it and pass --track FILE "
-            f"or set the environment variable {ZANDVOORT_ENV}"
-        )
-    if not Path(track).is_file():
-        raise WorkbenchInputError(f"zandvoort: track file {str(track)!r} does not exist; expected {ZANDVOORT_SOURCE}")
-    return Path(track)
+    """The track file for these options (`zandvoort_track_file` of --track)."""
+    return zandvoort_track_file(options.track_file)
 
 
 def _zandvoort_description(options: ScenarioOptions) -> str:
-    _zandvoort_track(options)
-    return "Zandvoort (TUMFTM racetrack-database centre line, closed loop)"
+    track = _zandvoort_track(options)
+    return f"Zandvoort (TUMFTM racetrack-database centre line and track widths, closed loop) from {track}"
 
 
 # ---------------------------------------------------------------------------------------------- files
@@ -269,7 +307,8 @@ def from_file(path: Path, options: ScenarioOptions) -> Scenario:
     waypoints = read_waypoints(path)
     ref = ReferencePath.from_waypoints(waypoints, name=path.stem)
     kind = "closed loop" if waypoints.closed else "open path"
-    return Scenario(path.stem, ref, f"waypoints from {path.name} ({len(waypoints)} points, {kind})")
+    widths = ", track widths" if waypoints.has_widths else ""
+    return Scenario(path.stem, ref, f"waypoints from {path.name} ({len(waypoints)} points, {kind}{widths})")
 
 
 ScenarioFactory = Callable[[ScenarioOptions], Scenario]

@@ -27,6 +27,7 @@ from workbench.simulation.control_interface import (
     Measurement,
     SteeringController,
 )
+from workbench.simulation.feasibility import VehicleLimits, check_path, feasibility_warnings
 from workbench.simulation.result import SimulationResult, Status
 from workbench.simulation.run_config import SimulationConfig
 from workbench.simulation.scenarios import Scenario
@@ -48,6 +49,7 @@ from workbench.simulation.step_kernel import (
     project_pose,
     run_settings,
 )
+from workbench.simulation.track_margin import VehicleOutline
 from workbench.vehicles.base import VehicleModel
 
 #: Spacing (m) of the points the speed profile is planned on (the paper plans on its waypoints).
@@ -110,6 +112,9 @@ class Simulation:
         self.controller = controller
         self.config = config or SimulationConfig()
         self.path = plan_path_speed(scenario.path, self.config)
+        #: Where the vehicle cannot follow the path at its planned speed (`feasibility.py`), said before the run
+        #: and written to metrics.json.
+        self.infeasible_curvature = check_path(self.path, vehicle)
 
     def warnings(self, label: str = "the run") -> list[str]:
         """What to tell a person before this run: `path_warnings` and `long_run_warning`."""
@@ -135,24 +140,9 @@ class Simulation:
 
     def path_warnings(self) -> list[str]:
         """What about the path this vehicle cannot do, to say before the run: stretches curving tighter than its
-        steering lock turns it (Ackermann, tan(max road-wheel angle) / wheelbase)."""
-        geometry = self.vehicle.geometry
-        reach = math.tan(geometry.max_road_wheel_angle_rad) / geometry.wheelbase_m
-        path = self.path
-        beyond = np.abs(path.curvature_1pm) > reach
-        if not beyond.any():
-            return []
-        edges = np.flatnonzero(np.diff(np.concatenate(([0], beyond.astype(np.int8), [0])))).reshape(-1, 2)
-        places = [
-            f"s = {path.s_m[first]:.1f}-{path.s_m[stop - 1]:.1f} m "
-            f"(peak {np.max(np.abs(path.curvature_1pm[first:stop])):.3g} 1/m)"
-            for first, stop in edges[:3]
-        ]
-        more = f" and {len(edges) - 3} more" if len(edges) > 3 else ""
-        return [
-            f"{path.name} curves tighter than the {self.vehicle.name} can turn at full lock ({reach:.3g} 1/m, a "
-            f"radius of {1.0 / reach:.2f} m) at {', '.join(places)}{more}: expect it to run wide there"
-        ]
+        steering lock turns it (understeer included), or asking more lateral acceleration than its rollover threshold
+        or tyres allow at the planned speed (`feasibility.py`)."""
+        return feasibility_warnings(self.path.name, VehicleLimits.of(self.vehicle), self.infeasible_curvature)
 
     @property
     def total_length_m(self) -> float:
@@ -291,6 +281,8 @@ class Simulation:
             controller=controller.name,
             vehicle=vehicle.name,
             config=cfg,
+            outline=VehicleOutline.of(vehicle),
+            infeasible_curvature=self.infeasible_curvature,
         )
 
 

@@ -18,8 +18,10 @@ from workbench.base.errors import WorkbenchInputError
 from workbench.simulation.metrics import METRIC_KEYS
 
 
-def test_scenarios_lists_every_named_scenario(capsys: pytest.CaptureFixture[str], monkeypatch) -> None:
+def test_scenarios_lists_every_named_scenario(capsys: pytest.CaptureFixture[str], monkeypatch, tmp_path: Path) -> None:
     monkeypatch.delenv("WORKBENCH_ZANDVOORT_CSV", raising=False)
+    monkeypatch.chdir(tmp_path)  # no tracks/ here, and none beside the checkout: the track file is not found
+    monkeypatch.setattr("workbench.simulation.scenarios.CHECKOUT_ROOT", None)
     assert main(["scenarios"]) == 0
     out = capsys.readouterr().out
     for name in ("figure8", "dlc", "fig17", "zandvoort"):

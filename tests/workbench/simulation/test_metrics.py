@@ -80,6 +80,7 @@ def test_keys_are_the_stable_metrics_json_names() -> None:
         "rms_cte_m", "max_abs_heading_error_deg", "max_abs_steer_wheel_deg", "max_abs_steer_rate_deg_s",
         "rms_steer_rate_deg_s", "steer_oscillation_deg", "limit_cycle", "limit_cycle_hz", "limit_cycle_amplitude_deg",
         "max_abs_lat_accel_g", "max_ltr", "max_offtracking_m", "step_time_median_us", "step_time_p99_us",
+        "min_track_margin_m", "left_track",
     )  # fmt: skip
 
 

@@ -20,6 +20,7 @@ import pytest
 
 from workbench.base.errors import WorkbenchInputError
 from workbench.base.path import ReferencePath
+from workbench.simulation import scenarios
 from workbench.simulation.scenarios import (
     SCENARIOS,
     ZANDVOORT_ENV,
@@ -275,13 +276,18 @@ def test_zandvoort_from_the_track_option(monkeypatch: pytest.MonkeyPatch) -> Non
     assert path.closed and path.length_m == pytest.approx(4316.5, rel=0.005)
 
 
-def test_zandvoort_without_a_track_file(monkeypatch: pytest.MonkeyPatch) -> None:
+def test_zandvoort_without_a_track_file(monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:
     monkeypatch.delenv(ZANDVOORT_ENV, raising=False)
+    monkeypatch.chdir(tmp_path)  # no tracks/ here
+    monkeypatch.setattr(scenarios, "CHECKOUT_ROOT", tmp_path / "checkout")  # nothing in ../shared/tracks beside it
     with pytest.raises(WorkbenchInputError, match=r"download it") as info:
         make_scenario("zandvoort")
     message = str(info.value)
     assert "https://github.com/TUMFTM/racetrack-database" in message
     assert ZANDVOORT_ENV in message and "--track" in message
+    for folder in (tmp_path / "tracks", tmp_path / "shared" / "tracks"):  # every place it looked, named
+        for name in ("Zandvoort_track.csv", "Zandvoort.csv"):
+            assert str(folder / name) in message
     # describe_scenarios still lists it, marked unavailable.
     rows = dict(describe_scenarios())
     assert list(rows) == list(SCENARIOS)
