@@ -252,8 +252,8 @@ def _longer_car(tmp_path: Path) -> Path:
     """A user's vehicle file (`workbench vehicles --show kinematic-bicycle`, edited): a longer wheelbase."""
     path = tmp_path / "longer.toml"
     text = preset_text("kinematic-bicycle")
-    assert "wheelbase_m = 2.578" in text
-    path.write_text(text.replace("wheelbase_m = 2.578", "wheelbase_m = 2.9"))
+    assert "wheelbase_m = 2.579" in text
+    path.write_text(text.replace("wheelbase_m = 2.579", "wheelbase_m = 2.9"))
     return path
 
 

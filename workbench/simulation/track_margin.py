@@ -39,7 +39,7 @@ if TYPE_CHECKING:
     from workbench.vehicles.base import VehicleModel
 
 #: A passenger car (every model without a trailer): front and rear overhang beyond the axles (m). CommonRoad
-#: vehicle 2's length 4.508 m less its wheelbase 2.578 m is 1.93 m, split 0.44 / 0.56 as in a front-engined saloon.
+#: vehicle 2's length 4.508 m less its wheelbase 2.579 m is 1.93 m, split 0.44 / 0.56 as in a front-engined saloon.
 CAR_FRONT_OVERHANG_M = 0.84
 CAR_REAR_OVERHANG_M = 1.09
 #: The tractor: bumper ahead of the steer axle (m; assumed, US conventional tractor, 0.9-1.2 m) and the frame behind

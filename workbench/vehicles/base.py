@@ -159,7 +159,7 @@ class VehicleModel(ABC):
         """One line with the key parameters, for `workbench vehicles`."""
         g = self.geometry
         return (
-            f"wheelbase {g.wheelbase_m:g} m, steering ratio {g.steering_ratio:g}, "
+            f"wheelbase {g.wheelbase_m:.3f} m, steering ratio {g.steering_ratio:g}, "
             f"max road-wheel angle {math.degrees(g.max_road_wheel_angle_rad):.0f} deg, width {g.width_m:g} m"
         )
 

@@ -14,6 +14,7 @@ from pathlib import Path
 from controllers.base import Controller
 from controllers.clothoid import ClothoidConfig, ClothoidController
 from tuning.own_tuning import tuned_controller
+from tuning.tuning_dirs import read_vehicle_tuning
 from workbench.base.path import ReferencePath
 from workbench.simulation.conditions import load_conditions
 from workbench.simulation.scenarios import ScenarioOptions, make_scenario
@@ -21,6 +22,8 @@ from workbench.simulation.simulator import Simulation, SimulationConfig
 from workbench.vehicles import make_vehicle
 
 HERE = Path(__file__).resolve().parent / "replay"
+#: The kinematic bicycle's wheelbase (m) when the runs were recorded.
+RECORDED_KINEMATIC_WHEELBASE_M = 2.578
 ZANDVOORT_CSV = HERE.parents[4] / "shared" / "tracks" / "Zandvoort_track.csv"
 
 
@@ -51,10 +54,19 @@ class Case:
         return Simulation(scenario, vehicle, controller or self.controller(), config)
 
     def controller(self) -> ClothoidController:
+        """The controller as it was recorded: the kinematic bicycle's geometry and tuning of then (its wheelbase
+        was 2.578 m until issue 20 made it 2.579 m, and its tuning was made for that), every other vehicle's own."""
         config = dataclasses.replace(ClothoidConfig(), **self.options)
+        vehicle = make_vehicle(self.vehicle)
+        geometry = vehicle.geometry
+        if self.vehicle == "kinematic-bicycle":
+            geometry = dataclasses.replace(geometry, wheelbase_m=RECORDED_KINEMATIC_WHEELBASE_M)
+            if self.tuned:
+                config = dataclasses.replace(config, tuning=read_vehicle_tuning(HERE / "kinematic-bicycle-tuning"))
+            return ClothoidController(geometry, config)
         if self.tuned:
-            return tuned_controller("clothoid", make_vehicle(self.vehicle), config)
-        return ClothoidController(make_vehicle(self.vehicle).geometry, config)
+            return tuned_controller("clothoid", vehicle, config)
+        return ClothoidController(geometry, config)
 
     def path(self) -> ReferencePath:
         return self.simulation().path

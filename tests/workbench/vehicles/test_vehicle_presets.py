@@ -76,13 +76,13 @@ def test_a_missing_key_is_rejected_naming_it(tmp_path: Path) -> None:
 @pytest.mark.parametrize(
     ("old", "new", "message"),
     [
-        ("wheelbase_m = 2.578", "wheelbase_m = 0.0", r"wheelbase_m must be in \[0.5, 15.0\] m; got 0.0"),
-        ("wheelbase_m = 2.578", 'wheelbase_m = "long"', "\\[parameters\\]: 'wheelbase_m' must be a number; got 'long'"),
-        ("wheelbase_m = 2.578", "wheelbase_m = true", "\\[parameters\\]: 'wheelbase_m' must be a number; got True"),
+        ("wheelbase_m = 2.579", "wheelbase_m = 0.0", r"wheelbase_m must be in \[0.5, 15.0\] m; got 0.0"),
+        ("wheelbase_m = 2.579", 'wheelbase_m = "long"', "\\[parameters\\]: 'wheelbase_m' must be a number; got 'long'"),
+        ("wheelbase_m = 2.579", "wheelbase_m = true", "\\[parameters\\]: 'wheelbase_m' must be a number; got True"),
         ('type = "kinematic-bicycle"', 'type = "bicycle"', "type must be one of kinematic-bicycle"),
         ('type = "kinematic-bicycle"', 'kind = "kinematic-bicycle"', "\\[model\\]: unknown key 'kind'"),
         ("[parameters]", "[params]", "top level: unknown key 'params', missing key 'parameters'"),
-        ("wheelbase_m = 2.578", "wheelbase_m = = 2", "not valid TOML"),
+        ("wheelbase_m = 2.579", "wheelbase_m = = 2", "not valid TOML"),
     ],
 )
 def test_bad_files_are_rejected_naming_the_file(tmp_path: Path, old: str, new: str, message: str) -> None:
