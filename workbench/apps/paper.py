@@ -36,9 +36,10 @@ import pandas as pd
 from tqdm import tqdm
 
 from workbench.apps.lookahead_study import frechet_vs_lookahead, min_frechet_vs_cte
+from workbench.base.errors import WorkbenchInputError
 from workbench.simulation import plots
 from workbench.simulation.result import SimulationResult
-from workbench.simulation.scenarios import ZANDVOORT_ENV, ScenarioOptions, make_scenario
+from workbench.simulation.scenarios import ZANDVOORT_ENV, ScenarioOptions, make_scenario, zandvoort_track_file
 from workbench.simulation.simulator import Simulation, SimulationConfig
 from workbench.vehicles import make_vehicle
 
@@ -382,7 +383,10 @@ def reproduce_paper(
         make_scenario("zandvoort", options)
         scenarios.append("zandvoort")
     else:
-        skipped.append("Figures 15-16 and the Zandvoort row: no track file (give --track or $WORKBENCH_ZANDVOORT_CSV)")
+        skipped.append(
+            "Figures 15-16 and the Zandvoort row: no track file (give --track or $WORKBENCH_ZANDVOORT_CSV, or put "
+            "Zandvoort_track.csv in ./tracks or ../shared/tracks)"
+        )
     out.mkdir(parents=True, exist_ok=True)
     steps: list[tuple[str, Callable[[], StepOutput]]] = [
         ("Figures 4b-5b: lookahead", lambda: _lookahead_figures(out)),
@@ -421,8 +425,15 @@ def reproduce_paper(
 
 
 def _track_given(options: ScenarioOptions) -> bool:
-    """Whether a Zandvoort track file is given (`--track` or $WORKBENCH_ZANDVOORT_CSV)."""
-    return options.track_file is not None or bool(os.environ.get(ZANDVOORT_ENV))
+    """Whether there is a Zandvoort track file: given (`--track` or $WORKBENCH_ZANDVOORT_CSV; then it must be
+    usable, checked by the caller) or found where `scenarios.zandvoort_track_file` looks."""
+    if options.track_file is not None or os.environ.get(ZANDVOORT_ENV):
+        return True
+    try:
+        zandvoort_track_file(None)
+    except WorkbenchInputError:
+        return False
+    return True
 
 
 __all__ = [

@@ -22,6 +22,8 @@ STEPS = {False: 4 + 2 + 1, True: 4 + 3 + 1}
 @pytest.mark.parametrize("with_track", [False, True])
 def test_paper_writes_every_figure_and_the_table(with_track: bool, tmp_path: Path, capsys, monkeypatch) -> None:
     monkeypatch.delenv("WORKBENCH_ZANDVOORT_CSV", raising=False)
+    monkeypatch.chdir(tmp_path)  # without --track: no file in ./tracks nor beside the checkout
+    monkeypatch.setattr("workbench.simulation.scenarios.CHECKOUT_ROOT", None)
     if with_track and not TRACK.is_file():
         pytest.skip(f"TUMFTM Zandvoort_track.csv not found at {TRACK} (third-party data kept outside the repo)")
     monkeypatch.setattr("sys.stderr.isatty", lambda: True)  # a terminal: the CLI shows its progress line

@@ -44,7 +44,13 @@ from workbench.base.errors import WorkbenchInputError, value_text
 from workbench.base.input_files import check_input_file, read_json, read_toml
 from workbench.base.typed_tables import type_name, typed_value, unwrap
 from workbench.simulation.metrics import METRIC_KEYS
-from workbench.simulation.scenarios import SCENARIOS, ZANDVOORT_ENV, ZANDVOORT_SOURCE, ScenarioOptions
+from workbench.simulation.scenarios import (
+    SCENARIOS,
+    ZANDVOORT_ENV,
+    ZANDVOORT_SOURCE,
+    ScenarioOptions,
+    zandvoort_track_file,
+)
 from workbench.simulation.simulator import SimulationConfig
 from workbench.vehicles import VEHICLES
 
@@ -389,12 +395,14 @@ class StudySpec:
         """controller_config and track_file as absolute paths to readable files (track_file from the environment
         when zandvoort is run without one)."""
         if "zandvoort" in self.scenarios and self.track_file is None:
-            if not os.environ.get(ZANDVOORT_ENV):
+            try:  # $WORKBENCH_ZANDVOORT_CSV, or where the scenario looks for it
+                found = zandvoort_track_file(None)
+            except WorkbenchInputError as exc:
                 raise WorkbenchInputError(
                     f"study.scenarios has zandvoort, which needs {ZANDVOORT_SOURCE}: give study.track_file "
-                    f"or set the environment variable {ZANDVOORT_ENV}"
-                )
-            object.__setattr__(self, "track_file", os.environ[ZANDVOORT_ENV])
+                    f"or set the environment variable {ZANDVOORT_ENV} ({exc})"
+                ) from None
+            object.__setattr__(self, "track_file", str(found))
         for name in ("controller_config", "track_file"):
             value = getattr(self, name)
             if value is not None:

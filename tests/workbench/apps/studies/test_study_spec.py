@@ -192,6 +192,8 @@ def test_an_optimise_spec_needs_its_table(tiny_spec: Path) -> None:
 
 def test_zandvoort_needs_its_track(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.delenv("WORKBENCH_ZANDVOORT_CSV", raising=False)
+    monkeypatch.chdir(tmp_path)  # no tracks/ here, and none beside the checkout: the file is not found
+    monkeypatch.setattr("workbench.simulation.scenarios.CHECKOUT_ROOT", None)
     path = write_spec(tmp_path, HEAD.replace('"dlc"', '"zandvoort"'))
     with pytest.raises(WorkbenchInputError, match="needs the TUMFTM racetrack-database file"):
         load_spec(path)
