@@ -9,6 +9,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from stadium_tracks import stadium_file
 
 from workbench.base.clothoid_chain import ClothoidChain
 from workbench.base.errors import WorkbenchInputError
@@ -32,19 +33,8 @@ G = 9.80665
 
 
 def _hairpin_file(folder: Path, radius_m: float = 6.5, straight_m: float = 80.0, first: int = 0) -> Path:
-    """A TUMFTM centre line (closed, counter-clockwise) of two straights joined by semicircular hairpins of
-    `radius_m`, points every 2 m on the straights and 0.8 m or so on the hairpins, starting at point `first` (0:
-    mid-straight)."""
-    points = [(x, 0.0) for x in np.arange(0.0, straight_m / 2, 2.0)]
-    arc = np.linspace(-math.pi / 2, math.pi / 2, 26)[:-1]
-    points += [(straight_m / 2 + radius_m * math.cos(a), radius_m + radius_m * math.sin(a)) for a in arc]
-    points += [(x, 2 * radius_m) for x in np.arange(straight_m / 2, -straight_m / 2, -2.0)]
-    points += [(-straight_m / 2 - radius_m * math.cos(a), radius_m - radius_m * math.sin(a)) for a in arc]
-    points += [(x, 0.0) for x in np.arange(-straight_m / 2, 0.0, 2.0)]
-    file = folder / "hairpins.csv"
-    rows = "\n".join(f"{float(x)!r},{float(y)!r},5.0,5.0" for x, y in points[first:] + points[:first])
-    file.write_text("# x_m,y_m,w_tr_right_m,w_tr_left_m\n" + rows + "\n", encoding="utf-8")
-    return file
+    """The hairpin track (`stadium_tracks.stadium_file`), 5 m of track each side."""
+    return stadium_file(folder, "hairpins.csv", radius_m, straight_m=straight_m, first=first)
 
 
 def _planned(path: ReferencePath, **config: float) -> ReferencePath:

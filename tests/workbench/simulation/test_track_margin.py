@@ -11,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from stadium_tracks import stadium_file
 
 from controllers import make_controller
 from workbench.base.clothoid_chain import ClothoidChain
@@ -168,18 +169,8 @@ def test_without_widths_or_outline_the_track_fields_are_null(tmp_path: Path) -> 
 
 
 def _stadium_file(folder: Path, radius_m: float, left_m: float, right_m: float, straight_m: float = 80.0) -> Path:
-    """A TUMFTM file of a closed stadium (counter-clockwise): straights joined by semicircular hairpins, points every
-    1 m or so, the start in the middle of the lower straight."""
-    points = [(x, 0.0) for x in np.arange(0.0, straight_m / 2, 2.0)]
-    arc = np.linspace(-math.pi / 2, math.pi / 2, 26)[:-1]
-    points += [(straight_m / 2 + radius_m * math.cos(a), radius_m + radius_m * math.sin(a)) for a in arc]
-    points += [(x, 2 * radius_m) for x in np.arange(straight_m / 2, -straight_m / 2, -2.0)]
-    points += [(-straight_m / 2 - radius_m * math.cos(a), radius_m - radius_m * math.sin(a)) for a in arc]
-    points += [(x, 0.0) for x in np.arange(-straight_m / 2, 0.0, 2.0)]
-    rows = "\n".join(f"{float(x)!r},{float(y)!r},{right_m},{left_m}" for x, y in points)
-    file = folder / "stadium.csv"
-    file.write_text("# x_m,y_m,w_tr_right_m,w_tr_left_m\n" + rows + "\n", encoding="utf-8")
-    return file
+    """The stadium track (`stadium_tracks.stadium_file`)."""
+    return stadium_file(folder, "stadium.csv", radius_m, right_m, left_m, straight_m)
 
 
 def _brute_force_margins(
