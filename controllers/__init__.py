@@ -15,6 +15,10 @@ import importlib
 from collections.abc import Iterator, Mapping
 from typing import TYPE_CHECKING, Any
 
+from workbench.base.compiled_cache import use_versioned_numba_cache
+
+use_versioned_numba_cache()  # before any controller module imports numba (workbench/base/compiled_cache.py)
+
 if TYPE_CHECKING:
     from controllers.base import Controller, Measurement
     from controllers.clothoid import ClothoidConfig, ClothoidController

@@ -17,8 +17,9 @@ What stays in Python: the speed over ground (`math.hypot`, whose rounding differ
 calls in about one case in 500), the measurement and the controller, the conditions' models, and the messages of
 a run that ends.
 
-Numba keys a cached kernel on its own source file only: after editing `workbench/base/path_search.py` or
-`speed_control.py` delete the caches (`__pycache__/*.nbi`, `*.nbc`), or this module's kernels keep the old code.
+Numba keys a cached kernel on its own source file only, and these kernels compile `path_search.py`'s and
+`speed_control.py`'s into themselves: the cache folder is therefore per version of all the compiled sources
+(`workbench/base/compiled_cache.py`).
 """
 
 from __future__ import annotations
