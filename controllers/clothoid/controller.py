@@ -273,7 +273,7 @@ class ClothoidController(Controller):
         self._here: PathTracker = path.tracker(0.0)
         self._kept = np.empty(path.x_m.size + 1)  # the path's distances from the start pose, one step's search
         self._state[:] = np.nan
-        self._state[sk.S_HELD_BAND] = self._state[sk.S_FILTER_KMH] = -1.0
+        self._state[sk.S_HELD_BAND] = -1.0
         self._floor_table[:] = np.nan
         self._filter_table[:] = np.nan
         p = self._params

@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Protocol
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numba import njit
@@ -146,14 +146,6 @@ def lead_step(coefficients: np.ndarray, x: np.ndarray, u: float) -> float:  # pr
     return x3 + c1 * (x1 - x3) + c2 * (x2 - x3) + d * (u - x3)
 
 
-class SteeringFilter(Protocol):
-    """What the controller needs of a filter: reset to a steady input, advance one sample."""
-
-    def reset(self, u0: float = 0.0) -> None: ...
-
-    def step(self, u: float) -> float: ...
-
-
 class DiscreteLeadFilter:
     """Eq. 6 discretised by Tustin (bilinear) at the controller's sample time dt_s (s), optionally pre-warped so
     that the response matches the continuous filter exactly at prewarp_rad_s (which must lie below the Nyquist
@@ -248,24 +240,6 @@ class DiscreteLeadFilter:
         u0 = float(u0)
         self._x[:] = u0
 
-    def continue_from(self, other: DiscreteLeadFilter) -> DiscreteLeadFilter:
-        """Take over the state of `other` (a filter of other parameters: a speed schedule moving on). The states
-        are the same physical signals (the lag chain), so the switch is bumpless at steady state."""
-        self._x[:] = other._x
-        return self
-
     def step(self, u: float) -> float:
         """Advance one sample with input u; return the output y[k] = C x[k] + D u[k] (`lead_step`)."""
         return lead_step(self._coeffs, self._x, float(u))
-
-
-class PassThroughFilter:
-    """The lead filter switched off: the output is the input."""
-
-    __slots__ = ()
-
-    def reset(self, u0: float = 0.0) -> None:
-        """Nothing to reset."""
-
-    def step(self, u: float) -> float:
-        return u

@@ -46,10 +46,9 @@ PARAM_COUNT = 36
 S_KAPPA_CMD = 0  # the integrator's curvature command (1/m; NaN before the first step)
 S_HELD_BAND = 1  # the speed band whose floor applies (-1 before the first step)
 S_LOOKAHEAD = 2  # the lookahead filter's state: its lookahead and floor (m; NaN before the first step)
-S_FILTER_KMH = 4  # the km/h whose lead filter runs (-1 before the first step)
-S_FILTER_X = 5  # the lead filter's three states (rad)
-S_NEED = 8  # what a NEED_* return asks for: the speed band or the km/h
-STATE_SIZE = 9
+S_FILTER_X = 4  # the lead filter's three states (rad), shared by the filters of every km/h (a bumpless switch)
+S_NEED = 7  # what a NEED_* return asks for: the speed band or the km/h
+STATE_SIZE = 8
 
 # `clothoid_step`'s status.
 STEP_DONE, NEED_FLOOR, NEED_FILTER = 0, 1, 2
@@ -159,9 +158,6 @@ def clothoid_step(
         state[S_NEED] = band
         return 0.0, NEED_FLOOR
 
-    # the lead filter of this km/h, continuing from the previous one's state (ClothoidController._lead_filter)
-    if filtered and kmh != int(state[S_FILTER_KMH]):
-        state[S_FILTER_KMH] = kmh
     wheelbase, ratio = p[P_WHEELBASE], p[P_STEERING_RATIO]
     steering_kappa = math.tan(steer_wheel_rad / ratio) / wheelbase
     if math.isnan(state[S_KAPPA_CMD]):  # first step: continue from the vehicle's current steering
@@ -249,7 +245,7 @@ def clothoid_step(
     state[S_KAPPA_CMD] = kappa_cmd
     steer = math.atan(wheelbase * kappa_cmd) * ratio  # Ackermann: tan(phi) = L kappa
     command = steer
-    if filtered:  # Eq. 6
+    if filtered:  # Eq. 6: this km/h's filter, on the state the last one left (the same lag-chain signals)
         command = lead_step(filters[kmh], state[S_FILTER_X : S_FILTER_X + 3], steer)
     limit = p[P_MAX_STEER]
     command = min(max(command, -limit), limit)

@@ -12,7 +12,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy import signal
 
-from controllers.clothoid.lead_filter import DiscreteLeadFilter, LeadFilterParams, PassThroughFilter
+from controllers.clothoid.lead_filter import DiscreteLeadFilter, LeadFilterParams
 from workbench.base.errors import WorkbenchInputError
 
 PAPER_LIKE = LeadFilterParams.from_lag(4.44, 0.80)  # wz = 4.44, psi = 0.8, wp = 13.32 rad/s
@@ -160,13 +160,10 @@ def test_steady_state_gain_is_one() -> None:
     assert run(f, np.full(2000, 0.7))[-1] == pytest.approx(0.7, abs=1e-12)  # converged from rest after 20 s
 
 
-def test_step_is_plain_python_and_pass_through_passes_through() -> None:
+def test_step_and_state_are_plain_python_floats() -> None:
     f = DiscreteLeadFilter(PAPER_LIKE, 0.01)
     f.reset(0.1)
     assert type(f.step(0.2)) is float and all(type(v) is float for v in f.state)
-    off = PassThroughFilter()
-    off.reset(0.3)
-    assert [off.step(v) for v in (0.1, -2.0, 7.5)] == [0.1, -2.0, 7.5]
 
 
 @pytest.mark.parametrize(
