@@ -32,7 +32,6 @@ import tempfile
 import time
 from collections.abc import Sequence
 from dataclasses import asdict, dataclass, field
-from importlib import metadata
 from pathlib import Path
 from typing import Any
 
@@ -61,12 +60,12 @@ from tuning.tuning_dirs import (
     shipped_tuning_root,
 )
 from workbench.base.errors import WorkbenchInputError, require_in_range
+from workbench.base.version import installed_version
 from workbench.vehicles import list_presets, make_vehicle
 from workbench.vehicles.base import VehicleModel
 
 EXIT_STALE = 1
 EXIT_INPUT_ERROR = 2
-PACKAGE = "lateral-workbench"
 
 
 @dataclass(frozen=True)
@@ -233,13 +232,6 @@ def tuning_commands(
     return [schedule, [*limits, "--out", LIMITS_FILE]]
 
 
-def _package_version() -> str:
-    try:
-        return metadata.version(PACKAGE)
-    except metadata.PackageNotFoundError:  # pragma: no cover - running from a source tree without installing
-        return "unknown"
-
-
 def write_manifest(
     directory: Path,
     vehicle: VehicleModel,
@@ -284,7 +276,7 @@ def write_manifest(
         "commands": [shlex.join(c) for c in commands],
         "dropped_speeds": dropped,
         "notes": notes,
-        "package_version": _package_version(),
+        "package_version": installed_version() or "unknown",
         "date": datetime.datetime.now(datetime.UTC).date().isoformat(),
         "generation_time_s": {k: round(v, 1) for k, v in seconds.items()},
     }

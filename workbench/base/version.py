@@ -49,15 +49,20 @@ def checkout_commit(root: Path = SOURCE_ROOT) -> str | None:
     return commit + ("+dirty" if changes else "")
 
 
-def version_text(prog: str) -> str:
-    """What `PROG --version` prints: the program, the distribution and its installed version (importlib.metadata)
-    and, from a git checkout, the commit (`checkout_commit`)."""
+def installed_version() -> str | None:
+    """The installed distribution's version (importlib.metadata), None when it is not installed."""
     import importlib.metadata
 
     try:
-        version = importlib.metadata.version(DISTRIBUTION)
+        return importlib.metadata.version(DISTRIBUTION)
     except importlib.metadata.PackageNotFoundError:
-        version = "(version unknown: not installed; run `pip install -e .` in the checkout)"
+        return None
+
+
+def version_text(prog: str) -> str:
+    """What `PROG --version` prints: the program, the distribution and its installed version and, from a git
+    checkout, the commit (`checkout_commit`)."""
+    version = installed_version() or "(version unknown: not installed; run `pip install -e .` in the checkout)"
     commit = checkout_commit()
     return f"{prog} ({DISTRIBUTION}) {version}" + (f", commit {commit}" if commit else "")
 
