@@ -271,7 +271,6 @@ class ClothoidController(Controller):
         self._dt = float(sample_time_s)
         self._tracker: PathTracker = path.tracker(0.0)
         self._here: PathTracker = path.tracker(0.0)
-        self._kept = np.empty(path.x_m.size + 1)  # the path's distances from the start pose, one step's search
         self._state[:] = np.nan
         self._state[sk.S_HELD_BAND] = -1.0
         self._floor_table[:] = np.nan
@@ -279,6 +278,7 @@ class ClothoidController(Controller):
         p = self._params
         p[sk.P_DT], p[sk.P_PATH_SPACING], p[sk.P_PATH_LENGTH] = self._dt, path.spacing_m, path.length_m
         p[sk.P_PATH_EXTENT], p[sk.P_TRACKER_WINDOW] = self._tracker.extent_m, self._tracker.min_window_m
+        p[sk.P_PATH_MAX_SEGMENT] = path.max_segment_m
         self._diag = self._declare_diagnostics(DIAGNOSTIC_KEYS)
         self._tables()  # read again: limits, tuning and schedule are the controller's attributes
         if path.speed_mps is not None:  # the floors of the planned speeds now, not inside a step (~0.1 s per band)
@@ -399,7 +399,7 @@ class ClothoidController(Controller):
                 self._state, path.x_m, path.y_m, path.heading_rad, path.curvature_1pm, path.closed,
                 self._tracker.state, self._here.state, self._limits, self._limit_speeds, self._lags,
                 self._measured_lags, self._lag_speeds, self._schedule, self._schedule_speeds, self._floor_table,
-                self._filter_table, self._buffers, self._scores, self._results, self._kept, self._scratch,
+                self._filter_table, self._buffers, self._scores, self._results, self._scratch,
                 self._diag,
             )  # fmt: skip
             if status == sk.STEP_DONE:

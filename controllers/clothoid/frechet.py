@@ -40,50 +40,79 @@ _SQ_HIGH = 1e280
 
 
 @njit(cache=True)
+def _cell(ax: np.ndarray, ay: np.ndarray, bx: np.ndarray, by: np.ndarray, i: int, j: int, squared: bool) -> float:
+    """|A_i - B_j|, squared if `squared` (every cell's one formula, so that equal cells compare equal)."""
+    dx, dy = ax[i] - bx[j], ay[i] - by[j]
+    return dx * dx + dy * dy if squared else math.hypot(dx, dy)
+
+
+@njit(cache=True)
 def _coupling_dp(
     ax: np.ndarray, ay: np.ndarray, bx: np.ndarray, by: np.ndarray, squared: bool, limit: float
 ) -> float:  # pragma: no cover - compiled
-    """The DP's bottom-right cell with the rolling row over B (the caller passes the shorter curve as B).
+    """The DP's bottom-right cell with the rolling row over B (the caller passes the shorter curve as B, so
+    m <= n).
 
     Cells hold squared distances if `squared`, else distances. Returns -1.0 as soon as the smallest cell of a
     row exceeds `limit` (compared as a distance: sqrt of the cell if squared): every coupling crosses every row
     and the cells never decrease along it, so the final value exceeds `limit` too.
+
+    Banded: the distance is at most `bound`, the largest cell of one coupling (j = floor(i (m-1) / (n-1)), which
+    advances j by 0 or 1 a row), so a cell farther apart than `bound` is on no optimal coupling and is left out
+    (+inf), and so is every cell no finite cell reaches. Each row then spans only the cells reachable from the
+    last row's, a few about the diagonal for curves that run alike (~n cells instead of n m). A cell that is not
+    left out gets the full DP's very value (the min over its neighbours only ever skips values above `bound`,
+    which the optimum does not take), so the result and the row at which the early exit stops are the full
+    DP's, bit for bit.
     """
     n, m = ax.size, bx.size
+    bound = 0.0
+    for i in range(n):
+        d = _cell(ax, ay, bx, by, i, (i * (m - 1)) // (n - 1) if n > 1 else 0, squared)
+        if d > bound:
+            bound = d
     row = np.empty(m)
-    # Row 0: Q's walker advances while P's waits at P_0.
-    x0, y0 = ax[0], ay[0]
+    # Row 0: Q's walker advances while P's waits at P_0, up to the first cell beyond the bound.
     acc = 0.0
+    hi = -1
     for j in range(m):
-        dx, dy = x0 - bx[j], y0 - by[j]
-        d = dx * dx + dy * dy if squared else math.hypot(dx, dy)
+        d = _cell(ax, ay, bx, by, 0, j, squared)
+        if d > bound:
+            break
         if d > acc:
             acc = d
         row[j] = acc
+        hi = j
+    lo = 0
     row_min = row[0]  # row 0 is non-decreasing
     if (math.sqrt(row_min) if squared else row_min) > limit:
         return -1.0
     for i in range(1, n):
-        xi, yi = ax[i], ay[i]
-        dx, dy = xi - bx[0], yi - by[0]
-        d = dx * dx + dy * dy if squared else math.hypot(dx, dy)
-        diag = row[0]
-        left = d if d > diag else diag
-        row[0] = left
-        row_min = left
-        for j in range(1, m):
-            up = row[j]
+        # lo..hi: the last row's span (its first and last finite cell); a cell before lo is reached by nothing.
+        left = diag = np.inf
+        new_lo, new_hi = -1, -1
+        row_min = np.inf
+        for j in range(lo, m):
+            up = row[j] if j <= hi else np.inf
             best = diag if diag < up else up
             if left < best:
                 best = left
-            dx, dy = xi - bx[j], yi - by[j]
-            d = dx * dx + dy * dy if squared else math.hypot(dx, dy)
-            v = d if d > best else best
+            if best == np.inf and j > hi:
+                break  # nothing reaches this cell, or any after it
+            v = np.inf
+            if best < np.inf:
+                d = _cell(ax, ay, bx, by, i, j, squared)
+                if d <= bound:
+                    v = d if d > best else best
+                    if new_lo < 0:
+                        new_lo = j
+                    new_hi = j
+                    if v < row_min:
+                        row_min = v
             row[j] = v
-            if v < row_min:
-                row_min = v
             diag = up
             left = v
+        lo, hi = new_lo, new_hi
         if (math.sqrt(row_min) if squared else row_min) > limit:
             return -1.0
     return row[m - 1]

@@ -29,12 +29,10 @@ from numba import njit
 from controllers.clothoid.clothoid_fit import FIT_UNREACHABLE, fit_kernel, sample_kernel
 from controllers.clothoid.frechet import frechet_below
 from workbench.base.path import ReferencePath
-from workbench.base.path_search import first_beyond_kept
+from workbench.base.path_search import first_beyond
 
 #: Most points per sampled curve (the Fréchet cost grows with its square).
 MAX_CURVE_POINTS = 64
-#: `kept` for a single evaluation: no distances kept (`path_search.first_beyond_kept`).
-_NOTHING_KEPT = np.empty(0)
 
 
 @njit(cache=True)
@@ -83,18 +81,18 @@ def evaluate_candidate(
     kdot_max: float,
     point_spacing_m: float,
     buffers: np.ndarray,
-    kept: np.ndarray,
+    max_segment_m: float,
     limit_m: float,
 ) -> tuple[float, float, float, float, float, float, float, int]:  # pragma: no cover - compiled
     """Fit and score one lookahead distance.
 
     Returns (frechet_m, kdot, length_m, target_x, target_y, end_x, end_y, status); buffers is a (4, MAX) work
-    array for the sampled clothoid (rows 0, 1) and reference (rows 2, 3); kept: the path's distances from
-    (px, py) kept between the candidates of one search (`path_search.first_beyond_kept`; empty: none); frechet_m
-    is inf once it is known to exceed limit_m (`frechet.frechet_below`; inf: always the distance itself).
+    array for the sampled clothoid (rows 0, 1) and reference (rows 2, 3); max_segment_m: the path's longest chord
+    between samples (`path_search.first_beyond`); frechet_m is inf once it is known to exceed limit_m
+    (`frechet.frechet_below`; inf: always the distance itself).
     """
     n_seg = path_x.size - 1
-    target_index = first_beyond_kept(path_x, path_y, px, py, foot_index, lookahead_m, closed, kept)
+    target_index = first_beyond(path_x, path_y, px, py, foot_index, lookahead_m, closed, max_segment_m)
     if target_index < 0.0:  # the open path ends nearer than the lookahead: aim beyond it, on its last tangent
         target_index = float(n_seg) + _beyond_end(path_x, path_y, px, py, lookahead_m)
     tx, ty = _point_at_index(path_x, path_y, target_index, closed)
@@ -146,7 +144,7 @@ def adaptive_search(
     buffers: np.ndarray,
     scores: np.ndarray,
     results: np.ndarray,
-    kept: np.ndarray,
+    max_segment_m: float,
 ) -> tuple[float, int]:  # pragma: no cover - compiled
     """The chosen lookahead (m) and the number of candidates evaluated; scores[k] holds candidate k's Fréchet
     distance (NaN where not evaluated, inf where it was cut short: more than the threshold in the bisection, more
@@ -159,7 +157,7 @@ def adaptive_search(
     def admissible(k: int, limit: float) -> bool:
         fd, kdot, length, tx, ty, ex, ey, status = evaluate_candidate(
             path_x, path_y, closed, foot_index, px, py, theta, kappa0, min_lookahead_m + k * step_m,
-            kdot_max, point_spacing_m, buffers, kept, limit,
+            kdot_max, point_spacing_m, buffers, max_segment_m, limit,
         )  # fmt: skip
         scores[k] = fd
         row = results[k]
@@ -214,28 +212,39 @@ def turn_limited_lookahead(
     py: float,
     max_turn_rad: float,
     max_m: float,
+    max_segment_m: float,
 ) -> float:  # pragma: no cover - compiled
     """The longest lookahead (m, at most max_m) whose target (`first_beyond` from (px, py)) the path reaches before
     its heading has turned by more than max_turn_rad from the heading at the foot point: the largest distance from
     (px, py) of the samples before that turn. Why (controller.py, ClothoidConfig.max_target_turn_deg): a lateral
     offset of the vehicle shows at a target a turn theta round the bend only as offset x cos(theta), and Eq. 3's
     gain on it falls with it. A closed path's unwrapped headings continue over its seam; beyond an open path's end
-    the target lies on its straight extension, which turns no further (max_m)."""
+    the target lies on its straight extension, which turns no further (max_m).
+
+    The walk reads headings only; a sample's distance is measured where it may reach max_m (k chords past the foot
+    point it is at most r0 + k max_segment_m away, r0 the foot point's distance: `path_search.first_beyond`), and
+    those before the turn are measured once the turn is found."""
     n_seg = path_x.size - 1
     lap_turn = path_heading[-1] - path_heading[0]
     i0 = int(foot_index)
     i0w = i0 % n_seg if closed else min(i0, n_seg - 1)
     f0 = foot_index - i0
     h0 = path_heading[i0w] + f0 * (path_heading[i0w + 1] - path_heading[i0w])
-    longest = 0.0
+    fx = path_x[i0w] + f0 * (path_x[i0w + 1] - path_x[i0w])
+    fy = path_y[i0w] + f0 * (path_y[i0w + 1] - path_y[i0w])
+    # Samples before `near` are nearer than max_m (one sample's slack against rounding).
+    near = foot_index + (max_m - math.hypot(fx - px, fy - py)) / max_segment_m - 1.0 if max_segment_m > 0.0 else 0.0
     last = i0 + n_seg if closed else n_seg
     for j in range(i0 + 1, last + 1):
         i = j % n_seg if closed else j
         heading = path_heading[i] + (lap_turn * (j // n_seg - i0 // n_seg) if closed else 0.0)
         if abs(heading - h0) > max_turn_rad:
+            longest = 0.0
+            for k in range(i0 + 1, j):
+                ik = k % n_seg if closed else k
+                longest = max(longest, np.hypot(path_x[ik] - px, path_y[ik] - py))
             return min(longest, max_m)
-        longest = max(longest, np.hypot(path_x[i] - px, path_y[i] - py))
-        if longest >= max_m:
+        if j >= near and np.hypot(path_x[i] - px, path_y[i] - py) >= max_m:
             return max_m
     return max_m
 
@@ -270,7 +279,7 @@ class LookaheadEvaluator:
         fd, kdot, length, tx, ty, ex, ey, status = evaluate_candidate(
             path.x_m, path.y_m, path.closed, s_foot_m / path.spacing_m, float(x_m), float(y_m),
             float(heading_rad), float(curvature_1pm), float(lookahead_m), float(max_curvature_rate_1pm2),
-            self.point_spacing_m, self._buffers, _NOTHING_KEPT, np.inf,
+            self.point_spacing_m, self._buffers, path.max_segment_m, np.inf,
         )  # fmt: skip
         return Candidate(lookahead_m, fd, kdot, length, (tx, ty), (ex, ey), status)
 

@@ -38,9 +38,9 @@ KAPPA0_YAW_RATE, KAPPA0_COMMAND, KAPPA0_STEERING = 0, 1, 2
     P_LOOKAHEAD_GAIN, P_MAX_TURN_RAD, P_FRECHET_THRESHOLD, P_POINT_SPACING, P_TOLERANCE_X, P_TOLERANCE_Y,
     P_KDOT_MAX, P_FEEDFORWARD, P_FEEDFORWARD_WINDOW, P_FEEDFORWARD_TIME, P_REFERENCE_LEAD, P_HYSTERESIS,
     P_MAX_GROWTH, P_MAX_SHRINK, P_MIN_SPEED, P_BAND_KMH, P_BAND_HYSTERESIS_KMH, P_PATH_SPACING, P_PATH_LENGTH,
-    P_PATH_EXTENT, P_TRACKER_WINDOW,
-) = range(36)  # fmt: skip
-PARAM_COUNT = 36
+    P_PATH_EXTENT, P_TRACKER_WINDOW, P_PATH_MAX_SEGMENT,
+) = range(37)  # fmt: skip
+PARAM_COUNT = 37
 
 # The step's own state (`state`).
 S_KAPPA_CMD = 0  # the integrator's curvature command (1/m; NaN before the first step)
@@ -129,15 +129,14 @@ def clothoid_step(
     buffers: np.ndarray,
     scores: np.ndarray,
     results: np.ndarray,
-    kept: np.ndarray,
     scratch: np.ndarray,
     diagnostics: np.ndarray,
 ) -> tuple[float, int]:  # pragma: no cover - compiled
     """(steering-wheel command rad, status) of one step (`controller.py` documents what it does); diagnostics (16)
     in the order of controller.DIAGNOSTIC_KEYS. tracker, here: the states of the start pose's and the measured
     position's path trackers; floors (FLOOR_ROWS) and filters (FILTER_ROWS, 9: `DiscreteLeadFilter.coefficients`)
-    NaN where not made yet; buffers, scores, results, kept: the search's work arrays (`lookahead.py`; kept: at least
-    the path's sample count + 1); scratch: SCRATCH_SIZE floats."""
+    NaN where not made yet; buffers, scores, results: the search's work arrays (`lookahead.py`); scratch:
+    SCRATCH_SIZE floats."""
     p = params
     speed = math.hypot(vx_mps, vy_mps)  # Measurement.speed_mps
     spacing, length = p[P_PATH_SPACING], p[P_PATH_LENGTH]
@@ -187,7 +186,7 @@ def clothoid_step(
         p[P_TRACKER_WINDOW], tracker, px, py, foot,
     )  # fmt: skip
     foot_index, cte = foot[0] / spacing, foot[6]
-    kept[0] = 0.0  # a new start pose: no distances of the path from it kept yet
+    max_segment = p[P_PATH_MAX_SEGMENT]
 
     state[S_HELD_BAND] = band
     floor = max(floors[band], p[P_MIN_LOOKAHEAD], p[P_MIN_PREVIEW] * speed)
@@ -199,7 +198,7 @@ def clothoid_step(
     else:
         if p[P_MAX_TURN_RAD] > 0.0:  # the geometric ceiling (ClothoidConfig.max_target_turn_deg)
             ceiling = turn_limited_lookahead(
-                path_x, path_y, path_heading, closed, foot_index, px, py, p[P_MAX_TURN_RAD], top
+                path_x, path_y, path_heading, closed, foot_index, px, py, p[P_MAX_TURN_RAD], top, max_segment
             )
             top = max(floor, ceiling)
         if mode == MODE_SPEED:
@@ -209,7 +208,7 @@ def clothoid_step(
             searched, evaluations = adaptive_search(
                 path_x, path_y, closed, foot_index, px, py, ph, kappa0, floor, top, p[P_LOOKAHEAD_STEP], threshold,
                 p[P_TOLERANCE_X], p[P_TOLERANCE_Y], p[P_KDOT_MAX], p[P_POINT_SPACING], buffers, scores, results,
-                kept,
+                max_segment,
             )  # fmt: skip
             lookahead = filtered_lookahead(
                 state[S_LOOKAHEAD : S_LOOKAHEAD + 2], searched, floor, top, speed * p[P_DT], p[P_HYSTERESIS],
@@ -223,7 +222,7 @@ def clothoid_step(
     else:
         frechet, kdot, clothoid_length, tx, ty, ex, ey, status = evaluate_candidate(
             path_x, path_y, closed, foot_index, px, py, ph, kappa0, lookahead, p[P_KDOT_MAX], p[P_POINT_SPACING],
-            buffers, kept, np.inf,
+            buffers, max_segment, np.inf,
         )  # fmt: skip
     clothoid_kdot = reference_kdot = feedforward_kdot = kdot
     if p[P_FEEDFORWARD] != 0.0:  # path_feedforward.py: feedback relative to the path's own clothoid, plus its rate

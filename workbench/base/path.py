@@ -174,6 +174,8 @@ class ReferencePath:
         self.name = name
         self.s_m = np.arange(self.x_m.size) * self.spacing_m
         self.length_m = float(self.s_m[-1])
+        #: The longest chord between neighbouring samples (m): what `first_beyond` may skip by.
+        self.max_segment_m = float(np.hypot(np.diff(self.x_m), np.diff(self.y_m)).max()) if self.x_m.size > 1 else 0.0
         for label, arr in (("heading", self.heading_rad), ("curvature", self.curvature_1pm)):
             if arr.shape != self.x_m.shape:
                 raise WorkbenchInputError(f"{name}: {label} has {arr.size} samples, positions have {self.x_m.size}")
@@ -344,7 +346,14 @@ class ReferencePath:
         """
         s_from = float(self.wrap_s(s_from_m))
         index = first_beyond(
-            self.x_m, self.y_m, float(x_m), float(y_m), s_from / self.spacing_m, float(distance_m), self.closed
+            self.x_m,
+            self.y_m,
+            float(x_m),
+            float(y_m),
+            s_from / self.spacing_m,
+            float(distance_m),
+            self.closed,
+            self.max_segment_m,
         )
         if index < 0.0:  # no point ahead is that far: the end of an open path
             return self.length_m if not self.closed else s_from

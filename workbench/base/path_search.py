@@ -58,46 +58,41 @@ def windowed_projection(
 
 @njit(cache=True)
 def first_beyond(
-    x: np.ndarray, y: np.ndarray, px: float, py: float, start: float, distance: float, closed: bool
+    x: np.ndarray, y: np.ndarray, px: float, py: float, start: float, distance: float, closed: bool, max_segment: float
 ) -> float:  # pragma: no cover - compiled
     """Fractional sample index of the first point at or after index `start` at least `distance` from (px, py).
 
-    Walks forward at most one lap; returns -1.0 when no such point exists (the end of an open path is nearer)."""
-    return first_beyond_kept(x, y, px, py, start, distance, closed, np.empty(0))
-
-
-@njit(cache=True)
-def first_beyond_kept(
-    x: np.ndarray, y: np.ndarray, px: float, py: float, start: float, distance: float, closed: bool, kept: np.ndarray
-) -> float:  # pragma: no cover - compiled
-    """`first_beyond`, keeping the distances it computes for the next call from the same (px, py) and `start`
-    (the lookahead search's candidates): kept[0] is how many are kept, kept[1 + k] the distance of sample
-    int(start) + 1 + k. Set kept[0] = 0 for a new point; an empty `kept` keeps nothing."""
+    Walks forward at most one lap; returns -1.0 when no such point exists (the end of an open path is nearer).
+    max_segment: the longest chord between neighbouring samples (`ReferencePath.max_segment_m`; inf: none known).
+    A sample k chords past the start is at most r0 + k max_segment from (px, py), r0 the start's own distance, so
+    the walk skips the samples that bound keeps nearer than `distance` and measures only from there on: the
+    same answer, bit for bit, from a few samples instead of every one up to the target (a 20 m lookahead on a
+    path sampled every 0.1 m: 200).
+    """
     n_seg = x.size - 1
-    known = int(kept[0]) if kept.size > 0 else 0
     i0 = int(start)
     frac0 = start - i0
     # The starting point itself (interpolated).
     i0w = i0 % n_seg if closed else min(i0, n_seg - 1)
     sx = x[i0w] + frac0 * (x[i0w + 1] - x[i0w])
     sy = y[i0w] + frac0 * (y[i0w + 1] - y[i0w])
-    if math.hypot(sx - px, sy - py) >= distance:
+    r0 = math.hypot(sx - px, sy - py)
+    if r0 >= distance:
         return start
-    ax, ay, index_a = sx, sy, start
     last = i0 + n_seg if closed else n_seg
-    for j in range(i0 + 1, last + 1):
+    # The first sample the bound lets reach `distance`, one before it against rounding.
+    reach = start + (distance - r0) / max_segment - 1.0 if max_segment > 0.0 else start
+    first = i0 + 1
+    if reach > first:
+        first = int(min(reach, float(last + 1)))
+    ax, ay, index_a = sx, sy, start
+    if first > i0 + 1:
+        i = (first - 1) % n_seg if closed else first - 1
+        ax, ay, index_a = x[i], y[i], float(first - 1)
+    for j in range(first, last + 1):
         i = j % n_seg if closed else j
         bx, by = x[i], y[i]
-        k = j - i0 - 1
-        if k < known:
-            d = kept[1 + k]
-        else:
-            d = math.hypot(bx - px, by - py)
-            if 1 + k < kept.size:
-                kept[1 + k] = d
-                known = k + 1
-                kept[0] = known
-        if d >= distance:
+        if math.hypot(bx - px, by - py) >= distance:
             # The circle of radius `distance` crosses segment A-B: solve |A + u (B - A) - P| = distance for u.
             dx, dy = bx - ax, by - ay
             ex, ey = ax - px, ay - py

@@ -17,6 +17,8 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from controllers.base import Measurement
 from controllers.clothoid import ClothoidConfig
@@ -33,6 +35,10 @@ from workbench.simulation.simulator import Simulation, SimulationConfig
 from workbench.vehicles import make_vehicle
 
 PERIOD = 0.02
+#: A loop and an open path with a bend, for the ceiling's chord-bound check.
+OPEN_BEND = ClothoidChain().straight(30.0).clothoid_to(1 / 15, 10.0).arc(40.0).to_path("open bend")
+LOOP_BEND = ClothoidChain().straight(30.0).clothoid_to(1 / 15, 10.0).arc(40.0).clothoid_to(0.0, 10.0).straight(20.0)
+LOOP_BEND = LOOP_BEND.to_path("bend")
 TRUCK = make_vehicle("tractor-semitrailer")
 #: A hairpin like Zandvoort's (radius 11.4 m, about 100 deg of turn): 12 m clothoids either side of a 7.5 m arc.
 HAIRPIN_RADIUS_M = 11.4
@@ -94,6 +100,7 @@ def test_the_ceiling_on_a_circle_is_the_chord_of_the_turn(turn_deg: float, chord
         float(y),
         math.radians(turn_deg),
         100.0,
+        path.max_segment_m,
     )
     assert ceiling == pytest.approx(chord * radius, abs=0.1)
 
@@ -103,8 +110,28 @@ def test_the_ceiling_is_the_most_on_a_straight_and_past_an_open_end() -> None:
     path = ClothoidChain().straight(30.0).to_path("straight")
     x, y = path.position(25.0)
     args = (path.x_m, path.y_m, path.heading_rad, False, 25.0 / path.spacing_m, float(x), float(y), math.pi / 3)
-    assert turn_limited_lookahead(*args, 40.0) == 40.0
-    assert turn_limited_lookahead(*args, 3.0) == 3.0
+    assert turn_limited_lookahead(*args, 40.0, path.max_segment_m) == 40.0
+    assert turn_limited_lookahead(*args, 3.0, path.max_segment_m) == 3.0
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    s=st.floats(0.0, 90.0),
+    offset=st.floats(-3.0, 3.0),
+    turn_deg=st.floats(5.0, 180.0),
+    max_m=st.floats(0.5, 60.0),
+)
+def test_the_ceiling_measures_only_where_it_must_and_finds_the_same(
+    s: float, offset: float, turn_deg: float, max_m: float
+) -> None:
+    """turn_limited_lookahead with the path's longest chord gives the ceiling measured at every sample, bit for bit."""
+    heading = float(LOOP_BEND.heading(s))
+    x, y = LOOP_BEND.position(s)
+    px, py = float(x) - offset * math.sin(heading), float(y) + offset * math.cos(heading)
+    for path in (LOOP_BEND, OPEN_BEND):
+        turn = math.radians(turn_deg)
+        args = (path.x_m, path.y_m, path.heading_rad, path.closed, s / path.spacing_m, px, py, turn, max_m)
+        assert turn_limited_lookahead(*args, path.max_segment_m) == turn_limited_lookahead(*args, math.inf)
 
 
 def test_a_falling_floor_takes_the_lookahead_down_keeping_its_excess() -> None:

@@ -64,7 +64,7 @@ def test_bisection_equals_brute_force_where_the_distance_is_monotone(s: float, c
     chosen, evaluations = adaptive_search(
         BEND.x_m, BEND.y_m, BEND.closed, s / BEND.spacing_m, *pose, kappa, 5.0, 20.0, 0.5, threshold,
         10.0, 10.0, KDOT_MAX, 0.5, np.empty((4, MAX_CURVE_POINTS)), scores, results := np.empty((grid.size, 8)),
-        np.zeros(BEND.x_m.size + 1),
+        BEND.max_segment_m,
     )  # fmt: skip
     assert chosen == pytest.approx(expected)
     assert evaluations <= 2 + math.ceil(math.log2(grid.size))
@@ -73,7 +73,7 @@ def test_bisection_equals_brute_force_where_the_distance_is_monotone(s: float, c
     assert k >= 0 and results[k, 0] == scores[k]
     again = evaluate_candidate(
         BEND.x_m, BEND.y_m, BEND.closed, s / BEND.spacing_m, *pose, kappa, chosen, KDOT_MAX, 0.5,
-        np.empty((4, MAX_CURVE_POINTS)), np.empty(0), np.inf,
+        np.empty((4, MAX_CURVE_POINTS)), BEND.max_segment_m, np.inf,
     )  # fmt: skip
     assert tuple(results[k]) == tuple(float(v) for v in again)
     assert evaluated(scores, results, 5.0, 0.5, chosen + 0.25) == -1  # off the grid: not evaluated
@@ -88,7 +88,7 @@ def test_when_nothing_qualifies_the_least_frechet_distance_is_taken() -> None:
     chosen, _ = adaptive_search(
         BEND.x_m, BEND.y_m, BEND.closed, s / BEND.spacing_m, *pose, kappa, 5.0, 20.0, 0.5, 0.5,
         10.0, 10.0, KDOT_MAX, 0.5, np.empty((4, MAX_CURVE_POINTS)), scores, np.empty((grid.size, 8)),
-        np.zeros(BEND.x_m.size + 1),
+        BEND.max_segment_m,
     )  # fmt: skip
     assert fd.min() >= cte - 1e-9  # the curves start |CTE| apart
     k = int(np.argmin(np.abs(grid - chosen)))
