@@ -213,6 +213,62 @@ def test_kernel_contract_for_empty_curves() -> None:
     assert not frechet_with_early_exit(empty, empty, one, one, 1.0)
 
 
+# ---------------------------------------------------------------------------------------------------------------
+# The banded DP (cells farther apart than one coupling's largest are left out) against every cell's recursion.
+
+
+def every_cell(P: np.ndarray, Q: np.ndarray) -> float:
+    """Appendix A's recursion over all n x m cells on squared distances, one sqrt at the end: the unbanded DP (NaN
+    where its square leaves the normal floats, and the kernel measures with hypot instead)."""
+    n, m = len(P), len(Q)
+    c = np.empty((n, m))
+    for i in range(n):
+        for j in range(m):
+            dx, dy = P[i, 0] - Q[j, 0], P[i, 1] - Q[j, 1]
+            d = dx * dx + dy * dy
+            if i == 0 and j == 0:
+                c[i, j] = d
+            elif i == 0:
+                c[i, j] = max(d, c[i, j - 1])
+            elif j == 0:
+                c[i, j] = max(d, c[i - 1, j])
+            else:
+                c[i, j] = max(d, min(c[i - 1, j], c[i, j - 1], c[i - 1, j - 1]))
+    return math.sqrt(c[-1, -1]) if 1e-280 <= c[-1, -1] <= 1e280 else math.nan
+
+
+@st.composite
+def alike_curves(draw: st.DrawFn) -> tuple[np.ndarray, np.ndarray]:
+    """The controller's case, where the band is narrowest: a smooth curve and a noisy copy of it resampled at
+    another count (3..60 points each), the noise 1 mm to 1 m on a 0.5 m spacing."""
+    rng = np.random.default_rng(draw(st.integers(0, 2**32 - 1)))
+    n, m = draw(st.integers(3, 60)), draw(st.integers(3, 60))
+    length, bend = 0.5 * max(n, m), rng.uniform(-0.2, 0.2)
+    s = np.linspace(0.0, length, n)
+    P = np.column_stack([np.sin(bend * s) / bend if bend else s, (1.0 - np.cos(bend * s)) / bend if bend else 0 * s])
+    t = np.linspace(0.0, length, m)
+    Q = np.column_stack([np.interp(t, s, P[:, 0]), np.interp(t, s, P[:, 1])])
+    return P, Q + rng.normal(scale=draw(st.sampled_from([0.001, 0.02, 0.3, 1.0])), size=Q.shape)
+
+
+@settings(max_examples=150, deadline=None)
+@given(st.one_of(alike_curves(), st.tuples(curves(), curves())))
+def test_the_banded_dp_is_every_cells_recursion_bit_for_bit(PQ: tuple[np.ndarray, np.ndarray]) -> None:
+    """Leaving out the cells beyond one coupling's bound changes no bit of the distance, nor where the early exit
+    stops: cut short exactly when the unbanded DP would be, for limits at, around and below the distance."""
+    P, Q = PQ
+    d = every_cell(P, Q)
+    if math.isnan(d):
+        return  # beyond the squares' range: measured with hypot (tested above)
+    px, py = columns(P)
+    qx, qy = columns(Q)
+    assert frechet_kernel(px, py, qx, qy) == d
+    assert frechet_kernel(qx, qy, px, py) == d
+    for limit in (d, np.nextafter(d, 0.0), 0.5 * d, 0.9 * d, 2.0 * d):
+        below = frechet_below(px, py, qx, qy, float(limit))
+        assert below == d or (below == math.inf and d > limit)
+
+
 def check_early_exit_agrees(P: np.ndarray, Q: np.ndarray, threshold: float) -> None:
     px, py = columns(P)
     qx, qy = columns(Q)
