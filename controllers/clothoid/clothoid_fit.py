@@ -80,6 +80,20 @@ EXACT_TURN_RAD = RULE_MAX_TURN_RAD[-1] * MAX_PANELS
 _N_RULES = len(RULE_SIZES)
 
 
+#: Within a panel whose heading turns at most this (rad), a node's cos and sin relative to the panel's start come
+#: from their Taylor series (to the 8th and 9th power: truncated below 3e-20), else from math.cos and math.sin.
+SERIES_MAX_TURN_RAD = 0.05
+
+
+@njit(cache=True)
+def _cis_series(d: float) -> tuple[float, float]:  # pragma: no cover - compiled
+    """(cos d, sin d) for |d| <= SERIES_MAX_TURN_RAD, by their Taylor series (Horner in d^2)."""
+    d2 = d * d
+    c = 1.0 + d2 * (-1.0 / 2.0 + d2 * (1.0 / 24.0 + d2 * (-1.0 / 720.0 + d2 * (1.0 / 40320.0))))
+    sn = d * (1.0 + d2 * (-1.0 / 6.0 + d2 * (1.0 / 120.0 + d2 * (-1.0 / 5040.0 + d2 * (1.0 / 362880.0)))))
+    return c, sn
+
+
 @njit(cache=True)
 def _integrate(
     kappa0: float, kdot: float, a: float, b: float, with_jacobian: bool
@@ -87,7 +101,9 @@ def _integrate(
     """int_a^b (cos, sin) theta(s) ds and, if asked, int_a^b (s^2 / 2) (-sin, cos) theta(s) ds (start frame).
 
     The heading turns at most `turn` = max |theta'| (b - a) across [a, b] (|theta'| is linear in s): the smallest
-    rule that is exact for that turn, on one panel; beyond the largest rule's turn, panels of it."""
+    rule that is exact for that turn, on one panel; beyond the largest rule's turn, panels of it. Each panel's
+    integrand is its start's direction (one cos and sin) turned by the node's heading change from there, which on
+    the short panels of a gently turning clothoid comes from a series (`_cis_series`), not from a cos and sin."""
     rate = max(abs(kappa0 + kdot * a), abs(kappa0 + kdot * b))
     turn = rate * (b - a)
     rule = 0
@@ -100,24 +116,42 @@ def _integrate(
     lo = GL_OFFSETS[rule]
     hi = GL_OFFSETS[rule + 1]
     h = (b - a) / n_p
+    series = turn / n_p <= SERIES_MAX_TURN_RAD  # a node's heading change from its panel's start is at most this
     fx = 0.0
     fy = 0.0
     gx = 0.0
     gy = 0.0
     for p in range(n_p):
         a_p = a + p * h
+        th_a = a_p * (kappa0 + 0.5 * kdot * a_p)
+        ca = math.cos(th_a)
+        sa = math.sin(th_a)
+        k_a = kappa0 + kdot * a_p
+        pc = 0.0  # sums over the nodes in the panel's start frame: w (cos, sin) and w s^2 / 2 (cos, sin)
+        ps = 0.0
+        qc = 0.0
+        qs = 0.0
         for j in range(lo, hi):
-            s = a_p + h * GL_NODES[j]
-            th = s * (kappa0 + 0.5 * kdot * s)
-            c = math.cos(th)
-            sn = math.sin(th)
+            u = h * GL_NODES[j]
+            turned = u * (k_a + 0.5 * kdot * u)  # theta(a_p + u) - theta(a_p)
+            if series:
+                c, sn = _cis_series(turned)
+            else:
+                c = math.cos(turned)
+                sn = math.sin(turned)
             w = GL_WEIGHTS[j]
-            fx += w * c
-            fy += w * sn
+            pc += w * c
+            ps += w * sn
             if with_jacobian:
+                s = a_p + u
                 q = w * 0.5 * s * s
-                gx -= q * sn
-                gy += q * c
+                qc += q * c
+                qs += q * sn
+        fx += ca * pc - sa * ps
+        fy += sa * pc + ca * ps
+        if with_jacobian:
+            gx -= sa * qc + ca * qs
+            gy += ca * qc - sa * qs
     return fx * h, fy * h, gx * h, gy * h
 
 
