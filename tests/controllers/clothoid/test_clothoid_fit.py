@@ -4,6 +4,7 @@ properties: end point on the target when not saturated, saturated lengths locall
 from __future__ import annotations
 
 import math
+import warnings
 
 import numpy as np
 import pytest
@@ -15,7 +16,10 @@ from controllers.clothoid.clothoid_fit import (
     FIT_OK,
     FIT_SATURATED,
     FIT_UNREACHABLE,
+    SERIES_MAX_TURN_RAD,
     ClothoidFit,
+    _cis_series,
+    _integrate,
     clothoid_points,
     fit_hyper_clothoid,
     fit_kernel,
@@ -98,6 +102,45 @@ def test_sampled_points_match_pyclothoids() -> None:
         assert (out_x[0], out_y[0]) == (case[0], case[1])
         assert math.hypot(out_x[n - 1] - ex, out_y[n - 1] - ey) < 1e-10
         assert np.isnan(out_x[n:]).all() and np.isnan(out_y[n:]).all()  # nothing written beyond n
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.floats(-SERIES_MAX_TURN_RAD, SERIES_MAX_TURN_RAD))
+def test_the_series_is_cos_and_sin_to_rounding(d: float) -> None:
+    """The quadrature's small-turn cos and sin: within 2 ulps of 1 (cos) and of |d| (sin) of libm's."""
+    c, sn = _cis_series(d)
+    assert abs(c - math.cos(d)) <= 2.0 * math.ulp(1.0)
+    assert abs(sn - math.sin(d)) <= 2.0 * math.ulp(abs(d)) + 1e-300
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    kappa0=st.floats(-0.2, 0.2),
+    kdot=st.floats(-0.05, 0.05),
+    a=st.floats(0.0, 20.0),
+    span=st.floats(0.01, 20.0),
+)
+def test_the_quadrature_is_scipys_adaptive_integral(kappa0: float, kdot: float, a: float, span: float) -> None:
+    """int_a^b (cos, sin) theta and the Jacobian's (s^2 / 2)(-sin, cos) theta against scipy.integrate.quad at its
+    tightest, across panels turning from a hair (the series) to radians (cos and sin): within 1e-12 of the span."""
+    from scipy.integrate import IntegrationWarning, quad
+
+    b = a + span
+    theta = lambda s: s * (kappa0 + 0.5 * kdot * s)  # noqa: E731
+    integrands = (
+        lambda s: math.cos(theta(s)),
+        lambda s: math.sin(theta(s)),
+        lambda s: -0.5 * s * s * math.sin(theta(s)),
+        lambda s: 0.5 * s * s * math.cos(theta(s)),
+    )
+    with warnings.catch_warnings():  # quad's note that it reached rounding, at this tolerance on smooth integrands
+        warnings.simplefilter("ignore", IntegrationWarning)
+        expected = [quad(f, a, b, epsabs=1e-14, epsrel=1e-14, limit=1000) for f in integrands]
+    got = _integrate(kappa0, kdot, a, b, True)
+    scale = (span, span, span * b * b, span * b * b)
+    for value, (reference, error), size in zip(got, expected, scale, strict=True):
+        assert error <= 1e-13 * size  # the reference is good to well within the tolerance
+        assert abs(value - reference) <= 1e-12 * size
 
 
 def test_clothoid_points_wrapper() -> None:
