@@ -31,6 +31,7 @@ from functools import partial
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from workbench.base.console import console_exit
 from workbench.base.errors import WorkbenchInputError
 from workbench.base.version import VersionAction
 
@@ -772,6 +773,11 @@ COMMANDS = {
     "schedule": _schedule,
     "margins": _margins,
 }
+
+
+def console() -> int:
+    """The console script: `main` on sys.argv (`workbench.base.console`: no collections at exit)."""
+    return console_exit(main)
 
 
 def main(argv: Sequence[str] | None = None) -> int:

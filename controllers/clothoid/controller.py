@@ -281,6 +281,12 @@ class ClothoidController(Controller):
         p[sk.P_PATH_MAX_SEGMENT] = path.max_segment_m
         self._diag = self._declare_diagnostics(DIAGNOSTIC_KEYS)
         self._tables()  # read again: limits, tuning and schedule are the controller's attributes
+        # The step's own arrays, in clothoid_step's order after the path's: looked up once, not every step.
+        self._own_arrays = (
+            self._tracker.state, self._here.state, self._limits, self._limit_speeds, self._lags, self._measured_lags,
+            self._lag_speeds, self._schedule, self._schedule_speeds, self._floor_table, self._filter_table,
+            self._buffers, self._scores, self._results, self._scratch, self._diag,
+        )  # fmt: skip
         if path.speed_mps is not None:  # the floors of the planned speeds now, not inside a step (~0.1 s per band)
             for speed_mps in np.unique(np.round(path.speed_mps * 3.6 / FLOOR_SPEED_BAND_KMH)) * FLOOR_SPEED_BAND_KMH:
                 self.lookahead_floor_m(float(speed_mps) / 3.6)
@@ -396,11 +402,7 @@ class ClothoidController(Controller):
         while True:  # once, unless the step asks for a floor or a lead filter Python makes (step_kernel.py)
             command, status = sk.clothoid_step(
                 m.t_s, m.x_m, m.y_m, m.vx_mps, m.vy_mps, m.yaw_rad, m.yaw_rate_rad_s, m.steer_wheel_rad, self._params,
-                self._state, path.x_m, path.y_m, path.heading_rad, path.curvature_1pm, path.closed,
-                self._tracker.state, self._here.state, self._limits, self._limit_speeds, self._lags,
-                self._measured_lags, self._lag_speeds, self._schedule, self._schedule_speeds, self._floor_table,
-                self._filter_table, self._buffers, self._scores, self._results, self._scratch,
-                self._diag,
+                self._state, path.x_m, path.y_m, path.heading_rad, path.curvature_1pm, path.closed, *self._own_arrays
             )  # fmt: skip
             if status == sk.STEP_DONE:
                 return command

@@ -32,6 +32,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from controllers import CONTROLLERS
+from workbench.base.console import console_exit
 from workbench.base.errors import WorkbenchInputError
 from workbench.base.output_dir import MANIFEST
 from workbench.base.version import VersionAction
@@ -757,6 +758,11 @@ def _controllers(args: argparse.Namespace) -> None:
         return
     for name, cls in CONTROLLERS.items():
         print(f"{name:<14} {cls.summary()}")
+
+
+def console() -> int:
+    """The console script: `main` on sys.argv (`workbench.base.console`: no collections at exit)."""
+    return console_exit(main)
 
 
 def main(argv: Sequence[str] | None = None) -> int:

@@ -179,6 +179,32 @@ def track(
 
 
 @njit(cache=True)
+def track_sequence(
+    x: np.ndarray,
+    y: np.ndarray,
+    heading: np.ndarray,
+    curvature: np.ndarray,
+    spacing: float,
+    length: float,
+    closed: bool,
+    extent: float,
+    min_window: float,
+    state: np.ndarray,
+    px: np.ndarray,
+    py: np.ndarray,
+    s_out: np.ndarray,
+    cte_out: np.ndarray,
+) -> None:  # pragma: no cover - compiled
+    """`track` for each of a sequence of finite positions in turn (a trace's, step by step), writing each foot
+    point's arc length and signed CTE to s_out and cte_out: one call for a whole trace instead of one per step."""
+    out = np.empty(TRACK_OUT_SIZE)
+    for k in range(px.size):
+        track(x, y, heading, curvature, spacing, length, closed, extent, min_window, state, px[k], py[k], out)
+        s_out[k] = out[0]
+        cte_out[k] = out[6]
+
+
+@njit(cache=True)
 def value_at(values: np.ndarray, s: float, spacing: float, length: float, closed: bool) -> float:
     """A per-sample quantity of the path (x, y, heading, curvature, ...) at arc length s (m), interpolated linearly
     between samples: s taken modulo the length on a loop, clipped to [0, length] on an open path."""

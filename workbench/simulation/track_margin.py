@@ -33,6 +33,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from workbench.base.errors import WorkbenchInputError, require_in_range
+from workbench.base.path_search import track_sequence
 
 if TYPE_CHECKING:
     from workbench.base.path import ReferencePath
@@ -59,8 +60,6 @@ OFF_TRACK_SPACING_M = 0.25
 #: Newton iterations of the foot-point search from the nearest sample (each about squares the error: one leaves
 #: under 1 mm at the corners of a Zandvoort lap, the second is for tighter bends).
 _NEWTON_ITERATIONS = 2
-#: Where `PathTracker.advance` leaves the foot point's arc length and the signed lateral offset (`Projection`'s order).
-_OUT_S, _OUT_CTE = 0, 6
 #: The Newton step's denominator 1 - kappa d is kept above this: a point near a bend's centre has no clear foot.
 _MIN_NEWTON_DENOMINATOR = 0.2
 
@@ -271,14 +270,16 @@ def trailer_feet(path: ReferencePath, x_m: np.ndarray, y_m: np.ndarray) -> tuple
     """(arc length (m, within the path), signed lateral offset (m, left positive)) of the foot point of each of a
     sequence of positions (the trailer's axle, step by step), projected with progress tracking: it never jumps to
     the other leg of a hairpin the trailer cuts across. Sideways only (`Projection.cte_m`)."""
+    x_m, y_m = np.ascontiguousarray(x_m, dtype=float), np.ascontiguousarray(y_m, dtype=float)
     tracker = path.tracker(None)
-    out = tracker.out  # the projection in `Projection`'s order (`PathTracker.advance`)
+    bad = np.flatnonzero(~(np.isfinite(x_m) & np.isfinite(y_m)))
+    if bad.size:
+        tracker.update(float(x_m[bad[0]]), float(y_m[bad[0]]))  # raises, naming the position
     s, cte = np.empty(x_m.size), np.empty(x_m.size)
-    for k, (x, y) in enumerate(zip(x_m.tolist(), y_m.tolist(), strict=True)):
-        if not (math.isfinite(x) and math.isfinite(y)):
-            tracker.update(x, y)  # raises, naming the position
-        tracker.advance(x, y)
-        s[k], cte[k] = out[_OUT_S], out[_OUT_CTE]
+    track_sequence(
+        path.x_m, path.y_m, path.heading_rad, path.curvature_1pm, path.spacing_m, path.length_m, path.closed,
+        tracker.extent_m, tracker.min_window_m, tracker.state, x_m, y_m, s, cte,
+    )  # fmt: skip
     return s, cte
 
 
