@@ -95,64 +95,73 @@ def _cis_series(d: float) -> tuple[float, float]:  # pragma: no cover - compiled
 
 
 @njit(cache=True)
+def _rule(turn: float) -> int:  # pragma: no cover - compiled
+    """The smallest quadrature rule exact for a panel turning `turn` (rad); the largest beyond them all."""
+    rule = 0
+    while rule < _N_RULES - 1 and not turn <= _RULE_TURNS[rule]:
+        rule += 1
+    return rule
+
+
+@njit(cache=True)
+def _panel(
+    kappa0: float, kdot: float, a: float, h: float, rule: int, series: bool, with_jacobian: bool
+) -> tuple[float, float, float, float]:  # pragma: no cover - compiled
+    """One panel [a, a + h] of `_integrate` by rule `rule`: its start's direction (one cos and sin) turned by each
+    node's heading change from there, which on a gently turning panel (`series`: at most SERIES_MAX_TURN_RAD)
+    comes from `_cis_series`, not from a cos and sin."""
+    th_a = a * (kappa0 + 0.5 * kdot * a)
+    ca = math.cos(th_a)
+    sa = math.sin(th_a)
+    k_a = kappa0 + kdot * a
+    pc = 0.0  # sums over the nodes in the panel's start frame: w (cos, sin) and w s^2 / 2 (cos, sin)
+    ps = 0.0
+    qc = 0.0
+    qs = 0.0
+    for j in range(GL_OFFSETS[rule], GL_OFFSETS[rule + 1]):
+        u = h * GL_NODES[j]
+        turned = u * (k_a + 0.5 * kdot * u)  # theta(a + u) - theta(a)
+        if series:
+            c, sn = _cis_series(turned)
+        else:
+            c = math.cos(turned)
+            sn = math.sin(turned)
+        w = GL_WEIGHTS[j]
+        pc += w * c
+        ps += w * sn
+        if with_jacobian:
+            s = a + u
+            q = w * 0.5 * s * s
+            qc += q * c
+            qs += q * sn
+    return (ca * pc - sa * ps) * h, (sa * pc + ca * ps) * h, -(sa * qc + ca * qs) * h, (ca * qc - sa * qs) * h
+
+
+@njit(cache=True)
 def _integrate(
     kappa0: float, kdot: float, a: float, b: float, with_jacobian: bool
 ) -> tuple[float, float, float, float]:  # pragma: no cover - compiled
     """int_a^b (cos, sin) theta(s) ds and, if asked, int_a^b (s^2 / 2) (-sin, cos) theta(s) ds (start frame).
 
     The heading turns at most `turn` = max |theta'| (b - a) across [a, b] (|theta'| is linear in s): the smallest
-    rule that is exact for that turn, on one panel; beyond the largest rule's turn, panels of it. Each panel's
-    integrand is its start's direction (one cos and sin) turned by the node's heading change from there, which on
-    the short panels of a gently turning clothoid comes from a series (`_cis_series`), not from a cos and sin."""
+    rule that is exact for that turn, on one panel; beyond the largest rule's turn, panels of it (`_panel`)."""
     rate = max(abs(kappa0 + kdot * a), abs(kappa0 + kdot * b))
     turn = rate * (b - a)
-    rule = 0
-    while rule < _N_RULES - 1 and not turn <= _RULE_TURNS[rule]:
-        rule += 1
+    rule = _rule(turn)
     n_p = 1
     if not turn <= _RULE_TURNS[rule]:
         limit = _RULE_TURNS[rule] * MAX_PANELS
         n_p = math.ceil(turn / _RULE_TURNS[rule]) if turn < limit else MAX_PANELS  # also catches inf / NaN
-    lo = GL_OFFSETS[rule]
-    hi = GL_OFFSETS[rule + 1]
     h = (b - a) / n_p
     series = turn / n_p <= SERIES_MAX_TURN_RAD  # a node's heading change from its panel's start is at most this
-    fx = 0.0
-    fy = 0.0
-    gx = 0.0
-    gy = 0.0
+    fx = fy = gx = gy = 0.0
     for p in range(n_p):
-        a_p = a + p * h
-        th_a = a_p * (kappa0 + 0.5 * kdot * a_p)
-        ca = math.cos(th_a)
-        sa = math.sin(th_a)
-        k_a = kappa0 + kdot * a_p
-        pc = 0.0  # sums over the nodes in the panel's start frame: w (cos, sin) and w s^2 / 2 (cos, sin)
-        ps = 0.0
-        qc = 0.0
-        qs = 0.0
-        for j in range(lo, hi):
-            u = h * GL_NODES[j]
-            turned = u * (k_a + 0.5 * kdot * u)  # theta(a_p + u) - theta(a_p)
-            if series:
-                c, sn = _cis_series(turned)
-            else:
-                c = math.cos(turned)
-                sn = math.sin(turned)
-            w = GL_WEIGHTS[j]
-            pc += w * c
-            ps += w * sn
-            if with_jacobian:
-                s = a_p + u
-                q = w * 0.5 * s * s
-                qc += q * c
-                qs += q * sn
-        fx += ca * pc - sa * ps
-        fy += sa * pc + ca * ps
-        if with_jacobian:
-            gx -= sa * qc + ca * qs
-            gy += ca * qc - sa * qs
-    return fx * h, fy * h, gx * h, gy * h
+        px, py, qx, qy = _panel(kappa0, kdot, a + p * h, h, rule, series, with_jacobian)
+        fx += px
+        fy += py
+        gx += qx
+        gy += qy
+    return fx, fy, gx, gy
 
 
 @njit(cache=True)
@@ -359,12 +368,21 @@ def sample_kernel(
     c0 = math.cos(theta0)
     s0 = math.sin(theta0)
     h = length / (n - 1)
+    # No interval turns more than the whole curve's steepest heading rate over h: when that rule is exact on one
+    # panel, every interval is one panel of it, chosen once.
+    turn = max(abs(kappa0), abs(kappa0 + kdot * length)) * h
+    rule = _rule(turn)
+    one_panel = turn <= _RULE_TURNS[rule]
+    series = turn <= SERIES_MAX_TURN_RAD
     fx = 0.0
     fy = 0.0
     for k in range(n - 1):
         a = k * h
         b = length if k == n - 2 else (k + 1) * h
-        ix, iy, _, _ = _integrate(kappa0, kdot, a, b, False)
+        if one_panel:
+            ix, iy, _, _ = _panel(kappa0, kdot, a, b - a, rule, series, False)
+        else:
+            ix, iy, _, _ = _integrate(kappa0, kdot, a, b, False)
         fx += ix
         fy += iy
         out_x[k + 1] = x0 + c0 * fx - s0 * fy
