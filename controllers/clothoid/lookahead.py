@@ -230,8 +230,7 @@ def turn_limited_lookahead(
     i0w = i0 % n_seg if closed else min(i0, n_seg - 1)
     f0 = foot_index - i0
     h0 = path_heading[i0w] + f0 * (path_heading[i0w + 1] - path_heading[i0w])
-    fx = path_x[i0w] + f0 * (path_x[i0w + 1] - path_x[i0w])
-    fy = path_y[i0w] + f0 * (path_y[i0w + 1] - path_y[i0w])
+    fx, fy = _point_at_index(path_x, path_y, foot_index, closed)
     # Samples before `near` are nearer than max_m (one sample's slack against rounding).
     near = foot_index + (max_m - math.hypot(fx - px, fy - py)) / max_segment_m - 1.0 if max_segment_m > 0.0 else 0.0
     last = i0 + n_seg if closed else n_seg
