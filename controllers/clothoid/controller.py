@@ -61,6 +61,7 @@ LOOKAHEAD_MODES = ("adaptive", "fixed", "speed")
 INITIAL_CURVATURE = ("yaw-rate", "command", "steering")
 HEADINGS = ("course", "yaw")
 THRESHOLD_MODES = ("excess", "absolute")
+SEARCH_STARTS = ("last", "ends")
 #: Below this speed (m/s) yaw rate / speed and the course angle are too noisy to use.
 MIN_SPEED_MPS = 0.5
 #: The lookahead floor is computed per band of this many km/h (and at least at the band's lower speed, 5 km/h).
@@ -104,6 +105,9 @@ class ClothoidConfig:
     lookahead_mode: "adaptive" (Fréchet, section 3), "fixed" (fixed_lookahead_m) or "speed" (lookahead_gain_s x
     speed, clipped to the range); min/max_lookahead_m: the range (m; the paper: 5-20 m; the analysis floor raises
     the lower end, and the upper one with it where needed); lookahead_step_m: the grid of the adaptive search (m);
+    search_start: where the adaptive search starts, "last" (the last step's choice; few fits a step) or "ends"
+    (bisection from the range's ends every step, as before issue 19); the two choose alike wherever admissibility
+    falls with the lookahead (`lookahead.adaptive_search`);
     min_preview_time_s: raises the lower end of the range to this time x speed (s; 0: off); lookahead_hysteresis_m,
     max_lookahead_growth_m_per_m, max_lookahead_shrink_m_per_m: how the search's choice is followed
     (`lookahead_filter.py`; None: at once); min_phase_margin_deg, min_gain_margin_db: the margins the lookahead
@@ -136,6 +140,7 @@ class ClothoidConfig:
     min_lookahead_m: float = 5.0
     max_lookahead_m: float = 20.0
     lookahead_step_m: float = 0.5
+    search_start: str = "last"
     min_preview_time_s: float = 0.0
     lookahead_hysteresis_m: float = 0.5
     max_lookahead_growth_m_per_m: float | None = 0.3
@@ -170,6 +175,7 @@ class ClothoidConfig:
         check_choice("initial_curvature", self.initial_curvature, INITIAL_CURVATURE)
         check_choice("heading", self.heading, HEADINGS)
         check_choice("threshold_mode", self.threshold_mode, THRESHOLD_MODES)
+        check_choice("search_start", self.search_start, SEARCH_STARTS)
         check_number("prediction_time_s", self.prediction_time_s, 0.0, 2.0, "s")
         check_number("known_delay_s", self.known_delay_s, 0.0, 1.0, "s", note="0: none")
         check_number("min_preview_time_s", self.min_preview_time_s, 0.0, 10.0, "s")
@@ -319,6 +325,7 @@ class ClothoidController(Controller):
         p[sk.P_COURSE], p[sk.P_EXCESS] = cfg.heading == "course", cfg.threshold_mode == "excess"
         p[sk.P_MIN_LOOKAHEAD], p[sk.P_MAX_LOOKAHEAD] = cfg.min_lookahead_m, cfg.max_lookahead_m
         p[sk.P_LOOKAHEAD_STEP], p[sk.P_MIN_PREVIEW] = cfg.lookahead_step_m, cfg.min_preview_time_s
+        p[sk.P_WARM_SEARCH] = cfg.search_start == "last"
         p[sk.P_FIXED_LOOKAHEAD], p[sk.P_LOOKAHEAD_GAIN] = cfg.fixed_lookahead_m, cfg.lookahead_gain_s
         p[sk.P_MAX_TURN_RAD] = math.radians(cfg.max_target_turn_deg)
         p[sk.P_FRECHET_THRESHOLD], p[sk.P_POINT_SPACING] = cfg.frechet_threshold_m, cfg.frechet_point_spacing_m

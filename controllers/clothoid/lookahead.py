@@ -145,11 +145,21 @@ def adaptive_search(
     scores: np.ndarray,
     results: np.ndarray,
     max_segment_m: float,
+    hint_m: float,
 ) -> tuple[float, int]:  # pragma: no cover - compiled
     """The chosen lookahead (m) and the number of candidates evaluated; scores[k] holds candidate k's Fréchet
     distance (NaN where not evaluated, inf where it was cut short: more than the threshold in the bisection, more
     than the least so far in the fallback's scan, so that it could not change the choice), with candidate k at
-    min + k step, and results[k] (scores.size, 8) all that `evaluate_candidate` returned for it (`evaluated`)."""
+    min + k step, and results[k] (scores.size, 8) all that `evaluate_candidate` returned for it (`evaluated`).
+
+    hint_m: where to start (NaN: from the range's ends). The choice moves little from one step to the next, so
+    a controller passes its last one: the hint and the candidate above it settle the search in two evaluations
+    when the hint still holds; otherwise it gallops (1, 2, 4, ... candidates) to where admissibility changes and
+    bisects there; when nothing qualifies from the hint down, the floor is taken if the candidate above it is no
+    nearer. Where admissibility falls with the lookahead and the Fréchet distance does not fall from the floor's
+    (the paper's Figure 4b; the premises of the search from the ends too), both starts choose the same candidate
+    (`test_lookahead.py`); elsewhere each finds one of the places where admissibility changes.
+    """
     count = max(1, min(candidate_count(min_lookahead_m, max_lookahead_m, step_m), scores.size))
     scores[:] = np.nan
     evaluations = 0
@@ -170,35 +180,70 @@ def adaptive_search(
         )
 
     top = count - 1
-    evaluations += 1
-    if admissible(top, np.inf):  # the ends in full: the fallback below may need their distances
-        return min_lookahead_m + top * step_m, evaluations
-    evaluations += 1
-    if admissible(0, np.inf):
-        lo, hi = 0, top  # lo qualifies, hi does not: bisect (Fréchet distance grows with the lookahead)
-        while hi - lo > 1:
-            mid = (lo + hi) // 2
-            evaluations += 1
-            if admissible(mid, threshold_m):
-                lo = mid
-            else:
-                hi = mid
-        return min_lookahead_m + lo * step_m, evaluations
-    # Nothing qualifies: the candidate of least Fréchet distance, coarse scan then its neighbours.
-    stride = max(1, count // 6)
-    best = 0
-    for k in range(stride, count, stride):
+    lo, hi = -1, -1  # once found: lo qualifies and hi does not; the bisection below closes the gap
+    if math.isfinite(hint_m):
+        k = min(max(round((hint_m - min_lookahead_m) / step_m), 0), top)
         evaluations += 1
-        admissible(k, scores[best])
-        if scores[k] < scores[best]:
-            best = k
-    for k in range(max(0, best - stride + 1), min(count, best + stride)):
-        if np.isnan(scores[k]):
-            evaluations += 1
-            admissible(k, scores[best])
-        if scores[k] < scores[best]:
-            best = k
-    return min_lookahead_m + best * step_m, evaluations
+        if admissible(k, np.inf if k == 0 or k == top else threshold_m):  # the ends in full, as below
+            if k == top:
+                return min_lookahead_m + top * step_m, evaluations
+            stride = 1  # gallop up to the first candidate that does not qualify
+            while hi < 0:
+                probe = min(k + stride, top)
+                evaluations += 1
+                if not admissible(probe, np.inf if probe == top else threshold_m):
+                    lo, hi = k, probe
+                elif probe == top:
+                    return min_lookahead_m + top * step_m, evaluations
+                else:
+                    k, stride = probe, 2 * stride
+        else:
+            stride = 1  # gallop down to the first candidate that qualifies
+            while lo < 0 and k > 0:
+                probe = max(k - stride, 0)
+                evaluations += 1
+                if admissible(probe, np.inf if probe == 0 else threshold_m):
+                    lo, hi = probe, k
+                else:
+                    k, stride = probe, 2 * stride
+            if lo < 0:  # nothing qualifies from the hint down: the floor, unless the candidate above is nearer
+                if top == 0:
+                    return min_lookahead_m, evaluations
+                evaluations += 1
+                admissible(1, scores[0])
+                if scores[1] >= scores[0]:
+                    return min_lookahead_m, evaluations
+                scores[:] = np.nan  # the distance falls from the floor's: the search from the ends
+    if lo < 0:
+        evaluations += 1
+        if admissible(top, np.inf):  # the ends in full: the fallback below may need their distances
+            return min_lookahead_m + top * step_m, evaluations
+        evaluations += 1
+        if not admissible(0, np.inf):
+            # Nothing qualifies: the candidate of least Fréchet distance, coarse scan then its neighbours.
+            stride = max(1, count // 6)
+            best = 0
+            for k in range(stride, count, stride):
+                evaluations += 1
+                admissible(k, scores[best])
+                if scores[k] < scores[best]:
+                    best = k
+            for k in range(max(0, best - stride + 1), min(count, best + stride)):
+                if np.isnan(scores[k]):
+                    evaluations += 1
+                    admissible(k, scores[best])
+                if scores[k] < scores[best]:
+                    best = k
+            return min_lookahead_m + best * step_m, evaluations
+        lo, hi = 0, top
+    while hi - lo > 1:  # lo qualifies, hi does not: bisect (Fréchet distance grows with the lookahead)
+        mid = (lo + hi) // 2
+        evaluations += 1
+        if admissible(mid, threshold_m):
+            lo = mid
+        else:
+            hi = mid
+    return min_lookahead_m + lo * step_m, evaluations
 
 
 @njit(cache=True)

@@ -38,9 +38,9 @@ KAPPA0_YAW_RATE, KAPPA0_COMMAND, KAPPA0_STEERING = 0, 1, 2
     P_LOOKAHEAD_GAIN, P_MAX_TURN_RAD, P_FRECHET_THRESHOLD, P_POINT_SPACING, P_TOLERANCE_X, P_TOLERANCE_Y,
     P_KDOT_MAX, P_FEEDFORWARD, P_FEEDFORWARD_WINDOW, P_FEEDFORWARD_TIME, P_REFERENCE_LEAD, P_HYSTERESIS,
     P_MAX_GROWTH, P_MAX_SHRINK, P_MIN_SPEED, P_BAND_KMH, P_BAND_HYSTERESIS_KMH, P_PATH_SPACING, P_PATH_LENGTH,
-    P_PATH_EXTENT, P_TRACKER_WINDOW, P_PATH_MAX_SEGMENT,
-) = range(37)  # fmt: skip
-PARAM_COUNT = 37
+    P_PATH_EXTENT, P_TRACKER_WINDOW, P_PATH_MAX_SEGMENT, P_WARM_SEARCH,
+) = range(38)  # fmt: skip
+PARAM_COUNT = 38
 
 # The step's own state (`state`).
 S_KAPPA_CMD = 0  # the integrator's curvature command (1/m; NaN before the first step)
@@ -48,7 +48,8 @@ S_HELD_BAND = 1  # the speed band whose floor applies (-1 before the first step)
 S_LOOKAHEAD = 2  # the lookahead filter's state: its lookahead and floor (m; NaN before the first step)
 S_FILTER_X = 4  # the lead filter's three states (rad), shared by the filters of every km/h (a bumpless switch)
 S_NEED = 7  # what a NEED_* return asks for: the speed band or the km/h
-STATE_SIZE = 8
+S_SEARCHED = 8  # the adaptive search's last choice (m; NaN before the first search): where the next one starts
+STATE_SIZE = 9
 
 # `clothoid_step`'s status.
 STEP_DONE, NEED_FLOOR, NEED_FILTER = 0, 1, 2
@@ -208,8 +209,9 @@ def clothoid_step(
             searched, evaluations = adaptive_search(
                 path_x, path_y, closed, foot_index, px, py, ph, kappa0, floor, top, p[P_LOOKAHEAD_STEP], threshold,
                 p[P_TOLERANCE_X], p[P_TOLERANCE_Y], p[P_KDOT_MAX], p[P_POINT_SPACING], buffers, scores, results,
-                max_segment,
+                max_segment, state[S_SEARCHED] if p[P_WARM_SEARCH] != 0.0 else np.nan,
             )  # fmt: skip
+            state[S_SEARCHED] = searched
             lookahead = filtered_lookahead(
                 state[S_LOOKAHEAD : S_LOOKAHEAD + 2], searched, floor, top, speed * p[P_DT], p[P_HYSTERESIS],
                 p[P_MAX_GROWTH], p[P_MAX_SHRINK],

@@ -56,7 +56,7 @@ class Case:
     def controller(self) -> ClothoidController:
         """The controller as it was recorded: the kinematic bicycle's geometry and tuning of then (its wheelbase
         was 2.578 m until issue 20 made it 2.579 m, and its tuning was made for that), every other vehicle's own."""
-        config = dataclasses.replace(ClothoidConfig(), **self.options)
+        config = dataclasses.replace(ClothoidConfig(search_start="ends"), **self.options)  # searched so then
         vehicle = make_vehicle(self.vehicle)
         geometry = vehicle.geometry
         if self.vehicle == "kinematic-bicycle":

@@ -1,5 +1,5 @@
 """Adaptive lookahead (section 3): the Fréchet distance grows with the lookahead on a bend (Figure 4b), and the
-bisection finds the same lookahead as trying every candidate."""
+search finds the same lookahead as trying every candidate, from the range's ends or from any hint."""
 
 from __future__ import annotations
 
@@ -48,26 +48,40 @@ def test_frechet_distance_grows_with_lookahead_entering_a_bend() -> None:
     assert fd[-1] > 0.5
 
 
-@settings(max_examples=40, deadline=None)
+#: A hint for the search: none (from the range's ends), or a last choice anywhere in or beyond the range.
+HINTS = st.one_of(st.just(math.nan), st.floats(0.0, 30.0))
+
+
+def _search(s: float, pose, kappa: float, threshold: float, hint: float, size: int):
+    scores, results = np.empty(size), np.empty((size, 8))
+    chosen, evaluations = adaptive_search(
+        BEND.x_m, BEND.y_m, BEND.closed, s / BEND.spacing_m, *pose, kappa, 5.0, 20.0, 0.5, threshold,
+        10.0, 10.0, KDOT_MAX, 0.5, np.empty((4, MAX_CURVE_POINTS)), scores, results, BEND.max_segment_m, hint,
+    )  # fmt: skip
+    return chosen, evaluations, scores, results
+
+
+@settings(max_examples=60, deadline=None)
 @given(
     s=st.floats(0.0, 30.0),
     cte=st.floats(-0.3, 0.3),
     threshold=st.floats(0.02, 0.6),
+    hint=HINTS,
 )
-def test_bisection_equals_brute_force_where_the_distance_is_monotone(s: float, cte: float, threshold: float) -> None:
+def test_the_search_equals_brute_force_where_the_distance_is_monotone(
+    s: float, cte: float, threshold: float, hint: float
+) -> None:
     pose = _pose(s, cte, 0.0)
     kappa = float(BEND.curvature(s))
     expected, grid, fd = _brute_force(s, pose, kappa, 5.0, 20.0, 0.5, threshold)
     if not np.all(np.diff(fd) >= 0.0) or expected is None:
         return  # the bisection's premise does not hold here, or nothing qualifies (the fallback's case)
-    scores = np.empty(grid.size)
-    chosen, evaluations = adaptive_search(
-        BEND.x_m, BEND.y_m, BEND.closed, s / BEND.spacing_m, *pose, kappa, 5.0, 20.0, 0.5, threshold,
-        10.0, 10.0, KDOT_MAX, 0.5, np.empty((4, MAX_CURVE_POINTS)), scores, results := np.empty((grid.size, 8)),
-        BEND.max_segment_m,
-    )  # fmt: skip
+    chosen, evaluations, scores, results = _search(s, pose, kappa, threshold, hint, grid.size)
     assert chosen == pytest.approx(expected)
-    assert evaluations <= 2 + math.ceil(math.log2(grid.size))
+    bisection = math.ceil(math.log2(grid.size))
+    assert evaluations <= (2 + bisection if math.isnan(hint) else 2 + 2 * bisection)  # galloping: twice at most
+    if math.isfinite(hint) and abs(hint - expected) < 0.25:
+        assert evaluations <= 2  # the hint and the candidate above it
     # what the search kept of each candidate is what evaluate_candidate gives for it
     k = evaluated(scores, results, 5.0, 0.5, chosen)
     assert k >= 0 and results[k, 0] == scores[k]
@@ -84,15 +98,30 @@ def test_when_nothing_qualifies_the_least_frechet_distance_is_taken() -> None:
     pose = _pose(s, cte, 0.0)
     kappa = float(BEND.curvature(s))
     _, grid, fd = _brute_force(s, pose, kappa, 5.0, 20.0, 0.5, 0.5)
-    scores = np.empty(grid.size)
-    chosen, _ = adaptive_search(
-        BEND.x_m, BEND.y_m, BEND.closed, s / BEND.spacing_m, *pose, kappa, 5.0, 20.0, 0.5, 0.5,
-        10.0, 10.0, KDOT_MAX, 0.5, np.empty((4, MAX_CURVE_POINTS)), scores, np.empty((grid.size, 8)),
-        BEND.max_segment_m,
-    )  # fmt: skip
+    chosen, *_ = _search(s, pose, kappa, 0.5, math.nan, grid.size)
     assert fd.min() >= cte - 1e-9  # the curves start |CTE| apart
     k = int(np.argmin(np.abs(grid - chosen)))
     assert fd[k] <= fd.min() + 0.05  # coarse scan and local refinement: within 5 cm of the true minimum
+    # From a hint: the floor where the distance does not fall from it, else the same scan.
+    for hint in (5.0, 12.0, 20.0):
+        warm, *_ = _search(s, pose, kappa, 0.5, hint, grid.size)
+        assert warm == (5.0 if fd[1] >= fd[0] else chosen)
+
+
+@pytest.mark.parametrize("hint", [5.0, 11.0, 20.0])
+def test_off_the_path_a_hint_settles_on_the_floor_in_two_fits(hint: float) -> None:
+    """0.3 m off a straight, every candidate's distance is at least 0.3 m and grows with the lookahead: from any hint
+    the search gallops down to the floor and takes it once the candidate above is no nearer."""
+    s, cte = 2.0, 0.3
+    pose, kappa = _pose(s, cte, 0.0), 0.0
+    _, grid, fd = _brute_force(s, pose, kappa, 5.0, 20.0, 0.5, 0.02)
+    assert fd.min() >= cte - 1e-9 and fd[1] >= fd[0]
+    chosen, evaluations, *_ = _search(s, pose, kappa, 0.02, hint, grid.size)
+    cold, cold_evaluations, *_ = _search(s, pose, kappa, 0.02, math.nan, grid.size)
+    assert chosen == cold == 5.0
+    assert evaluations <= 2 + math.ceil(math.log2(grid.size)) and evaluations < cold_evaluations
+    if hint == 5.0:
+        assert evaluations == 2
 
 
 @pytest.mark.parametrize("remaining_m", [0.0, 1.0, 3.0, 7.0])
