@@ -32,7 +32,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from controllers import CONTROLLERS
-from workbench.base.console import console_exit
+from workbench.base.console import console_exit, warn_on_stderr
 from workbench.base.errors import WorkbenchInputError
 from workbench.base.output_dir import MANIFEST
 from workbench.base.version import VersionAction
@@ -454,7 +454,7 @@ def _compared_vehicles(args: argparse.Namespace) -> list[tuple[str, float | None
 
 
 def _compare(args: argparse.Namespace) -> int:
-    from workbench.apps.comparison import RunSpec, compare, warn_on_stderr
+    from workbench.apps.comparison import RunSpec, compare
     from workbench.apps.report import ReportSection, write_report
     from workbench.base.output_dir import OutputDir
     from workbench.simulation.scenarios import ScenarioOptions
@@ -664,7 +664,6 @@ def _optimise(args: argparse.Namespace) -> int:
 def _run(args: argparse.Namespace) -> int:
     from controllers import make_controller
     from tuning.own_tuning import tuned_controller
-    from workbench.apps.comparison import warn_on_stderr
     from workbench.apps.controller_config import read_controller_config
     from workbench.base.output_dir import OutputDir
     from workbench.simulation.limit_cycle import detect_limit_cycle

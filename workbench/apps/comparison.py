@@ -31,6 +31,7 @@ from tqdm import tqdm
 from controllers import CONTROLLERS
 from tuning.own_tuning import tuned_controller
 from workbench.apps.controller_config import read_controller_config
+from workbench.base.console import warn_on_stderr
 from workbench.base.errors import WorkbenchInputError
 from workbench.simulation.limit_cycle import LimitCycle, detect_limit_cycle
 from workbench.simulation.metrics import METRIC_KEYS
@@ -234,11 +235,6 @@ class Comparison:
         return written + (self.save_figures(out) if with_plots else [])
 
 
-def warn_on_stderr(message: str) -> None:
-    """Print a warning as the CLI does: `workbench: warning: ...` on stderr."""
-    print(f"workbench: warning: {message}", file=sys.stderr, flush=True)
-
-
 def _simulation(
     spec: RunSpec, scenario: str | Scenario, scenario_options: ScenarioOptions | None, config: SimulationConfig
 ) -> Simulation:
@@ -310,5 +306,4 @@ __all__ = [
     "RunSpec",
     "compare",
     "converge_distance_m",
-    "warn_on_stderr",
 ]
