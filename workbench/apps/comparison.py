@@ -209,16 +209,14 @@ class Comparison:
 
     def save_figures(self, out_dir: str | Path, prefix: str = "") -> list[Path]:
         """Write the four comparison figures as PNG; return their paths."""
-        import matplotlib.pyplot as plt
+        from workbench.simulation.plots import file_axes
 
         out = Path(out_dir)
         out.mkdir(parents=True, exist_ok=True)
         written = []
         for name, method in FIGURES:
-            ax = getattr(self, method)()
             path = out / f"{prefix}{name}"
-            ax.figure.savefig(path, dpi=110)
-            plt.close(ax.figure)
+            getattr(self, method)(file_axes()).figure.savefig(path, dpi=110)
             written.append(path)
         return written
 

@@ -2,9 +2,10 @@
 several runs on shared axes (the paper's Figures 17 and 18: `trajectories`, `cte_comparison`, `speed_comparison`,
 `steering_comparison`).
 
-matplotlib.pyplot is imported where a figure is drawn, not with this module (issue 17): `result.py` and the CLI's
-startup need none of it. A plotted run is anything with a `SimulationResult`'s fields (`PlottedRun`), so this module
-does not import the result that draws itself with it."""
+matplotlib is imported where a figure is drawn, not with this module (issue 17): `result.py` and the CLI's
+startup need none of it; figures written to files are bare Figures (`file_axes`), without pyplot. A plotted run is
+anything with a `SimulationResult`'s fields (`PlottedRun`), so this module does not import the result that draws
+itself with it."""
 
 from __future__ import annotations
 
@@ -38,6 +39,14 @@ def _axes(ax: Axes | None) -> Axes:
 
         _, ax = plt.subplots(figsize=(8, 4.5), layout="constrained")
     return ax
+
+
+def file_axes(figsize: tuple[float, float] = (8, 4.5)) -> Axes:
+    """The axes of a new figure to be written to a file: a bare `matplotlib.figure.Figure`, not pyplot's (no
+    figure manager or GUI backend loaded, nothing to close: matplotlib's way for figures a program saves)."""
+    from matplotlib.figure import Figure
+
+    return Figure(figsize=figsize, layout="constrained").add_subplot()
 
 
 def _label(result: PlottedRun) -> str:
@@ -124,14 +133,10 @@ RUN_PLOTS = {
 
 def save_run_plots(result: PlottedRun, out_dir: Path) -> list[Path]:
     """Write the four standard plots of a run as PNG files in out_dir."""
-    import matplotlib.pyplot as plt
-
     written = []
     for filename, draw in RUN_PLOTS.items():
-        ax = draw(result, None)
         path = out_dir / filename
-        ax.figure.savefig(path, dpi=120)
-        plt.close(ax.figure)
+        draw(result, file_axes()).figure.savefig(path, dpi=120)
         written.append(path)
     return written
 
