@@ -33,20 +33,25 @@ class PlottedRun(Protocol):
     vehicle: str
 
 
+#: Size of a plot's figure (inches), on screen and in files.
+FIGURE_SIZE_IN = (8.0, 4.5)
+
+
 def _axes(ax: Axes | None) -> Axes:
+    """ax, or the axes of a new pyplot figure (shown inline in a notebook)."""
     if ax is None:
         import matplotlib.pyplot as plt
 
-        _, ax = plt.subplots(figsize=(8, 4.5), layout="constrained")
+        _, ax = plt.subplots(figsize=FIGURE_SIZE_IN, layout="constrained")
     return ax
 
 
-def file_axes(figsize: tuple[float, float] = (8, 4.5)) -> Axes:
+def file_axes() -> Axes:
     """The axes of a new figure to be written to a file: a bare `matplotlib.figure.Figure`, not pyplot's (no
     figure manager or GUI backend loaded, nothing to close: matplotlib's way for figures a program saves)."""
     from matplotlib.figure import Figure
 
-    return Figure(figsize=figsize, layout="constrained").add_subplot()
+    return Figure(figsize=FIGURE_SIZE_IN, layout="constrained").add_subplot()
 
 
 def _label(result: PlottedRun) -> str:
