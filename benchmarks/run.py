@@ -134,17 +134,17 @@ def bench_run(scenario_name: str, controller_name: str, vehicle_name: str, optio
               speed_kmh: float = 30.0, goals: RunGoals = RunGoals(),
               overrides: tuple[str, ...] = ()) -> Entry:  # fmt: skip
     sim = _simulation(scenario_name, controller_name, vehicle_name, options, speed_kmh, overrides)
-    return _run_entry(sim, *_timed_run(sim), goals, overrides)
+    return _run_entry(*_timed_run(sim), goals, overrides)
 
 
-def _run_entry(sim: Simulation, result: SimulationResult, wall: float, goals: RunGoals = RunGoals(),
-               overrides: tuple[str, ...] = (), note: str = "") -> Entry:  # fmt: skip
+def _run_entry(result: SimulationResult, wall: float, goals: RunGoals = RunGoals(), overrides: tuple[str, ...] = (),
+               note: str = "") -> Entry:  # fmt: skip
     simulated = float(result.trace["t_s"][-1])
     rtf = simulated / wall
     m = result.metrics
     label = f" ({', '.join(overrides)})" if overrides else ""
     entry = Entry(
-        f"{result.scenario.name}: {result.controller}{label} on {result.vehicle} at {sim.config.speed_kmh:g} km/h, "
+        f"{result.scenario.name}: {result.controller}{label} on {result.vehicle} at {result.config.speed_kmh:g} km/h, "
         "whole run",
         m.step_time_median_us,
         m.step_time_p99_us,
@@ -196,7 +196,7 @@ def bench_compared(scenario_name: str, options: ScenarioOptions, clothoid_goals:
         best = int(np.argmin(medians))
         spread = f"; least of {rounds} alternated rounds' step medians ({min(medians):.1f}-{max(medians):.1f} us)"
         goals = clothoid_goals if name == "clothoid" else RunGoals()
-        entries.append(_run_entry(sims[name], *runs[best], goals, note=spread))
+        entries.append(_run_entry(*runs[best], goals, note=spread))
     clothoid = [result.metrics.step_time_median_us for result, _ in timed["clothoid"]]
     for name in ("nmpc", "lmpc"):
         ratios = [result.metrics.step_time_median_us / c for (result, _), c in zip(timed[name], clothoid, strict=True)]
