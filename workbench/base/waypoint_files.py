@@ -22,12 +22,13 @@ point is dropped and ``closed=True``. Bad input raises `WorkbenchInputError` nam
 
 from __future__ import annotations
 
+import csv
+import math
 import os
-import warnings
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-import pandas as pd
 from numpy.typing import ArrayLike
 
 from workbench.base.errors import WorkbenchInputError, require_in_range
@@ -113,44 +114,65 @@ def geodetic_to_local_en(
     return np.asarray(east, dtype=float), np.asarray(north, dtype=float)
 
 
-def _read_table(file: Path) -> pd.DataFrame:
-    """The file's cells as stripped strings; blank rows dropped, index i kept for file line i + 2."""
+@dataclass(frozen=True)
+class _Table:
+    """A CSV file's header and cells: columns as written in the header, cells[j] the stripped strings of column j,
+    lines[i] the file line of data row i (blank rows dropped)."""
+
+    columns: tuple[str, ...]
+    cells: tuple[tuple[str, ...], ...]
+    lines: tuple[int, ...]
+
+    def column(self, name: str) -> tuple[str, ...]:
+        return self.cells[self.columns.index(name)]
+
+    def __len__(self) -> int:
+        return len(self.lines)
+
+
+def _read_table(file: Path) -> _Table:
+    """The file's header and cells (the standard library's csv: a waypoint file is a few thousand rows of text).
+    The header is the first row that is not blank; a row shorter than it is padded with empty cells, a longer one
+    refused."""
     if not file.is_file():
         what = "is not a file" if file.exists() else "does not exist"
         raise WorkbenchInputError(f"waypoint file {str(file)!r} {what}; expected a CSV file")
+    header: list[str] | None = None
+    rows: list[list[str]] = []
+    lines: list[int] = []
     try:
-        with warnings.catch_warnings():
-            # pandas only warns (and drops data) when rows have more fields than the header: make it an error.
-            warnings.simplefilter("error", pd.errors.ParserWarning)
-            table = pd.read_csv(
-                file,
-                dtype=str,
-                keep_default_na=False,
-                skip_blank_lines=False,
-                index_col=False,
-                encoding="utf-8-sig",
-            )
-    except pd.errors.EmptyDataError:
-        table = pd.DataFrame()
-    except (pd.errors.ParserError, pd.errors.ParserWarning, UnicodeDecodeError, OSError) as err:
-        problem = "data rows have more fields than the header" if isinstance(err, Warning) else str(err).strip()
+        with file.open(newline="", encoding="utf-8-sig") as stream:
+            reader = csv.reader(stream, strict=True)
+            for row in reader:
+                cells = [cell.strip() for cell in row]
+                if not any(cells):
+                    continue
+                if header is None:
+                    header = row
+                elif len(row) > len(header):
+                    raise csv.Error(
+                        f"line {reader.line_num} has {len(row)} fields, more fields than the header's {len(header)}"
+                    )
+                else:
+                    rows.append(cells + [""] * (len(header) - len(cells)))
+                    lines.append(reader.line_num)
+    except (csv.Error, UnicodeDecodeError, OSError) as err:
         raise WorkbenchInputError(
-            f"{file.name}: not readable as CSV ({problem}); expected UTF-8 text, comma-separated, a header "
+            f"{file.name}: not readable as CSV ({str(err).strip()}); expected UTF-8 text, comma-separated, a header "
             "row and rows with the same number of fields"
         ) from err
-    if table.columns.empty:
+    if header is None:
         raise WorkbenchInputError(
             f"{file.name}: the file is empty; expected a CSV header row (x,y or lat,lon) and data rows"
         )
-    table = table.fillna("").apply(lambda column: column.str.strip())
-    return table[(table != "").any(axis=1)]
+    return _Table(tuple(header), tuple(zip(*rows, strict=True)) or ((),) * len(header), tuple(lines))
 
 
 def _normalise(column: object) -> str:
     return str(column).strip().lstrip("#").strip().lower()
 
 
-def _find(table: pd.DataFrame, names: tuple[str, ...], file_name: str) -> str | None:
+def _find(table: _Table, names: tuple[str, ...], file_name: str) -> str | None:
     """The one column whose normalised name is in `names`, or None; several is an error."""
     found = [column for column in table.columns if _normalise(column) in names]
     if len(found) > 1:
@@ -158,7 +180,7 @@ def _find(table: pd.DataFrame, names: tuple[str, ...], file_name: str) -> str | 
     return found[0] if found else None
 
 
-def _refuse_unknown_speed_unit(table: pd.DataFrame, file_name: str) -> None:
+def _refuse_unknown_speed_unit(table: _Table, file_name: str) -> None:
     """A column that reads as a speed but names no unit would be ignored, and the path planned at another speed."""
     for column in table.columns:
         label = _normalise(column)
@@ -169,7 +191,7 @@ def _refuse_unknown_speed_unit(table: pd.DataFrame, file_name: str) -> None:
             )
 
 
-def _track_widths(table: pd.DataFrame, file_name: str) -> tuple[np.ndarray | None, np.ndarray | None]:
+def _track_widths(table: _Table, file_name: str) -> tuple[np.ndarray | None, np.ndarray | None]:
     """The right and left track widths (m), or (None, None) without width columns; one without the other, a
     blank, non-numeric, NaN, negative or implausibly large entry raises naming the column and line."""
     right_col, left_col = _find(table, WIDTH_RIGHT_NAMES, file_name), _find(table, WIDTH_LEFT_NAMES, file_name)
@@ -188,41 +210,50 @@ def _track_widths(table: pd.DataFrame, file_name: str) -> tuple[np.ndarray | Non
         if bad.size:
             i = int(bad[0])
             raise WorkbenchInputError(
-                f"{file_name}: column {column!r}, line {table.index[i] + 2}: {float(values[i])!r} m is outside the "
+                f"{file_name}: column {column!r}, line {table.lines[i]}: {float(values[i])!r} m is outside the "
                 f"allowed range [0, {MAX_TRACK_HALF_WIDTH_M:g}] m (the distance from the centre line to the edge)"
             )
         widths.append(values)
     return widths[0], widths[1]
 
 
-def _require_rows(table: pd.DataFrame, file_name: str) -> None:
+def _require_rows(table: _Table, file_name: str) -> None:
     if len(table) < 3:
         raise WorkbenchInputError(f"{file_name}: a path needs at least 3 waypoint rows; the file has {len(table)}")
 
 
-def _numbers(table: pd.DataFrame, column: str, file_name: str) -> np.ndarray:
+def _numbers(table: _Table, column: str, file_name: str) -> np.ndarray:
     """Column as floats; raise naming column, line and text at the first blank, non-numeric, NaN or inf."""
-    values = pd.to_numeric(table[column], errors="coerce").to_numpy(dtype=float, na_value=np.nan)
+    texts = table.column(column)
+    values = np.array([_number(text) for text in texts], dtype=float)
     bad = np.flatnonzero(~np.isfinite(values))
     if bad.size:
         i = int(bad[0])
-        text = table[column].iloc[i]
+        text = texts[i]
         shown = repr(text) if text else "an empty entry"
         raise WorkbenchInputError(
-            f"{file_name}: column {column!r}, line {table.index[i] + 2}: {shown} is not allowed; "
+            f"{file_name}: column {column!r}, line {table.lines[i]}: {shown} is not allowed; "
             "every entry must be a finite number"
         )
     return values
 
 
-def _in_range(table: pd.DataFrame, column: str, file_name: str, limit: float) -> np.ndarray:
+def _number(text: str) -> float:
+    """A cell as a float, NaN when it is not a number (blank, text)."""
+    try:
+        return float(text)
+    except ValueError:
+        return math.nan
+
+
+def _in_range(table: _Table, column: str, file_name: str, limit: float) -> np.ndarray:
     """Column as floats in [-limit, limit] degrees; raise naming column, line and value otherwise."""
     values = _numbers(table, column, file_name)
     bad = np.flatnonzero(np.abs(values) > limit)
     if bad.size:
         i = int(bad[0])
         raise WorkbenchInputError(
-            f"{file_name}: column {column!r}, line {table.index[i] + 2}: {float(values[i])!r} deg is outside "
+            f"{file_name}: column {column!r}, line {table.lines[i]}: {float(values[i])!r} deg is outside "
             f"the allowed range [-{limit:g}, {limit:g}] deg"
         )
     return values

@@ -19,6 +19,7 @@ if TYPE_CHECKING:
     from matplotlib.axes import Axes
 
     from workbench.simulation.feasibility import InfeasibleSpan
+    from workbench.simulation.plot_worker import PlotWorker
     from workbench.simulation.run_config import SimulationConfig
     from workbench.simulation.track_margin import VehicleOutline
 
@@ -101,19 +102,22 @@ class SimulationResult:
 
         return plots.speed_vs_distance(self, ax)
 
-    def save(self, out_dir: str | Path, with_plots: bool = True) -> list[Path]:
+    def save(self, out_dir: str | Path, with_plots: bool = True, plot_worker: PlotWorker | None = None) -> list[Path]:
         """Write trace.parquet, metrics.json (the metrics, then infeasible_curvature: a list of
         `InfeasibleSpan.to_dict`, or null when not checked, then status and message) and the PNG plots; return the
         paths. The files a run writes that are already in out_dir (an earlier run's, the plots included when
-        with_plots is False) are removed first, so the folder never holds files of two runs."""
+        with_plots is False) are removed first, so the folder never holds files of two runs. plot_worker: a
+        `plot_worker.PlotWorker` that draws the plots meanwhile (here, if it cannot)."""
         from workbench.simulation import plots  # matplotlib itself only when the plots are drawn
 
         out = Path(out_dir)
         out.mkdir(parents=True, exist_ok=True)
         for name in ("trace.parquet", "metrics.json", *plots.RUN_PLOTS):
             (out / name).unlink(missing_ok=True)
+        if with_plots and plot_worker is not None:
+            plot_worker.submit(self, out)
         written = [out / "trace.parquet", out / "metrics.json"]
-        self.to_pandas().to_parquet(written[0], index=False)
+        _write_parquet(self.trace, written[0])
         spans = self.infeasible_curvature
         document = self.metrics.to_dict() | {
             "infeasible_curvature": None if spans is None else [span.to_dict() for span in spans],
@@ -124,5 +128,23 @@ class SimulationResult:
             document |= {"conditions": self.config.conditions.name, "seed": self.config.seed}
         written[1].write_text(json.dumps(document, indent=2) + "\n")
         if with_plots:
-            written += plots.save_run_plots(self, out)
+            drawn = plot_worker.wait() if plot_worker is not None else None
+            written += drawn if drawn is not None else plots.save_run_plots(self, out)
         return written
+
+
+def _write_parquet(trace: dict[str, np.ndarray], file: Path) -> None:
+    """The trace as a Parquet file, one column per signal, with pyarrow (what pandas' to_parquet calls). Numeric
+    columns go to Arrow as buffers: `pyarrow.array` would look for a pandas Series first and import pandas, ~0.3 s of
+    a CLI run that needs no pandas otherwise."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    def arrow(values: np.ndarray) -> pa.Array:
+        values = np.asarray(values)
+        if values.ndim == 1 and values.dtype.kind in "fiu":
+            values = np.ascontiguousarray(values)
+            return pa.Array.from_buffers(pa.from_numpy_dtype(values.dtype), values.size, [None, pa.py_buffer(values)])
+        return pa.array(values)
+
+    pq.write_table(pa.Table.from_arrays([arrow(v) for v in trace.values()], names=list(trace)), file)

@@ -13,13 +13,15 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, fields
-from typing import ClassVar
+from typing import TYPE_CHECKING, ClassVar
 
 import numpy as np
-import pandas as pd
 from scipy.constants import g as G_MPS2  # standard gravity, 9.80665 m/s^2
 
 from workbench.base.errors import WorkbenchInputError, require_finite, require_in_range, require_positive
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 
 @dataclass(frozen=True)
@@ -189,6 +191,8 @@ class SpeedProfile:
 
     def to_pandas(self) -> pd.DataFrame:
         """One row per waypoint: s_m, speed_mps, curvature_1pm."""
+        import pandas as pd  # not needed to plan or run a profile
+
         return pd.DataFrame({name: getattr(self, name) for name in self._ARRAYS})
 
 
