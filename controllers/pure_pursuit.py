@@ -12,10 +12,14 @@ import math
 from dataclasses import dataclass
 from typing import ClassVar
 
+import numpy as np
+from numba import njit
+
 from controllers.base import Controller, Measurement
 from controllers.config_checks import check_number
 from workbench.base.errors import WorkbenchInputError, value_text
 from workbench.base.path import PathTracker, ReferencePath
+from workbench.base.path_search import first_beyond, track, value_at
 
 #: The longest lookahead (m) the options allow.
 MAX_LOOKAHEAD_M = 1000.0
@@ -49,19 +53,68 @@ class PurePursuit(Controller):
         self._diag = self._declare_diagnostics(("lookahead_m", "target_s_m", "curvature_cmd_1pm"))
 
     def _command(self, measurement: Measurement, path: ReferencePath) -> float:
-        cfg = self.config
-        m = measurement
-        foot = self._tracker.update(m.x_m, m.y_m)
-        lookahead = min(max(cfg.lookahead_gain_s * m.speed_mps, cfg.min_lookahead_m), cfg.max_lookahead_m)
-        lookahead = max(lookahead, abs(foot.cte_m) + cfg.min_lookahead_m)
-        target_s = path.s_at_euclidean_distance(foot.s_m, m.x_m, m.y_m, lookahead)
-        tx, ty = path.position(target_s)
-        dx, dy = float(tx) - m.x_m, float(ty) - m.y_m
-        distance = math.hypot(dx, dy)
-        if distance < 1e-6:  # at the very end of an open path: hold the path's curvature
-            curvature = foot.curvature_1pm
-        else:
-            alpha = math.atan2(dy, dx) - m.yaw_rad
-            curvature = 2.0 * math.sin(alpha) / distance
+        cfg, m, tracker = self.config, measurement, self._tracker
+        curvature, lookahead, target_s = pure_pursuit_step(
+            m.x_m, m.y_m, m.yaw_rad, m.speed_mps, cfg.lookahead_gain_s, cfg.min_lookahead_m, cfg.max_lookahead_m,
+            path.x_m, path.y_m, path.heading_rad, path.curvature_1pm, path.spacing_m, path.length_m, path.closed,
+            path.max_segment_m, tracker.extent_m, tracker.min_window_m, tracker.state, tracker.out,
+        )  # fmt: skip
         self._diag[:] = (lookahead, target_s, curvature)
         return self.saturate(self.geometry.steer_wheel_for_curvature(curvature))
+
+
+@njit(cache=True)
+def pure_pursuit_step(
+    x_m: float,
+    y_m: float,
+    yaw_rad: float,
+    speed_mps: float,
+    gain_s: float,
+    min_lookahead_m: float,
+    max_lookahead_m: float,
+    path_x: np.ndarray,
+    path_y: np.ndarray,
+    path_heading: np.ndarray,
+    path_curvature: np.ndarray,
+    spacing: float,
+    length: float,
+    closed: bool,
+    max_segment: float,
+    extent: float,
+    min_window: float,
+    tracker: np.ndarray,
+    foot: np.ndarray,
+) -> tuple[float, float, float]:  # pragma: no cover - compiled
+    """(curvature 1/m, lookahead l_d m, target arc length m) of one step (module docstring), compiled: the foot
+    point (`path_search.track`, the tracker's state and output arrays), l_d, the target at l_d ahead
+    (`ReferencePath.s_at_euclidean_distance`) and the arc to it."""
+    track(
+        path_x,
+        path_y,
+        path_heading,
+        path_curvature,
+        spacing,
+        length,
+        closed,
+        extent,
+        min_window,
+        tracker,
+        x_m,
+        y_m,
+        foot,
+    )
+    foot_s, foot_curvature, cte = foot[0], foot[5], foot[6]
+    lookahead = min(max(gain_s * speed_mps, min_lookahead_m), max_lookahead_m)
+    lookahead = max(lookahead, abs(cte) + min_lookahead_m)
+    s_from = foot_s % length if closed else min(max(foot_s, 0.0), length)
+    index = first_beyond(path_x, path_y, x_m, y_m, s_from / spacing, lookahead, closed, max_segment)
+    if index < 0.0:  # no point ahead is that far: the end of an open path
+        target_s = length if not closed else s_from
+    else:
+        target_s = min(index * spacing, length)
+    dx = value_at(path_x, target_s, spacing, length, closed) - x_m
+    dy = value_at(path_y, target_s, spacing, length, closed) - y_m
+    distance = math.hypot(dx, dy)
+    if distance < 1e-6:  # at the very end of an open path: hold the path's curvature
+        return foot_curvature, lookahead, target_s
+    return 2.0 * math.sin(math.atan2(dy, dx) - yaw_rad) / distance, lookahead, target_s
