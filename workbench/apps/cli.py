@@ -42,6 +42,7 @@ if TYPE_CHECKING:
     from workbench.apps.studies import StudySpec
     from workbench.apps.studies.backends import Backend
     from workbench.base.output_dir import OutputDir
+    from workbench.simulation.plot_worker import PlotWorker
     from workbench.simulation.run_config import SimulationConfig
 
 # Heavy modules (the simulator, the scenarios' paths, plotting, the controllers' solvers, the studies' backends)
@@ -662,6 +663,21 @@ def _optimise(args: argparse.Namespace) -> int:
 
 
 def _run(args: argparse.Namespace) -> int:
+    """`workbench run`: with a second CPU, its plots are drawn by a second process, started first so that it imports
+    matplotlib while this one simulates (`workbench.simulation.plot_worker`)."""
+    from workbench.simulation import plot_worker
+
+    if args.no_plots or not plot_worker.worthwhile():
+        return _run_with(args, None)
+    try:
+        worker = plot_worker.PlotWorker()
+    except OSError:  # no second process to be had: draw here
+        return _run_with(args, None)
+    with worker:
+        return _run_with(args, worker)
+
+
+def _run_with(args: argparse.Namespace, plot_worker: PlotWorker | None) -> int:
     from controllers import make_controller
     from tuning.own_tuning import tuned_controller
     from workbench.apps.controller_config import read_controller_config
@@ -689,7 +705,7 @@ def _run(args: argparse.Namespace) -> int:
         warn_on_stderr(warning)
     result = simulation.run(progress=sys.stderr.isatty())
     with _writing(out):
-        written = result.save(args.out, with_plots=not args.no_plots)
+        written = result.save(args.out, with_plots=not args.no_plots, plot_worker=plot_worker)
     m = result.metrics
 
     def fmt(value: float | None, unit: str) -> str:

@@ -4,12 +4,14 @@ several runs on shared axes (the paper's Figures 17 and 18: `trajectories`, `cte
 
 matplotlib is imported where a figure is drawn, not with this module (issue 17): `result.py` and the CLI's
 startup need none of it; figures written to files are bare Figures (`file_axes`), without pyplot. A plotted run is
-anything with a `SimulationResult`'s fields (`PlottedRun`), so this module does not import the result that draws
-itself with it."""
+anything with a `SimulationResult`'s fields (`PlottedRun`, its path and scenario read through `PlottedPath` and
+`PlottedCourse`), so this module does not import the result that draws itself with it; `RunDrawing` is such a run in
+plain arrays, for a process that only draws (`plot_worker.py`)."""
 
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Protocol
 
@@ -18,8 +20,22 @@ import numpy as np
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
 
-    from workbench.base.path import ReferencePath
-    from workbench.simulation.scenarios import Scenario
+
+class PlottedPath(Protocol):
+    """What a plot reads of a path (a `ReferencePath` is one): its samples and its track's edges."""
+
+    x_m: np.ndarray
+    y_m: np.ndarray
+
+    def track_edges(self) -> tuple[tuple[np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray]] | None: ...
+
+
+class PlottedCourse(Protocol):
+    """What a plot reads of a scenario (a `Scenario` is one): its name, description and cones."""
+
+    name: str
+    description: str
+    cones_xy: np.ndarray | None
 
 
 class PlottedRun(Protocol):
@@ -27,10 +43,62 @@ class PlottedRun(Protocol):
     which controller and vehicle ran it."""
 
     trace: dict[str, np.ndarray]
-    path: ReferencePath
-    scenario: Scenario
+    path: PlottedPath
+    scenario: PlottedCourse
     controller: str
     vehicle: str
+
+
+@dataclass(frozen=True)
+class PathOutline:
+    """A path as the plots draw it: its samples and its track's edges (None: no widths)."""
+
+    x_m: np.ndarray
+    y_m: np.ndarray
+    edges: tuple[tuple[np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray]] | None
+
+    def track_edges(self) -> tuple[tuple[np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray]] | None:
+        return self.edges
+
+
+@dataclass(frozen=True)
+class CourseLabel:
+    """A scenario as the plots draw it: name, description and cones ((n, 2) m, or None)."""
+
+    name: str
+    description: str
+    cones_xy: np.ndarray | None
+
+
+#: The trace signals the run plots read (those a run has: the trailer's only with a trailer).
+RUN_PLOT_SIGNALS = (
+    "t_s", "x_m", "y_m", "trailer_x_m", "trailer_y_m", "progress_m", "cte_m", "steer_wheel_cmd_rad",
+    "steer_wheel_rad", "speed_ref_mps", "speed_mps",
+)  # fmt: skip
+
+
+@dataclass(frozen=True)
+class RunDrawing:
+    """What the run plots read of a run, in arrays and strings: a `PlottedRun` that unpickles with numpy alone, so a
+    process that only draws (`plot_worker.py`) needs none of the run's own classes and their imports."""
+
+    trace: dict[str, np.ndarray]
+    path: PathOutline
+    scenario: CourseLabel
+    controller: str
+    vehicle: str
+
+    @classmethod
+    def of(cls, run: PlottedRun) -> RunDrawing:
+        trace = {name: run.trace[name] for name in RUN_PLOT_SIGNALS if name in run.trace}
+        path, course = run.path, run.scenario
+        return cls(
+            trace,
+            PathOutline(path.x_m, path.y_m, path.track_edges()),
+            CourseLabel(course.name, course.description, course.cones_xy),
+            run.controller,
+            run.vehicle,
+        )
 
 
 #: Size of a plot's figure (inches), on screen and in files.
