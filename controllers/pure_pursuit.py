@@ -89,20 +89,9 @@ def pure_pursuit_step(
     point (`path_search.track`, the tracker's state and output arrays), l_d, the target at l_d ahead
     (`ReferencePath.s_at_euclidean_distance`) and the arc to it."""
     track(
-        path_x,
-        path_y,
-        path_heading,
-        path_curvature,
-        spacing,
-        length,
-        closed,
-        extent,
-        min_window,
-        tracker,
-        x_m,
-        y_m,
+        path_x, path_y, path_heading, path_curvature, spacing, length, closed, extent, min_window, tracker, x_m, y_m,
         foot,
-    )
+    )  # fmt: skip
     foot_s, foot_curvature, cte = foot[0], foot[5], foot[6]
     lookahead = min(max(gain_s * speed_mps, min_lookahead_m), max_lookahead_m)
     lookahead = max(lookahead, abs(cte) + min_lookahead_m)

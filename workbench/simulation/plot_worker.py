@@ -4,7 +4,7 @@ included, at 150 times real time).
 A run's four plots take about as long as its simulation: matplotlib's import (~0.4 s) and drawing (~0.7 s). The
 worker is started before the run, imports matplotlib while the simulation runs, and draws the plots from a
 `plots.RunDrawing` (arrays and strings: it unpickles with numpy alone) while the run's trace and metrics are written.
-It is worth it with two or more CPUs (`worthwhile`); the console script uses it, `SimulationResult.save` takes it.
+It is worth it with two or more CPUs (`worthwhile`); `workbench run` uses it, `SimulationResult.save` takes it.
 
 Whatever goes wrong in the worker (it cannot start, dies, or its drawing raises), `wait` returns None and the caller
 draws the plots itself: the worker only saves time, and a plotting error then surfaces where it always did.
