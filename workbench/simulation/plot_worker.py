@@ -43,7 +43,15 @@ class PlotWorker:
         context = multiprocessing.get_context("spawn")  # a fresh interpreter everywhere: no forked numba or locks
         self._connection, child = context.Pipe()
         self._process = context.Process(target=_serve, args=(child,), name="workbench-plots", daemon=True)
-        self._process.start()
+        # Ctrl-C is this process's to handle: the worker starts with SIGINT blocked (the mask survives the exec), so
+        # not even its start-up prints a KeyboardInterrupt; it then ignores SIGINT and ends with this process
+        masks = hasattr(signal, "pthread_sigmask")  # POSIX
+        previous = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT}) if masks else None
+        try:
+            self._process.start()
+        finally:
+            if previous is not None:
+                signal.pthread_sigmask(signal.SIG_SETMASK, previous)
         child.close()
         self._submitted = self._replied = False
 
@@ -87,6 +95,8 @@ def _serve(connection: Connection) -> None:  # pragma: no cover - runs in the wo
     """The worker: import matplotlib, draw the one run it is sent, reply, and leave without the interpreter's
     teardown (its replies are sent; nothing else to clean up)."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the parent's to handle; the worker ends with it
+    if hasattr(signal, "pthread_sigmask"):
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})  # ignored now, no longer pending
     from matplotlib.figure import Figure  # noqa: F401 - imported now, while the parent simulates
 
     from workbench.simulation.plots import save_run_plots

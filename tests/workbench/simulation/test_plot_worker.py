@@ -4,7 +4,9 @@ would, from a drawing that unpickles with numpy alone; whatever goes wrong there
 from __future__ import annotations
 
 import json
+import os
 import pickle
+import signal
 import subprocess
 import sys
 from pathlib import Path
@@ -102,6 +104,16 @@ def test_a_drawing_that_fails_in_the_worker_is_left_to_the_caller(tmp_path: Path
         assert worker.wait() is None
     with pytest.raises(KeyError, match="cte_m"):  # drawn again here, the error is this process's own
         plots.save_run_plots(broken, tmp_path)
+
+
+@pytest.mark.skipif(not hasattr(signal, "pthread_sigmask"), reason="POSIX signal masks")
+def test_ctrl_c_is_left_to_this_process_from_the_workers_start(tmp_path: Path) -> None:
+    """A terminal's Ctrl-C reaches the whole process group: the worker neither dies of it nor prints a
+    KeyboardInterrupt, even in its start-up; this process ends it."""
+    with PlotWorker() as worker:
+        os.kill(worker._process.pid, signal.SIGINT)  # at once: the worker is still starting
+        worker.submit(_run(), tmp_path)
+        assert worker.wait() == [tmp_path / name for name in plots.RUN_PLOTS]
 
 
 def test_closing_an_unused_worker_stops_it() -> None:
