@@ -16,7 +16,6 @@ import multiprocessing
 import os
 import signal
 import sys
-import traceback
 from multiprocessing.connection import Connection
 from pathlib import Path
 
@@ -109,7 +108,7 @@ def _serve(connection: Connection) -> None:  # pragma: no cover - runs in the wo
         drawing, out_dir = job
         reply = ("drawn", save_run_plots(drawing, out_dir))
     except Exception:  # the parent draws again in its own process, where the error surfaces
-        reply = ("failed", traceback.format_exc())
+        reply = ("failed", None)
     try:
         connection.send(reply)
     finally:

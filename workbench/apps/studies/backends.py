@@ -38,6 +38,7 @@ from threadpoolctl import threadpool_limits
 from workbench.apps.studies.runner import execute_run, failed_row
 from workbench.apps.studies.spec import PlannedRun
 from workbench.base.errors import WorkbenchInputError
+from workbench.simulation.plot_worker import usable_cpus
 
 BACKENDS = ("local", "dask")
 
@@ -72,11 +73,8 @@ class Backend(Protocol):
 
 
 def default_workers() -> int:
-    """The CPUs this process may run on."""
-    try:
-        return len(os.sched_getaffinity(0))
-    except AttributeError:  # not on Linux
-        return os.cpu_count() or 1
+    """The CPUs this process may run on (`plot_worker.usable_cpus`)."""
+    return usable_cpus()
 
 
 def _require_workers(workers: int | None) -> None:
