@@ -23,6 +23,11 @@ Added to the paper so that the loop keeps its margins on the vehicle it steers (
     and the path's curvature rate fed forward, so tracking needs no short lookaheads where the loop has no margin;
   - the steered vehicle's own lead filter, curvature limits and lags (`vehicle_tuning.py`, made by `tuning
     schedule --design margins`; the config holds them); without them, no lead filter and no floor.
+
+A known dead time (issue 18, known_delay_s: measurement latency plus actuation dead time) is compensated by default
+with the identified lags driven by the commands already sent (`delay_predictor.py`, a Smith predictor): the start
+pose and kappa(0) are where the vehicle will be when the command now sent takes effect, the loop the clothoid law
+closes is the delay-free one, and so is the floor (the loop with its delay keeps 30 deg and 3 dB besides).
 """
 
 from __future__ import annotations
@@ -37,6 +42,7 @@ from scipy.constants import g as G_MPS2  # standard gravity, 9.80665 m/s^2
 from controllers.base import Controller, Measurement
 from controllers.clothoid import step_kernel as sk
 from controllers.clothoid.curvature_limits import CurvatureLimits
+from controllers.clothoid.delay_predictor import history_length
 from controllers.clothoid.filter_schedule import FilterSchedule
 from controllers.clothoid.lead_filter import DiscreteLeadFilter
 from controllers.clothoid.lookahead import MAX_CURVE_POINTS, candidate_count
@@ -59,6 +65,7 @@ if TYPE_CHECKING:  # the loop analysis (python-control, ~0.9 s to import) only w
 
 LOOKAHEAD_MODES = ("adaptive", "fixed", "speed")
 INITIAL_CURVATURE = ("yaw-rate", "command", "steering")
+DELAY_COMPENSATIONS = ("model", "arc")
 HEADINGS = ("course", "yaw")
 THRESHOLD_MODES = ("excess", "absolute")
 SEARCH_STARTS = ("last", "ends")
@@ -111,19 +118,25 @@ class ClothoidConfig:
     min_preview_time_s: raises the lower end of the range to this time x speed (s; 0: off); lookahead_hysteresis_m,
     max_lookahead_growth_m_per_m, max_lookahead_shrink_m_per_m: how the search's choice is followed
     (`lookahead_filter.py`; None: at once); min_phase_margin_deg, min_gain_margin_db: the margins the lookahead
-    floor keeps (`loop_analysis.py`; 0 and 0: no floor); max_target_turn_deg: the lookahead's geometric ceiling, no
-    target farther round a bend than the path turning this much from the foot point (deg; 0: none; never below the
-    floor): an offset of the vehicle shows at a target theta round the bend as offset x cos(theta), and Eq. 3's gain
-    on it falls alike (0.46 of a straight's at 60 deg, none at 90 deg), which the margins do not see;
+    floor keeps (`loop_analysis.py`; 0 and 0: no floor; with a known delay compensated by the lags' model, the nominal,
+    delay-free loop's); min_delayed_phase_margin_deg, min_delayed_gain_margin_db: with that compensation, the margins
+    the loop with its delay and the predictor keeps besides, at the steering sent; max_target_turn_deg: the lookahead's
+    geometric ceiling, no target farther round a bend than the path turning this much from the foot point (deg; 0: none;
+    never below the floor): an offset of the vehicle shows at a target theta round the bend as offset x cos(theta), and
+    Eq. 3's gain on it falls alike (0.46 of a straight's at 60 deg, none at 90 deg), which the margins do not see;
     frechet_threshold_m: the adaptive threshold (m; the paper: 0.5 m) and threshold_mode how it applies ("excess" of
-    |CTE| or "absolute"; module docstring); frechet_point_spacing_m: sampling of the curves compared (m);
-    tolerance_x_m, tolerance_y_m: delta_x, delta_y of Eq. 3 (m); max_curvature_rate_1pm2: saturation of the
-    clothoid's kappa' (1/m^2); initial_curvature: kappa(0)
-    of Eq. 3, "yaw-rate", "command" or "steering"; heading: "course" or "yaw"; prediction_time_s: pose prediction
-    (s; 0: off); known_delay_s: the loop's dead time the controller knows, measurement latency (the pose measured
-    is that long old) plus actuation dead time (a command reaches the steering that much later) (s; 0: none): the
-    pose is predicted over prediction_time_s + known_delay_s, the reference pose and the feed-forward point move
-    ahead with it, and the lookahead floor's loop analysis has it as a pure delay (`loop_analysis.LoopSettings`);
+    |CTE| or "absolute"; module docstring); frechet_point_spacing_m: sampling of the curves compared (m); tolerance_x_m,
+    tolerance_y_m: delta_x, delta_y of Eq. 3 (m); max_curvature_rate_1pm2: saturation of the clothoid's kappa' (1/m^2);
+    initial_curvature: kappa(0) of Eq. 3, "yaw-rate", "command" or "steering"; heading: "course" or "yaw";
+    prediction_time_s: pose prediction (s; 0: off); known_delay_s: the loop's dead time the controller knows,
+    measurement latency (the pose measured is that long old) plus actuation dead time (a command reaches the
+    steering that much later) (s; 0: none): the pose is predicted over it as well, the reference pose and the
+    feed-forward point move ahead with it, and the lookahead floor's loop analysis has it
+    (`loop_analysis.LoopSettings`); delay_compensation: how the pose is predicted over the known delay, "model" (the
+    identified lags driven by the commands already sent, a Smith predictor, `delay_predictor.py`: the loop's nominal
+    dynamics are the delay-free ones, and so is the lookahead floor; needs the tuning and initial_curvature
+    "yaw-rate") or "arc" (on kappa(0) over prediction_time_s + known_delay_s; the delay stays in the loop, and the
+    floor is the delayed loop's);
     path_feedforward: the two-degree-of-freedom form (`path_feedforward.py`; False: Eq. 3 alone);
     feedforward_window_m: the window the path's curvature rate is averaged over (m); feedforward_time_s,
     reference_lead_s: its timings (s; None: from the vehicle's identified lags); tuning: the steered vehicle's own
@@ -147,6 +160,8 @@ class ClothoidConfig:
     max_lookahead_shrink_m_per_m: float | None = 0.5
     min_phase_margin_deg: float = 45.0
     min_gain_margin_db: float = 6.0
+    min_delayed_phase_margin_deg: float = 30.0
+    min_delayed_gain_margin_db: float = 3.0
     max_target_turn_deg: float = 60.0
     fixed_lookahead_m: float = 10.0
     lookahead_gain_s: float = 1.0
@@ -160,6 +175,7 @@ class ClothoidConfig:
     heading: str = "course"
     prediction_time_s: float = 0.2
     known_delay_s: float = 0.0
+    delay_compensation: str = "model"
     path_feedforward: bool = True
     feedforward_window_m: float = 6.0
     feedforward_time_s: float | None = None
@@ -169,6 +185,11 @@ class ClothoidConfig:
     use_lead_filter: bool = True
     curvature_limits: CurvatureLimits | None = None
 
+    @property
+    def predicts_with_model(self) -> bool:
+        """Whether the pose is predicted over a known delay with the identified lags (`delay_predictor.py`)."""
+        return self.delay_compensation == "model" and self.known_delay_s > 0.0
+
     def __post_init__(self) -> None:
         # Every field on its own first (`config_checks.py`), then what relates them.
         check_choice("lookahead_mode", self.lookahead_mode, LOOKAHEAD_MODES)
@@ -176,6 +197,7 @@ class ClothoidConfig:
         check_choice("heading", self.heading, HEADINGS)
         check_choice("threshold_mode", self.threshold_mode, THRESHOLD_MODES)
         check_choice("search_start", self.search_start, SEARCH_STARTS)
+        check_choice("delay_compensation", self.delay_compensation, DELAY_COMPENSATIONS)
         check_number("prediction_time_s", self.prediction_time_s, 0.0, 2.0, "s")
         check_number("known_delay_s", self.known_delay_s, 0.0, 1.0, "s", note="0: none")
         check_number("min_preview_time_s", self.min_preview_time_s, 0.0, 10.0, "s")
@@ -184,6 +206,8 @@ class ClothoidConfig:
         require_rate("max_lookahead_shrink_m_per_m", self.max_lookahead_shrink_m_per_m)
         check_number("min_phase_margin_deg", self.min_phase_margin_deg, 0.0, 89.0, "deg")
         check_number("min_gain_margin_db", self.min_gain_margin_db, 0.0, 40.0, "dB")
+        check_number("min_delayed_phase_margin_deg", self.min_delayed_phase_margin_deg, 0.0, 89.0, "deg")
+        check_number("min_delayed_gain_margin_db", self.min_delayed_gain_margin_db, 0.0, 40.0, "dB")
         check_number("max_target_turn_deg", self.max_target_turn_deg, 0.0, 180.0, "deg", note="0: no ceiling")
         check_number("min_lookahead_m", self.min_lookahead_m, 0.5, MAX_LOOKAHEAD_M, "m")
         check_number("max_lookahead_m", self.max_lookahead_m, 0.5, MAX_LOOKAHEAD_M, "m")
@@ -203,6 +227,12 @@ class ClothoidConfig:
         check_optional_instance("lead_filter", self.lead_filter, FilterSchedule)
         check_bool("use_lead_filter", self.use_lead_filter)
         check_optional_instance("curvature_limits", self.curvature_limits, CurvatureLimits)
+        if self.predicts_with_model and self.initial_curvature != "yaw-rate":
+            raise WorkbenchInputError(
+                f"delay_compensation 'model' predicts the measured kappa(0), initial_curvature 'yaw-rate'; got "
+                f"initial_curvature {self.initial_curvature!r} with known_delay_s = {value_text(self.known_delay_s)}: "
+                "set delay_compensation = 'arc' (the pose predicted on kappa(0)) or initial_curvature = 'yaw-rate'"
+            )
         if self.max_lookahead_m < self.min_lookahead_m:
             raise WorkbenchInputError(
                 f"max_lookahead_m must be >= min_lookahead_m = {value_text(self.min_lookahead_m)} m; "
@@ -246,6 +276,12 @@ class ClothoidController(Controller):
                 "vehicle"
             )
         self.tuning: VehicleTuning | None = cfg.tuning
+        if cfg.predicts_with_model and self.tuning is None:
+            raise WorkbenchInputError(
+                f"delay_compensation 'model' (known_delay_s = {value_text(cfg.known_delay_s)} s) predicts with the "
+                "vehicle's identified lags, and this controller has no tuning: give ClothoidConfig(tuning=...) "
+                "(tuning.own_tuning.tuning_for) or set delay_compensation = 'arc'"
+            )
         if cfg.curvature_limits is not None:
             self.limits = cfg.curvature_limits
         elif self.tuning is not None:
@@ -268,6 +304,7 @@ class ClothoidController(Controller):
         self._floor_table = np.empty(sk.FLOOR_ROWS)
         self._filter_table = np.empty((sk.FILTER_ROWS, 9))
         self._scratch = np.empty(sk.SCRATCH_SIZE)
+        self._history = np.empty(1)  # the delay predictor's commands sent, sized by `_reset`
         self._params = self._parameters()
         self._tables()
 
@@ -287,11 +324,16 @@ class ClothoidController(Controller):
         p[sk.P_PATH_MAX_SEGMENT] = path.max_segment_m
         self._diag = self._declare_diagnostics(DIAGNOSTIC_KEYS)
         self._tables()  # read again: limits, tuning and schedule are the controller's attributes
+        if self.config.predicts_with_model:
+            longest = self.config.known_delay_s + float(
+                max(self._lags[:, 2].max(), self._measured_lags[:, 2].max(initial=0.0))
+            )
+            self._history = np.empty(history_length(self._dt, longest))
         # The step's own arrays, in clothoid_step's order after the path's: looked up once, not every step.
         self._own_arrays = (
             self._tracker.state, self._here.state, self._limits, self._limit_speeds, self._lags, self._measured_lags,
             self._lag_speeds, self._schedule, self._schedule_speeds, self._floor_table, self._filter_table,
-            self._buffers, self._scores, self._results, self._scratch, self._diag,
+            self._buffers, self._scores, self._results, self._scratch, self._diag, self._history,
         )  # fmt: skip
         if path.speed_mps is not None:  # the floors of the planned speeds now, not inside a step (~0.1 s per band)
             for speed_mps in np.unique(np.round(path.speed_mps * 3.6 / FLOOR_SPEED_BAND_KMH)) * FLOOR_SPEED_BAND_KMH:
@@ -326,6 +368,7 @@ class ClothoidController(Controller):
         p[sk.P_MIN_LOOKAHEAD], p[sk.P_MAX_LOOKAHEAD] = cfg.min_lookahead_m, cfg.max_lookahead_m
         p[sk.P_LOOKAHEAD_STEP], p[sk.P_MIN_PREVIEW] = cfg.lookahead_step_m, cfg.min_preview_time_s
         p[sk.P_WARM_SEARCH] = cfg.search_start == "last"
+        p[sk.P_DELAY_MODEL] = cfg.predicts_with_model
         p[sk.P_FIXED_LOOKAHEAD], p[sk.P_LOOKAHEAD_GAIN] = cfg.fixed_lookahead_m, cfg.lookahead_gain_s
         p[sk.P_MAX_TURN_RAD] = math.radians(cfg.max_target_turn_deg)
         p[sk.P_FRECHET_THRESHOLD], p[sk.P_POINT_SPACING] = cfg.frechet_threshold_m, cfg.frechet_point_spacing_m
@@ -356,7 +399,11 @@ class ClothoidController(Controller):
         from controllers.clothoid.loop_analysis import LoopSettings
 
         lead = self.filter_schedule.at_speed(speed_kmh) if self.filter_schedule is not None else None
-        return LoopSettings(self._dt, self.config.prediction_time_s, lead=lead, known_delay_s=self.config.known_delay_s)
+        cfg = self.config
+        return LoopSettings(
+            self._dt, cfg.prediction_time_s, lead=lead, known_delay_s=cfg.known_delay_s,
+            delay_compensation=cfg.delay_compensation,
+        )  # fmt: skip
 
     def lookahead_floor_m(self, speed_mps: float) -> float:
         """The shortest lookahead (m) that keeps the configured margins at this speed (per FLOOR_SPEED_BAND_KMH band,
@@ -382,7 +429,8 @@ class ClothoidController(Controller):
                 floor = lookahead_floor(
                     lags, self.loop_settings(speed_kmh), v, cfg.min_lookahead_m,
                     max(cfg.max_lookahead_m, MAX_FLOOR_LOOKAHEAD_M), cfg.lookahead_step_m, (0.0, arc),
-                    cfg.min_phase_margin_deg, cfg.min_gain_margin_db,
+                    cfg.min_phase_margin_deg, cfg.min_gain_margin_db, cfg.min_delayed_phase_margin_deg,
+                    cfg.min_delayed_gain_margin_db,
                 )  # fmt: skip
             self._floors[band] = floor
         return floor

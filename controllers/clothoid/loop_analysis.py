@@ -28,6 +28,7 @@ actuator's own rate limit and lag, which also bound the cycle, are not in it).
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -46,8 +47,18 @@ from workbench.vehicles.steering_lag import SteeringLag
 #: margin (dB) both ways (rise and reduction).
 REQUIRED_PHASE_MARGIN_DEG = 45.0
 REQUIRED_GAIN_MARGIN_DB = 6.0
+#: With a known delay compensated by the lags' model (`LoopSettings.nominal`), the margins above are the nominal
+#: loop's, which sets the response; the loop with its delay and the predictor, broken at the steering sent, keeps
+#: at least these (deg, dB both ways): what a gain or delay the model does not know may change before the loop
+#: goes unstable. A Smith predictor's loop has less than its nominal one (Normey-Rico & Camacho, "Control of
+#: Dead-time Processes", 2007, ch. 5); 30 deg is the usual least phase margin (Skogestad & Postlethwaite,
+#: "Multivariable Feedback Control", 2005, sec. 2.4.3).
+REQUIRED_DELAYED_PHASE_MARGIN_DEG = 30.0
+REQUIRED_DELAYED_GAIN_MARGIN_DB = 3.0
 #: kappa(0) choices the analysis models (the controller's "steering" is not).
 INITIAL_CURVATURES = ("yaw-rate", "command")
+#: How the pose is predicted over the known delay (`ClothoidConfig.delay_compensation`).
+DELAY_COMPENSATIONS = ("model", "arc")
 #: Finite-difference step of the clothoid-law gains (m, rad and 1/m x 1 m).
 _PROBE = 1e-4
 #: Spacing (m) of the check above a bisected floor.
@@ -62,8 +73,9 @@ class LoopSettings:
     prediction, s), initial_curvature (kappa(0) of Eq. 3: "yaw-rate", the measured curvature, or "command", the
     integrator's), lead (Eq. 6 filter, None: off), measurement_delay_s (a dead time the controller does not know,
     s, rounded to whole periods), known_delay_s (the dead time it knows, measurement latency plus actuation dead
-    time, s: the same pure delay in the loop, and the pose is predicted over it too, prediction_time_s +
-    known_delay_s; `ClothoidConfig.known_delay_s`).
+    time, s: the same pure delay in the loop; `ClothoidConfig.known_delay_s`), delay_compensation (how the pose is
+    predicted over the known delay: "model", with the lags driven by the commands sent, `delay_predictor.py`, in
+    whole periods here; "arc", on kappa(0) over prediction_time_s + known_delay_s).
 
     Where a delay sits does not matter here: the loop is single-input (broken at the steering sent) and every
     output the controller measures (y, psi, kappa) comes out of the same plant, so a measurement latency z^-n P(z)
@@ -76,17 +88,38 @@ class LoopSettings:
     lead: LeadFilterParams | None = None
     measurement_delay_s: float = 0.0
     known_delay_s: float = 0.0
+    delay_compensation: str = "model"
 
     def __post_init__(self) -> None:
         require_in_range("sample_time_s", self.sample_time_s, 1e-4, 1.0, "s")
         require_in_range("prediction_time_s", self.prediction_time_s, 0.0, 2.0, "s")
         require_in_range("measurement_delay_s", self.measurement_delay_s, 0.0, 2.0, "s")
         require_in_range("known_delay_s", self.known_delay_s, 0.0, 2.0, "s")
+        if self.delay_compensation not in DELAY_COMPENSATIONS:
+            raise WorkbenchInputError(
+                f"delay_compensation must be one of {', '.join(DELAY_COMPENSATIONS)}; got {self.delay_compensation!r}"
+            )
         if self.initial_curvature not in INITIAL_CURVATURES:
             raise WorkbenchInputError(
                 f"initial_curvature must be one of {', '.join(INITIAL_CURVATURES)} for the analysis; got "
                 f"{self.initial_curvature!r}"
             )
+        if self.predicts_with_model and self.initial_curvature != "yaw-rate":
+            raise WorkbenchInputError(
+                "delay_compensation 'model' predicts the measured kappa(0), initial_curvature 'yaw-rate'; got "
+                f"{self.initial_curvature!r}"
+            )
+
+    @property
+    def predicts_with_model(self) -> bool:
+        """Whether the pose is predicted over a known delay with the lags' model."""
+        return self.delay_compensation == "model" and self.known_delay_s > 0.0
+
+    @property
+    def nominal(self) -> LoopSettings:
+        """The loop the delay compensation leaves when its model is the plant: with "model", the delay-free loop
+        (Smith's predictor takes the delay out of the characteristic equation); with "arc", this loop itself."""
+        return dataclasses.replace(self, known_delay_s=0.0) if self.predicts_with_model else self
 
 
 @dataclass(frozen=True)
@@ -185,15 +218,15 @@ class PlantLags:
     measured: SteeringLag | None = None
 
 
-def _plant_parts(
-    lags: PlantLags, speed_mps: float, path_curvature_1pm: float, settings: LoopSettings
-) -> tuple[control.StateSpace, tuple[int, int]]:
-    """The plant without its delays: two inputs (the steering reaching the path lag, the measured lag), outputs (y,
-    psi, kappa measured); and each input's delay in whole periods."""
+def _plant_continuous(
+    lags: PlantLags, speed_mps: float, path_curvature_1pm: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(A, B, C) of the plant in continuous time, without its delays: states path lag (2), psi, y, measured lag (2),
+    each lag as SteeringLag's [y, y'] realisation (its gain K here); inputs the steering reaching the path lag and
+    the measured lag; outputs (y, psi, kappa measured)."""
     require_positive("speed_mps", speed_mps)
-    dt, v, kr = settings.sample_time_s, float(speed_mps), float(path_curvature_1pm)
+    v, kr = float(speed_mps), float(path_curvature_1pm)
     path, measured = lags.path, lags.measured or lags.path
-    # states: path lag (2), psi, y, measured lag (2); each lag as SteeringLag's [y, y'] realisation, its gain K here
     a_c = np.zeros((6, 6))
     b_c = np.zeros((6, 2))
     a_c[0:2, 0:2], b_c[0:2, 0] = path.companion_matrices()
@@ -201,7 +234,18 @@ def _plant_parts(
     a_c[2, 0], a_c[2, 3], a_c[3, 2] = v * path.steady_state_gain, -v * kr * kr, v
     c_c = np.zeros((3, 6))
     c_c[0, 3], c_c[1, 2], c_c[2, 4] = 1.0, 1.0, measured.steady_state_gain
+    return a_c, b_c, c_c
+
+
+def _plant_parts(
+    lags: PlantLags, speed_mps: float, path_curvature_1pm: float, settings: LoopSettings
+) -> tuple[control.StateSpace, tuple[int, int]]:
+    """The plant without its delays (`_plant_continuous`) at the controller period, zero-order hold; and each
+    input's delay in whole periods."""
+    dt = settings.sample_time_s
+    a_c, b_c, c_c = _plant_continuous(lags, speed_mps, path_curvature_1pm)
     a, b, c, d, _ = signal.cont2discrete((a_c, b_c, c_c, np.zeros((3, 2))), dt, method="zoh")
+    path, measured = lags.path, lags.measured or lags.path
     extra = settings.measurement_delay_s + settings.known_delay_s
     taps = (_delay_steps(path.delay_s + extra, dt), _delay_steps(measured.delay_s + extra, dt))
     return control.ss(a, b, c, d, dt), taps
@@ -230,32 +274,68 @@ def plant(lags: PlantLags, speed_mps: float, path_curvature_1pm: float, settings
 
 
 def _controller_step(
-    settings: LoopSettings, speed_mps: float, gains: tuple[float, float, float]
+    settings: LoopSettings,
+    lags: PlantLags,
+    speed_mps: float,
+    path_curvature_1pm: float,
+    gains: tuple[float, float, float],
 ) -> tuple[int, Callable[[np.ndarray, np.ndarray], tuple[np.ndarray, float]]]:
     """(state size, step(state, [y, psi, kappa]) -> (next state, curvature sent)): the controller's step in deviation
-    variables, linear, in the order `controller.py` runs it. State: [kappa_cmd, lead filter (3)]."""
+    variables, linear, in the order `controller.py` runs it. State: [kappa_cmd, lead filter (3)], then with the
+    model's delay compensation the lags' model (path, measured: 2 each) and the commands sent (newest first)."""
     dt, v = settings.sample_time_s, float(speed_mps)
     g_y, g_psi, g_k = gains
     if settings.lead is not None:
         a_f, b_f, c_f, d_f = DiscreteLeadFilter(settings.lead, dt).state_space
         a_f, b_f, c_f = np.array(a_f), np.array(b_f), np.array(c_f)
-    dp = v * (settings.prediction_time_s + settings.known_delay_s)  # the pose predicted over the known delay too
     measured = settings.initial_curvature == "yaw-rate"
+    model = settings.predicts_with_model
+    dp = v * (settings.prediction_time_s + (0.0 if model else settings.known_delay_s))
+    sent = 0
+    if model:
+        # delay_predictor.py, exactly in whole periods: the plant's own equations (lags, psi, y) at the controller
+        # period, a third input adding a constant curvature to psi' (the measured curvature less the model's, which
+        # the prediction holds), each lag's input (its delay + the known delay) late
+        a_c, b_c, _ = _plant_continuous(lags, v, path_curvature_1pm)
+        offset = np.zeros((6, 1))
+        offset[2, 0] = v
+        a_m, b_m, *_ = signal.cont2discrete((a_c, np.hstack([b_c, offset]), np.eye(6), np.zeros((6, 3))), dt)
+        k_path, k_measured = lags.path.steady_state_gain, (lags.measured or lags.path).steady_state_gain
+        taps = (_delay_steps(lags.path.delay_s + settings.known_delay_s, dt),
+                _delay_steps((lags.measured or lags.path).delay_s + settings.known_delay_s, dt))  # fmt: skip
+        ahead, sent = _delay_steps(settings.known_delay_s, dt), max(*taps, 1)
+        lag_states = [0, 1, 4, 5]
+    size = 4 + (4 + sent if model else 0)
 
     def step(s: np.ndarray, meas: np.ndarray) -> tuple[np.ndarray, float]:
         y, psi, kappa_meas = meas
         kappa0 = kappa_meas if measured else s[0]
+        if model:  # the pose moved on the measured curvature plus the model's change, kappa(0) likewise
+            line = s[8:]
+            z = np.array([s[4], s[5], psi, y, s[6], s[7]])
+            held = kappa_meas - k_path * s[4]
+            for j in range(ahead):  # the commands reaching each lag j periods from now (the last held beyond)
+                z = a_m @ z + b_m @ np.array([line[max(taps[0] - j - 1, 0)], line[max(taps[1] - j - 1, 0)], held])
+            psi, y = z[2], z[3]
+            kappa0 = kappa_meas + k_measured * (z[4] - s[6])
         yp, psip = y + psi * dp + 0.5 * kappa0 * dp * dp, psi + kappa0 * dp  # the chord formula, linearised
         kappa_cmd = s[0] + dt * v * (g_y * yp + g_psi * psip + g_k * kappa0)
-        nxt = np.zeros(4)
+        nxt = np.zeros(size)
         nxt[0] = kappa_cmd
-        if settings.lead is None:
-            return nxt, kappa_cmd
-        f = s[1:4]
-        nxt[1:4] = a_f @ f + b_f * kappa_cmd
-        return nxt, float(c_f @ f + d_f * kappa_cmd)
+        u = kappa_cmd
+        if settings.lead is not None:
+            f = s[1:4]
+            nxt[1:4] = a_f @ f + b_f * kappa_cmd
+            u = float(c_f @ f + d_f * kappa_cmd)
+        if model:  # the model advances a period on what reached it; the command sent joins the line
+            reached = [s[8 + tap - 1] if tap else u for tap in taps]
+            z = np.array([s[4], s[5], 0.0, 0.0, s[6], s[7]])
+            nxt[4:8] = (a_m @ z + b_m @ np.array([*reached, 0.0]))[lag_states]
+            nxt[8] = u
+            nxt[9:] = s[8:-1]
+        return nxt, u
 
-    return 4, step
+    return size, step
 
 
 def controller(
@@ -264,7 +344,7 @@ def controller(
     """The controller linearised (module docstring): inputs (y, psi, kappa), output the steering sent as curvature;
     read off its linear step by unit probes."""
     gains = clothoid_law_gains(lookahead_m, path_curvature_1pm)
-    size, step = _controller_step(settings, speed_mps, gains)
+    size, step = _controller_step(settings, lags, speed_mps, path_curvature_1pm, gains)
     a, c = np.zeros((size, size)), np.zeros((1, size))
     b, d = np.zeros((size, 3)), np.zeros((1, 3))
     for i in range(size):
@@ -430,18 +510,32 @@ def lookahead_floor(
     path_curvatures_1pm: tuple[float, ...] = (0.0,),
     phase_margin_deg: float = REQUIRED_PHASE_MARGIN_DEG,
     gain_margin_db: float = REQUIRED_GAIN_MARGIN_DB,
+    delayed_phase_margin_deg: float = REQUIRED_DELAYED_PHASE_MARGIN_DEG,
+    delayed_gain_margin_db: float = REQUIRED_DELAYED_GAIN_MARGIN_DB,
 ) -> float:
     """The shortest lookahead (m, on a grid of step_m from min_lookahead_m) from which every lookahead up to
     max_lookahead_m keeps the required margins about each of the path curvatures; max_lookahead_m when none does.
-    A bisection on the grid (margins mostly improve with the lookahead: the loop's gain falls as L^-3), then a check
-    every _FLOOR_CHECK_M above the result; a failure there restarts the bisection above it."""
+    The margins are those of the nominal loop (`LoopSettings.nominal`: with the model's delay compensation the
+    delay-free one, which it leaves when its model is the vehicle); with that compensation the loop itself keeps
+    delayed_phase_margin_deg and delayed_gain_margin_db at the steering sent. A bisection
+    on the grid (margins mostly improve with the lookahead: the loop's gain falls as L^-3), then a check every
+    _FLOOR_CHECK_M above the result; a failure there restarts the bisection above it."""
     grid = np.arange(min_lookahead_m, max_lookahead_m + 1e-9, step_m)
     if grid.size == 0 or grid[-1] < max_lookahead_m - 1e-9:
         grid = np.append(grid, max_lookahead_m)
 
+    nominal = settings.nominal
+
     def ok(i: int) -> bool:
+        v, lookahead = float(speed_mps), float(grid[i])
         return all(
-            loop_margins(lags, settings, float(speed_mps), float(grid[i]), kr).meets(phase_margin_deg, gain_margin_db)
+            loop_margins(lags, nominal, v, lookahead, kr).meets(phase_margin_deg, gain_margin_db)
+            and (
+                nominal is settings
+                or loop_margins(lags, settings, v, lookahead, kr).meets(
+                    delayed_phase_margin_deg, delayed_gain_margin_db
+                )
+            )
             for kr in path_curvatures_1pm
             if abs(kr) * grid[i] < 1.8
         )

@@ -75,18 +75,21 @@ def two_degree_of_freedom_rate(
     reference_lead_s: float,
     steady_state_gain: float,
     window_m: float,
+    path_time_s: float = 0.0,
 ) -> tuple[float, float, float]:  # pragma: no cover - compiled
     """(kappa' to integrate, the reference's kappa', the feed-forward kappa') (1/m^2), module docstring. here: the
     foot point of the vehicle's measured position (`path_search.track`'s output: s, progress, x, y, heading,
     curvature, ...); the timings of `FeedforwardTiming`.
 
-    The reference pose: the path's pose reference_lead_s ahead of the foot point, moved over the rest of the
-    prediction time on the path's curvature there, by the chord of that arc (as the vehicle's own prediction).
+    The reference pose: the path's pose path_time_s + reference_lead_s ahead of the foot point, moved over the rest
+    of the prediction time on the path's curvature there, by the chord of that arc (as the vehicle's own
+    prediction; path_time_s: the known delay when the vehicle's pose is predicted over it with the lags' model,
+    which follows the path's own curvature, `delay_predictor.py`; else 0).
     The feed-forward: dkappa/ds of the path speed x feedforward_time_s ahead of the foot point, averaged over
     window_m, over K."""
     lead = min(reference_lead_s, prediction_time_s)
-    if lead > 0.0:
-        s_ref = here[0] + speed_mps * lead
+    if path_time_s + lead > 0.0:
+        s_ref = here[0] + speed_mps * (path_time_s + lead)
         rx = value_at(path_x, s_ref, spacing, length, closed)
         ry = value_at(path_y, s_ref, spacing, length, closed)
         rh = value_at(path_heading, s_ref, spacing, length, closed)

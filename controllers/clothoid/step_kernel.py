@@ -18,6 +18,7 @@ import math
 import numpy as np
 from numba import njit
 
+from controllers.clothoid import delay_predictor as dp
 from controllers.clothoid.lead_filter import lead_step
 from controllers.clothoid.lookahead import adaptive_search, evaluate_candidate, evaluated, turn_limited_lookahead
 from controllers.clothoid.lookahead_filter import filtered_lookahead
@@ -38,9 +39,9 @@ KAPPA0_YAW_RATE, KAPPA0_COMMAND, KAPPA0_STEERING = 0, 1, 2
     P_LOOKAHEAD_GAIN, P_MAX_TURN_RAD, P_FRECHET_THRESHOLD, P_POINT_SPACING, P_TOLERANCE_X, P_TOLERANCE_Y,
     P_KDOT_MAX, P_FEEDFORWARD, P_FEEDFORWARD_WINDOW, P_FEEDFORWARD_TIME, P_REFERENCE_LEAD, P_HYSTERESIS,
     P_MAX_GROWTH, P_MAX_SHRINK, P_MIN_SPEED, P_BAND_KMH, P_BAND_HYSTERESIS_KMH, P_PATH_SPACING, P_PATH_LENGTH,
-    P_PATH_EXTENT, P_TRACKER_WINDOW, P_PATH_MAX_SEGMENT, P_WARM_SEARCH,
-) = range(38)  # fmt: skip
-PARAM_COUNT = 38
+    P_PATH_EXTENT, P_TRACKER_WINDOW, P_PATH_MAX_SEGMENT, P_WARM_SEARCH, P_DELAY_MODEL,
+) = range(39)  # fmt: skip
+PARAM_COUNT = 39
 
 # The step's own state (`state`).
 S_KAPPA_CMD = 0  # the integrator's curvature command (1/m; NaN before the first step)
@@ -49,7 +50,8 @@ S_LOOKAHEAD = 2  # the lookahead filter's state: its lookahead and floor (m; NaN
 S_FILTER_X = 4  # the lead filter's three states (rad), shared by the filters of every km/h (a bumpless switch)
 S_NEED = 7  # what a NEED_* return asks for: the speed band or the km/h
 S_SEARCHED = 8  # the adaptive search's last choice (m; NaN before the first search): where the next one starts
-STATE_SIZE = 9
+S_MODEL = 9  # the delay predictor's model (`delay_predictor.MODEL_SIZE` values; NaN before the first step)
+STATE_SIZE = S_MODEL + dp.MODEL_SIZE
 
 # `clothoid_step`'s status.
 STEP_DONE, NEED_FLOOR, NEED_FILTER = 0, 1, 2
@@ -57,8 +59,9 @@ STEP_DONE, NEED_FLOOR, NEED_FILTER = 0, 1, 2
 FILTER_ROWS = 541
 #: Rows of the floor table: every speed band up to 540 km/h.
 FLOOR_ROWS = 120
-#: Size of `clothoid_step`'s scratch array: a table row, then a projection.
-SCRATCH_SIZE = 4 + TRACK_OUT_SIZE
+#: Size of `clothoid_step`'s scratch array: a table row, a projection, then the two lags' rows at this speed.
+LAG_ROWS = 4 + TRACK_OUT_SIZE
+SCRATCH_SIZE = LAG_ROWS + 8
 
 
 @njit(cache=True)
@@ -132,12 +135,14 @@ def clothoid_step(
     results: np.ndarray,
     scratch: np.ndarray,
     diagnostics: np.ndarray,
+    history: np.ndarray,
 ) -> tuple[float, int]:  # pragma: no cover - compiled
     """(steering-wheel command rad, status) of one step (`controller.py` documents what it does); diagnostics (16)
     in the order of controller.DIAGNOSTIC_KEYS. tracker, here: the states of the start pose's and the measured
     position's path trackers; floors (FLOOR_ROWS) and filters (FILTER_ROWS, 9: `DiscreteLeadFilter.coefficients`)
     NaN where not made yet; buffers, scores, results: the search's work arrays (`lookahead.py`); scratch:
-    SCRATCH_SIZE floats."""
+    SCRATCH_SIZE floats; history: the delay predictor's commands sent (`delay_predictor.history_length` slots; any
+    size without it)."""
     p = params
     speed = math.hypot(vx_mps, vy_mps)  # Measurement.speed_mps
     spacing, length = p[P_PATH_SPACING], p[P_PATH_LENGTH]
@@ -179,8 +184,25 @@ def clothoid_step(
     if p[P_COURSE] != 0.0 and vx_mps > p[P_MIN_SPEED]:
         heading += math.atan2(vy_mps, vx_mps)
     px, py, ph = x_m, y_m, heading
-    if p[P_HORIZON] > 0.0:
-        px, py, ph = along_arc(x_m, y_m, heading, kappa0, speed * p[P_HORIZON])
+    horizon = p[P_HORIZON]
+    model = state[S_MODEL : S_MODEL + dp.MODEL_SIZE]
+    predicting = p[P_DELAY_MODEL] != 0.0
+    if predicting:  # over the known delay with the identified lags and the commands sent (`delay_predictor.py`)
+        path_lag, measured_lag = scratch[LAG_ROWS : LAG_ROWS + 4], scratch[LAG_ROWS + 4 : LAG_ROWS + 8]
+        table_row(lag_speeds, lags, speed * 3.6, False, path_lag)
+        if measured_lags.shape[0] > 0:
+            table_row(lag_speeds, measured_lags, speed * 3.6, False, measured_lag)
+        else:
+            measured_lag[:] = path_lag
+        delay = p[P_KNOWN_DELAY]
+        dp.record_and_advance(model, history, t_s, p[P_DT], path_lag, measured_lag, delay, steering_kappa)
+        px, py, ph, kappa0 = dp.predicted_start(
+            model, history, x_m, y_m, heading, kappa0, speed, p[P_DT], path_lag, measured_lag, delay
+        )
+        kappa0 = min(max(kappa0, -kappa_max), kappa_max)
+        horizon -= delay
+    if horizon > 0.0:
+        px, py, ph = along_arc(px, py, ph, kappa0, speed * horizon)
     foot = scratch[4 : 4 + TRACK_OUT_SIZE]
     track(
         path_x, path_y, path_heading, path_curvature, spacing, length, closed, p[P_PATH_EXTENT],
@@ -237,7 +259,7 @@ def clothoid_step(
         )
         kdot, reference_kdot, feedforward_kdot = two_degree_of_freedom_rate(
             kdot, path_x, path_y, path_heading, path_curvature, spacing, length, closed, foot, tx, ty, speed,
-            p[P_HORIZON], ff_time, reference_lead, gain, p[P_FEEDFORWARD_WINDOW],
+            horizon, ff_time, reference_lead, gain, p[P_FEEDFORWARD_WINDOW], p[P_HORIZON] - horizon,
         )  # fmt: skip
 
     # Figure 2: kappa' x V integrated to curvature, under the rate and curvature limits (section 4).
@@ -250,6 +272,8 @@ def clothoid_step(
         command = lead_step(filters[kmh], state[S_FILTER_X : S_FILTER_X + 3], steer)
     limit = p[P_MAX_STEER]
     command = min(max(command, -limit), limit)
+    if predicting:
+        dp.send(model, history, math.tan(command / ratio) / wheelbase)
 
     d = diagnostics
     d[0], d[1], d[2], d[3], d[4], d[5] = lookahead, searched, floor, top, frechet, kdot

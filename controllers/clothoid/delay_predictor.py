@@ -1,0 +1,179 @@
+"""The pose and kappa(0) predicted over a known dead time with the vehicle's identified lags and the commands
+already sent: a Smith predictor (Smith 1957) in the form of a state prediction, as the MPCs compensate a known
+input delay (`controllers/mpc`).
+
+Why. With a dead time T in the loop (measurement latency plus actuation dead time, `ClothoidConfig.known_delay_s`)
+the steering the controller sends now acts T later, on a vehicle T further on. Predicting the pose over T on an
+arc of the curvature measured now (`delay_compensation="arc"`) leaves the delay in the loop: it costs omega_c T of
+phase at the crossover, and the lookahead floor that keeps the margins grows (the loaded truck at 20 km/h: 5.5 m
+without a delay, 10.5 m with 0.11 s), which leaves a hairpin's error uncorrected over twice the distance. But what
+the vehicle does over those T seconds is decided already: by the commands sent in the last T plus the lag's own
+delay. Driven through the identified lags of Eq. 5 (`VehicleTuning`), they tell how the curvature will change;
+the start pose and kappa(0) the controller fits from are then where the vehicle will be when the command now sent
+takes effect, and the loop the clothoid law closes is the delay-free one (`loop_analysis.py`).
+
+What. A model of each lag (to the path curvature, which turns the course, and to the measured yaw-rate curvature),
+run from the kinematic curvature of the steering sent, delayed by T plus the lag's own delay; over the next T the
+curvature changes by the model's change, added to what is measured now (the measurement anchors the prediction,
+so a model's steady-state error in K does not bias it):
+    kappa_path(t + tau) = kappa(0) + K_p (x_p(t + tau) - x_p(t)),   kappa(0)' = kappa(0) + K_m (x_m(t + T) - x_m(t))
+and the pose is moved along kappa_path in substeps of at most SUBSTEP_S, each on its mean curvature. The lags are
+discretised exactly (zero- order hold) at the substep, per step at the speed's interpolated lag.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from controllers.clothoid.pose_prediction import along_arc
+
+#: Longest substep (s) of the lag models and the pose's integration.
+SUBSTEP_S = 0.002
+#: The model's state: path lag [y, y'], measured lag [y, y'] (y in kinematic curvature, 1/m), then the time of the
+#: last step (s) and the ring buffer's next slot.
+M_PATH, M_MEASURED, M_TIME, M_HEAD = 0, 2, 4, 5
+MODEL_SIZE = 6
+
+
+@njit(cache=True)
+def substeps_per_period(period_s: float) -> int:
+    """How many substeps of at most SUBSTEP_S make one controller period."""
+    return max(1, math.ceil(period_s / SUBSTEP_S - 1e-9))
+
+
+def history_length(period_s: float, longest_delay_s: float) -> int:
+    """Slots of the ring buffer of commands sent: the commands of the last longest_delay_s (the known delay plus
+    the longest lag delay, s), two periods over."""
+    return math.ceil(longest_delay_s / period_s) + 3
+
+
+@njit(cache=True)
+def lag_transition(omega_n: float, zeta: float, h: float) -> tuple[float, float, float, float, float, float]:
+    """(a11, a12, a21, a22, b1, b2): Eq. 5's unit-gain lag y'' = -wn^2 y - 2 zeta wn y' + wn^2 u discretised exactly
+    over h with the input held: x+ = A x + b u. exp(M), M = A h, by its eigenvalues mu +- s (Cayley-Hamilton);
+    b = A^-1 (exp(A h) - I) [0, wn^2]."""
+    mu = -zeta * omega_n * h
+    q = (omega_n * h) ** 2 * (1.0 - zeta * zeta)  # det(M) - mu^2
+    if q > 1e-12:
+        s = math.sqrt(q)
+        c, f = math.cos(s), math.sin(s) / s
+    elif q < -1e-12:
+        s = math.sqrt(-q)
+        c, f = math.cosh(s), math.sinh(s) / s
+    else:
+        c, f = 1.0, 1.0
+    e = math.exp(mu)
+    m11, m12, m21, m22 = 0.0, h, -((omega_n * h) ** 2) / h, -2.0 * zeta * omega_n * h
+    a11, a12 = e * (c + f * (m11 - mu)), e * f * m12
+    a21, a22 = e * f * m21, e * (c + f * (m22 - mu))
+    b1 = -2.0 * zeta * omega_n * a12 - (a22 - 1.0)
+    b2 = omega_n * omega_n * a12
+    return a11, a12, a21, a22, b1, b2
+
+
+@njit(cache=True)
+def _advance(
+    y: float, dy: float, lag: tuple[float, float, float, float, float, float], u: float
+) -> tuple[float, float]:  # pragma: no cover - compiled
+    """One substep of a lag: (y, y') after it, the input u held (`lag_transition`'s matrices)."""
+    a11, a12, a21, a22, b1, b2 = lag
+    return a11 * y + a12 * dy + b1 * u, a21 * y + a22 * dy + b2 * u
+
+
+@njit(cache=True)
+def _input(history: np.ndarray, head: int, offset: int, delay_substeps: int, per_period: int) -> float:
+    """What a lag whose input is delay_substeps late gets in the substep `offset` substeps after now: the command
+    sent then (each held over its period; the last one sent, before now, held on beyond it; the oldest kept before
+    the buffer)."""
+    back = -1 - (offset - delay_substeps) // per_period  # periods before the last command sent
+    n = history.size
+    return history[(head - 1 - min(max(back, 0), n - 1)) % n]
+
+
+@njit(cache=True)
+def record_and_advance(
+    model: np.ndarray,
+    history: np.ndarray,
+    t_s: float,
+    period_s: float,
+    path_lag: np.ndarray,
+    measured_lag: np.ndarray,
+    known_delay_s: float,
+    initial_input: float,
+) -> None:  # pragma: no cover - compiled
+    """Bring the model to the step at t_s (before its command is sent). On the first call (model[M_TIME] NaN) it
+    starts at rest at initial_input (the kinematic curvature of the steering now), every slot of the history
+    holding it; later, the periods since the last step pass with the commands then sent (a step the controller did
+    not take held the last command). path_lag, measured_lag: (wn, zeta, delay s, K) at this speed."""
+    per = substeps_per_period(period_s)
+    h = period_s / per
+    if math.isnan(model[M_TIME]):
+        history[:] = initial_input
+        model[M_PATH], model[M_PATH + 1] = initial_input, 0.0
+        model[M_MEASURED], model[M_MEASURED + 1] = initial_input, 0.0
+        model[M_TIME], model[M_HEAD] = t_s, 0.0
+        return
+    n = history.size
+    periods = min(max(round((t_s - model[M_TIME]) / period_s), 0), n)
+    head = int(model[M_HEAD])
+    for _ in range(periods - 1):  # steps not taken: the last command held
+        history[head] = history[(head - 1) % n]
+        head = (head + 1) % n
+    model[M_HEAD] = head
+    path = lag_transition(path_lag[0], path_lag[1], h)
+    measured = lag_transition(measured_lag[0], measured_lag[1], h)
+    d_path = round((known_delay_s + path_lag[2]) / h)
+    d_measured = round((known_delay_s + measured_lag[2]) / h)
+    yp, dyp, ym, dym = model[M_PATH], model[M_PATH + 1], model[M_MEASURED], model[M_MEASURED + 1]
+    for offset in range(-periods * per, 0):
+        yp, dyp = _advance(yp, dyp, path, _input(history, head, offset, d_path, per))
+        ym, dym = _advance(ym, dym, measured, _input(history, head, offset, d_measured, per))
+    model[M_PATH], model[M_PATH + 1], model[M_MEASURED], model[M_MEASURED + 1] = yp, dyp, ym, dym
+    model[M_TIME] = t_s
+
+
+@njit(cache=True)
+def send(model: np.ndarray, history: np.ndarray, curvature_1pm: float) -> None:  # pragma: no cover - compiled
+    """Record the command sent this step (as kinematic curvature, 1/m; a non-finite one, which the controller
+    does not send, as the last held)."""
+    head = int(model[M_HEAD])
+    n = history.size
+    history[head] = curvature_1pm if math.isfinite(curvature_1pm) else history[(head - 1) % n]
+    model[M_HEAD] = (head + 1) % n
+
+
+@njit(cache=True)
+def predicted_start(
+    model: np.ndarray,
+    history: np.ndarray,
+    x_m: float,
+    y_m: float,
+    heading_rad: float,
+    kappa0: float,
+    speed_mps: float,
+    period_s: float,
+    path_lag: np.ndarray,
+    measured_lag: np.ndarray,
+    known_delay_s: float,
+) -> tuple[float, float, float, float]:  # pragma: no cover - compiled
+    """(x, y, heading, kappa(0)) known_delay_s ahead (module docstring); the model is left as it was."""
+    per = substeps_per_period(period_s)
+    h = period_s / per
+    path = lag_transition(path_lag[0], path_lag[1], h)
+    measured = lag_transition(measured_lag[0], measured_lag[1], h)
+    d_path = round((known_delay_s + path_lag[2]) / h)
+    d_measured = round((known_delay_s + measured_lag[2]) / h)
+    head = int(model[M_HEAD])
+    yp, dyp, ym, dym = model[M_PATH], model[M_PATH + 1], model[M_MEASURED], model[M_MEASURED + 1]
+    yp0, ym0 = yp, ym
+    x, y, heading = x_m, y_m, heading_rad
+    for offset in range(round(known_delay_s / h)):
+        before = yp
+        yp, dyp = _advance(yp, dyp, path, _input(history, head, offset, d_path, per))
+        ym, dym = _advance(ym, dym, measured, _input(history, head, offset, d_measured, per))
+        kappa = kappa0 + path_lag[3] * (0.5 * (before + yp) - yp0)  # the substep's mean (trapezoidal)
+        x, y, heading = along_arc(x, y, heading, kappa, speed_mps * h)
+    return x, y, heading, kappa0 + measured_lag[3] * (ym - ym0)
