@@ -117,13 +117,15 @@ class ClothoidConfig:
     falls with the lookahead (`lookahead.adaptive_search`);
     min_preview_time_s: raises the lower end of the range to this time x speed (s; 0: off); lookahead_hysteresis_m,
     max_lookahead_growth_m_per_m, max_lookahead_shrink_m_per_m: how the search's choice is followed
-    (`lookahead_filter.py`; None: at once); min_phase_margin_deg, min_gain_margin_db: the margins the lookahead
-    floor keeps (`loop_analysis.py`; 0 and 0: no floor; with a known delay compensated by the lags' model, the nominal,
-    delay-free loop's); min_delayed_phase_margin_deg, min_delayed_gain_margin_db: with that compensation, the margins
-    the loop with its delay and the predictor keeps besides, at the steering sent; max_target_turn_deg: the lookahead's
-    geometric ceiling, no target farther round a bend than the path turning this much from the foot point (deg; 0: none;
-    never below the floor): an offset of the vehicle shows at a target theta round the bend as offset x cos(theta), and
-    Eq. 3's gain on it falls alike (0.46 of a straight's at 60 deg, none at 90 deg), which the margins do not see;
+    (`lookahead_filter.py`; None: at once); min_phase_margin_deg, min_gain_margin_db: the margins the lookahead floor
+    keeps (`loop_analysis.py`; 0 and 0: no floor; with a known delay compensated by the lags' model, the nominal,
+    delay-free loop's); min_delayed_phase_margin_deg, min_delayed_gain_margin_db, known_delay_uncertainty_s: with that
+    compensation, the margins the loop with its delay and the predictor keeps besides, at the steering sent, the
+    vehicle's dead time within +- known_delay_uncertainty_s (s) of the known one (`loop_analysis.DelayRobustness`);
+    max_target_turn_deg: the lookahead's geometric ceiling, no target farther round a bend than the path turning this
+    much from the foot point (deg; 0: none; never below the floor): an offset of the vehicle shows at a target theta
+    round the bend as offset x cos(theta), and Eq. 3's gain on it falls alike (0.46 of a straight's at 60 deg, none at
+    90 deg), which the margins do not see;
     frechet_threshold_m: the adaptive threshold (m; the paper: 0.5 m) and threshold_mode how it applies ("excess" of
     |CTE| or "absolute"; module docstring); frechet_point_spacing_m: sampling of the curves compared (m); tolerance_x_m,
     tolerance_y_m: delta_x, delta_y of Eq. 3 (m); max_curvature_rate_1pm2: saturation of the clothoid's kappa' (1/m^2);
@@ -162,6 +164,7 @@ class ClothoidConfig:
     min_gain_margin_db: float = 6.0
     min_delayed_phase_margin_deg: float = 30.0
     min_delayed_gain_margin_db: float = 3.0
+    known_delay_uncertainty_s: float = 0.05
     max_target_turn_deg: float = 60.0
     fixed_lookahead_m: float = 10.0
     lookahead_gain_s: float = 1.0
@@ -208,6 +211,7 @@ class ClothoidConfig:
         check_number("min_gain_margin_db", self.min_gain_margin_db, 0.0, 40.0, "dB")
         check_number("min_delayed_phase_margin_deg", self.min_delayed_phase_margin_deg, 0.0, 89.0, "deg")
         check_number("min_delayed_gain_margin_db", self.min_delayed_gain_margin_db, 0.0, 40.0, "dB")
+        check_number("known_delay_uncertainty_s", self.known_delay_uncertainty_s, 0.0, 1.0, "s")
         check_number("max_target_turn_deg", self.max_target_turn_deg, 0.0, 180.0, "deg", note="0: no ceiling")
         check_number("min_lookahead_m", self.min_lookahead_m, 0.5, MAX_LOOKAHEAD_M, "m")
         check_number("max_lookahead_m", self.max_lookahead_m, 0.5, MAX_LOOKAHEAD_M, "m")
@@ -421,7 +425,8 @@ class ClothoidController(Controller):
             if lags is None or (cfg.min_phase_margin_deg <= 0.0 and cfg.min_gain_margin_db <= 0.0):
                 floor = cfg.min_lookahead_m
             else:
-                from controllers.clothoid.loop_analysis import lookahead_floor  # python-control: imported when used
+                # python-control: imported when used
+                from controllers.clothoid.loop_analysis import DelayRobustness, lookahead_floor
 
                 v = speed_kmh / 3.6
                 kappa_max, _ = self.limits.at_speed(v)
@@ -429,8 +434,11 @@ class ClothoidController(Controller):
                 floor = lookahead_floor(
                     lags, self.loop_settings(speed_kmh), v, cfg.min_lookahead_m,
                     max(cfg.max_lookahead_m, MAX_FLOOR_LOOKAHEAD_M), cfg.lookahead_step_m, (0.0, arc),
-                    cfg.min_phase_margin_deg, cfg.min_gain_margin_db, cfg.min_delayed_phase_margin_deg,
-                    cfg.min_delayed_gain_margin_db,
+                    cfg.min_phase_margin_deg, cfg.min_gain_margin_db,
+                    DelayRobustness(
+                        cfg.min_delayed_phase_margin_deg, cfg.min_delayed_gain_margin_db,
+                        cfg.known_delay_uncertainty_s,
+                    ),
                 )  # fmt: skip
             self._floors[band] = floor
         return floor

@@ -55,6 +55,12 @@ REQUIRED_GAIN_MARGIN_DB = 6.0
 #: "Multivariable Feedback Control", 2005, sec. 2.4.3).
 REQUIRED_DELAYED_PHASE_MARGIN_DEG = 30.0
 REQUIRED_DELAYED_GAIN_MARGIN_DB = 3.0
+#: How far (s) the plant's dead time may differ from the known one, either way, with the loop kept stable and half
+#: those margins: a Smith predictor is as sensitive to a delay told too long as too short (the measured response
+#: and the model's change then count the same steering twice, or neither), and a few tens of milliseconds of it
+#: unsettle a fast loop (the dynamic bicycle at 30 km/h and 5.5 m: unstable 40 ms either way).
+DELAY_UNCERTAINTY_S = 0.05
+UNCERTAIN_DELAY_MARGIN_FRACTION = 0.5
 #: kappa(0) choices the analysis models (the controller's "steering" is not).
 INITIAL_CURVATURES = ("yaw-rate", "command")
 #: How the pose is predicted over the known delay (`ClothoidConfig.delay_compensation`).
@@ -93,7 +99,7 @@ class LoopSettings:
     def __post_init__(self) -> None:
         require_in_range("sample_time_s", self.sample_time_s, 1e-4, 1.0, "s")
         require_in_range("prediction_time_s", self.prediction_time_s, 0.0, 2.0, "s")
-        require_in_range("measurement_delay_s", self.measurement_delay_s, 0.0, 2.0, "s")
+        require_in_range("measurement_delay_s", self.measurement_delay_s, -self.known_delay_s, 2.0, "s")
         require_in_range("known_delay_s", self.known_delay_s, 0.0, 2.0, "s")
         if self.delay_compensation not in DELAY_COMPENSATIONS:
             raise WorkbenchInputError(
@@ -120,6 +126,28 @@ class LoopSettings:
         """The loop the delay compensation leaves when its model is the plant: with "model", the delay-free loop
         (Smith's predictor takes the delay out of the characteristic equation); with "arc", this loop itself."""
         return dataclasses.replace(self, known_delay_s=0.0) if self.predicts_with_model else self
+
+
+@dataclass(frozen=True)
+class DelayRobustness:
+    """What a floor asks of the loop with a known delay compensated by the lags' model, broken at the steering sent
+    (the nominal loop keeps the floor's own margins): phase_margin_deg and gain_margin_db (both ways) with the
+    plant's dead time the known one, and UNCERTAIN_DELAY_MARGIN_FRACTION of them with it anywhere within +-
+    delay_uncertainty_s of it (s; checked at +-1 and +-1/2 times it, never below no delay at all)."""
+
+    phase_margin_deg: float = REQUIRED_DELAYED_PHASE_MARGIN_DEG
+    gain_margin_db: float = REQUIRED_DELAYED_GAIN_MARGIN_DB
+    delay_uncertainty_s: float = DELAY_UNCERTAINTY_S
+
+    def __post_init__(self) -> None:
+        require_in_range("phase_margin_deg", self.phase_margin_deg, 0.0, 89.0, "deg")
+        require_in_range("gain_margin_db", self.gain_margin_db, 0.0, 40.0, "dB")
+        require_in_range("delay_uncertainty_s", self.delay_uncertainty_s, 0.0, 1.0, "s")
+
+    def delay_errors_s(self, known_delay_s: float) -> tuple[float, ...]:
+        """The plant's dead time less the known one (s) at which the reduced margins are checked."""
+        d = self.delay_uncertainty_s
+        return tuple(sorted({max(e, -known_delay_s) for e in (-d, -0.5 * d, 0.5 * d, d)} - {0.0}))
 
 
 @dataclass(frozen=True)
@@ -243,12 +271,22 @@ def _plant_parts(
     """The plant without its delays (`_plant_continuous`) at the controller period, zero-order hold; and each
     input's delay in whole periods."""
     dt = settings.sample_time_s
-    a_c, b_c, c_c = _plant_continuous(lags, speed_mps, path_curvature_1pm)
-    a, b, c, d, _ = signal.cont2discrete((a_c, b_c, c_c, np.zeros((3, 2))), dt, method="zoh")
     path, measured = lags.path, lags.measured or lags.path
     extra = settings.measurement_delay_s + settings.known_delay_s
     taps = (_delay_steps(path.delay_s + extra, dt), _delay_steps(measured.delay_s + extra, dt))
-    return control.ss(a, b, c, d, dt), taps
+    return _discrete_plant(lags, float(speed_mps), float(path_curvature_1pm), dt)[0], taps
+
+
+@lru_cache(maxsize=1024)
+def _discrete_plant(
+    lags: PlantLags, speed_mps: float, path_curvature_1pm: float, sample_time_s: float
+) -> tuple[control.StateSpace, np.ndarray]:
+    """The plant without its delays at the controller period, and its frequency response on the margins' grid (n, 3,
+    2): cached, as the floor search asks for the same plant against several delays and lookaheads."""
+    a_c, b_c, c_c = _plant_continuous(lags, speed_mps, path_curvature_1pm)
+    a, b, c, d, _ = signal.cont2discrete((a_c, b_c, c_c, np.zeros((3, 2))), sample_time_s, method="zoh")
+    system = control.ss(a, b, c, d, sample_time_s)
+    return system, _batched_response(system, _frequency_grid(sample_time_s)[1])
 
 
 def plant(lags: PlantLags, speed_mps: float, path_curvature_1pm: float, settings: LoopSettings) -> control.StateSpace:
@@ -381,8 +419,7 @@ def _response(loop: control.StateSpace, omega: np.ndarray) -> np.ndarray:
 def margins(loop: control.StateSpace) -> Margins:
     """Margins of a discrete SISO loop (see Margins), from its frequency response on a log grid up to the Nyquist
     frequency, crossings refined by interpolation; stability from the closed-loop poles."""
-    nyquist = math.pi / loop.dt
-    omega = np.logspace(math.log10(nyquist) - 5.0, math.log10(nyquist * (1 - 1e-6)), _GRID_POINTS)
+    omega, _ = _frequency_grid(float(loop.dt))
     return _margins_from(omega, _response(loop, omega), control.feedback(loop, 1).poles())
 
 
@@ -479,22 +516,62 @@ def _batched_response(system: control.StateSpace, z: np.ndarray) -> np.ndarray:
     return c @ np.linalg.solve(lhs, np.broadcast_to(b, (z.size, *b.shape)).astype(complex)) + d
 
 
+@lru_cache(maxsize=8)
+def _frequency_grid(sample_time_s: float) -> tuple[np.ndarray, np.ndarray]:
+    """(omega, z = e^{j omega dt}): the margins' log grid up to the Nyquist frequency."""
+    nyquist = math.pi / sample_time_s
+    omega = np.logspace(math.log10(nyquist) - 5.0, math.log10(nyquist * (1 - 1e-6)), _GRID_POINTS)
+    return omega, np.exp(1j * omega * sample_time_s)
+
+
+@lru_cache(maxsize=1024)
+def _controller_with_response(
+    lags: PlantLags, settings: LoopSettings, speed_mps: float, lookahead_m: float, path_curvature_1pm: float
+) -> tuple[control.StateSpace, np.ndarray]:
+    """The controller (`controller`) and its frequency response on the grid, (n, 3): cached, since the floor search
+    asks for the same controller against several plant delays (`DelayRobustness`), and with the model's delay
+    compensation it has some 30 states. The controller does not depend on settings.measurement_delay_s."""
+    ctrl = controller(settings, lags, speed_mps, lookahead_m, path_curvature_1pm)
+    z = _frequency_grid(settings.sample_time_s)[1]
+    if not settings.predicts_with_model:
+        return ctrl, _batched_response(ctrl, z)[:, 0, :]
+    return ctrl, _response_with_line(ctrl, _MODEL_CORE_STATES, z)
+
+
+#: The controller's states before its line of commands sent, with the model's delay compensation (`_controller_step`).
+_MODEL_CORE_STATES = 8
+
+
+def _response_with_line(system: control.StateSpace, core: int, z: np.ndarray) -> np.ndarray:
+    """The frequency response (n, inputs) of a single-output system whose states from `core` on are a line of its
+    own past outputs, newest first (line_j = z^-(j+1) y): by block elimination, u = (C_c R B_c + D) / (1 - C_c R A_cl
+    w - C_l w), R = (zI - A_cc)^-1 and w_j = z^-(j+1), one core-sized solve per frequency instead of one of the
+    whole state (the same numbers as `_batched_response`, to rounding)."""
+    a, b, c, d = (np.asarray(m, dtype=float) for m in (system.A, system.B, system.C, system.D))
+    w = np.cumprod(np.repeat((1.0 / z)[:, None], a.shape[0] - core, axis=1), axis=1)  # (n, line): z^-(j+1)
+    lhs = z[:, None, None] * np.eye(core) - a[:core, :core]
+    inputs = np.broadcast_to(b[:core], (z.size, core, b.shape[1]))
+    rhs = np.concatenate([(w @ a[:core, core:].T)[:, :, None], inputs], 2)
+    x = np.linalg.solve(lhs, rhs.astype(complex))  # (n, core, 1 + inputs)
+    loop = x[:, :, 0] @ c[0, :core] + w @ c[0, core:]
+    return (np.einsum("k,nki->ni", c[0, :core], x[:, :, 1:]) + d[0]) / (1.0 - loop)[:, None]
+
+
 @lru_cache(maxsize=8192)
 def loop_margins(
     lags: PlantLags, settings: LoopSettings, speed_mps: float, lookahead_m: float, path_curvature_1pm: float = 0.0
 ) -> Margins:
     """margins(loop_transfer(...)), cached (all arguments are frozen values), with the frequency response composed
-    from the delay-free plant (6 states), its delays as z^-n and the controller (4 states): the same numbers, a
-    fraction of the work, for the controller's floor search."""
-    parts, taps = _plant_parts(lags, speed_mps, path_curvature_1pm, settings)
-    ctrl = controller(settings, lags, speed_mps, lookahead_m, path_curvature_1pm)
-    nyquist = math.pi / settings.sample_time_s
-    omega = np.logspace(math.log10(nyquist) - 5.0, math.log10(nyquist * (1 - 1e-6)), _GRID_POINTS)
-    z = np.exp(1j * omega * settings.sample_time_s)
-    p = _batched_response(parts, z)  # (n, 3, 2)
+    from the delay-free plant (6 states), its delays as z^-n and the controller: the same numbers, a fraction of
+    the work, for the controller's floor search."""
+    _, taps = _plant_parts(lags, speed_mps, path_curvature_1pm, settings)
+    _, p = _discrete_plant(lags, float(speed_mps), float(path_curvature_1pm), settings.sample_time_s)  # (n, 3, 2)
+    ctrl, c = _controller_with_response(
+        lags, dataclasses.replace(settings, measurement_delay_s=0.0), speed_mps, lookahead_m, path_curvature_1pm
+    )
+    omega, z = _frequency_grid(settings.sample_time_s)
     delays = np.stack([z ** (-tap) for tap in taps], axis=1)  # (n, 2)
     plant_response = np.einsum("nij,nj->ni", p, delays)  # (n, 3)
-    c = _batched_response(ctrl, z)[:, 0, :]  # (n, 3)
     response = -np.einsum("ni,ni->n", c, plant_response)
     poles = control.feedback(-control.series(plant(lags, speed_mps, path_curvature_1pm, settings), ctrl), 1).poles()
     return _margins_from(omega, response, poles)
@@ -510,34 +587,37 @@ def lookahead_floor(
     path_curvatures_1pm: tuple[float, ...] = (0.0,),
     phase_margin_deg: float = REQUIRED_PHASE_MARGIN_DEG,
     gain_margin_db: float = REQUIRED_GAIN_MARGIN_DB,
-    delayed_phase_margin_deg: float = REQUIRED_DELAYED_PHASE_MARGIN_DEG,
-    delayed_gain_margin_db: float = REQUIRED_DELAYED_GAIN_MARGIN_DB,
+    delayed: DelayRobustness = DelayRobustness(),
 ) -> float:
     """The shortest lookahead (m, on a grid of step_m from min_lookahead_m) from which every lookahead up to
     max_lookahead_m keeps the required margins about each of the path curvatures; max_lookahead_m when none does.
     The margins are those of the nominal loop (`LoopSettings.nominal`: with the model's delay compensation the
     delay-free one, which it leaves when its model is the vehicle); with that compensation the loop itself keeps
-    delayed_phase_margin_deg and delayed_gain_margin_db at the steering sent. A bisection
-    on the grid (margins mostly improve with the lookahead: the loop's gain falls as L^-3), then a check every
-    _FLOOR_CHECK_M above the result; a failure there restarts the bisection above it."""
+    `delayed`'s margins at the steering sent (`DelayRobustness`). A bisection on the grid
+    (margins mostly improve with the lookahead: the loop's gain falls as L^-3), then a check every _FLOOR_CHECK_M
+    above the result; a failure there restarts the bisection above it."""
     grid = np.arange(min_lookahead_m, max_lookahead_m + 1e-9, step_m)
     if grid.size == 0 or grid[-1] < max_lookahead_m - 1e-9:
         grid = np.append(grid, max_lookahead_m)
 
+    # (loop, phase margin, gain margin) to keep: the nominal loop, then with the model the loop itself, with its
+    # delay as known and as it may be
     nominal = settings.nominal
+    checks = [(nominal, phase_margin_deg, gain_margin_db)]
+    if nominal is not settings:
+        checks.append((settings, delayed.phase_margin_deg, delayed.gain_margin_db))
+        fraction = UNCERTAIN_DELAY_MARGIN_FRACTION
+        for error in delayed.delay_errors_s(settings.known_delay_s + settings.measurement_delay_s):
+            late = dataclasses.replace(settings, measurement_delay_s=settings.measurement_delay_s + error)
+            checks.append((late, fraction * delayed.phase_margin_deg, fraction * delayed.gain_margin_db))
 
     def ok(i: int) -> bool:
         v, lookahead = float(speed_mps), float(grid[i])
         return all(
-            loop_margins(lags, nominal, v, lookahead, kr).meets(phase_margin_deg, gain_margin_db)
-            and (
-                nominal is settings
-                or loop_margins(lags, settings, v, lookahead, kr).meets(
-                    delayed_phase_margin_deg, delayed_gain_margin_db
-                )
-            )
+            loop_margins(lags, loop, v, lookahead, kr).meets(pm, gm)
             for kr in path_curvatures_1pm
             if abs(kr) * grid[i] < 1.8
+            for loop, pm, gm in checks
         )
 
     if not ok(grid.size - 1):
