@@ -18,7 +18,7 @@ curvature changes by the model's change, added to what is measured now (the meas
 so a model's steady-state error in K does not bias it):
     kappa_path(t + tau) = kappa(0) + K_p (x_p(t + tau) - x_p(t)),   kappa(0)' = kappa(0) + K_m (x_m(t + T) - x_m(t))
 and the pose is moved along kappa_path in substeps of at most SUBSTEP_S, each on its mean curvature. The lags are
-discretised exactly (zero- order hold) at the substep, per step at the speed's interpolated lag.
+discretised exactly (zero-order hold) at the substep, per step at the speed's interpolated lag.
 """
 
 from __future__ import annotations
@@ -46,7 +46,7 @@ def substeps_per_period(period_s: float) -> int:
 
 def history_length(period_s: float, longest_delay_s: float) -> int:
     """Slots of the ring buffer of commands sent: the commands of the last longest_delay_s (the known delay plus
-    the longest lag delay, s), two periods over."""
+    the longest lag delay, s), and three slots more (the step now, the rounding of the delays to substeps)."""
     return math.ceil(longest_delay_s / period_s) + 3
 
 
