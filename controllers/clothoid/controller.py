@@ -129,7 +129,10 @@ class ClothoidConfig:
     frechet_threshold_m: the adaptive threshold (m; the paper: 0.5 m) and threshold_mode how it applies ("excess" of
     |CTE| or "absolute"; module docstring); frechet_point_spacing_m: sampling of the curves compared (m); tolerance_x_m,
     tolerance_y_m: delta_x, delta_y of Eq. 3 (m); max_curvature_rate_1pm2: saturation of the clothoid's kappa' (1/m^2);
-    initial_curvature: kappa(0) of Eq. 3, "yaw-rate", "command" or "steering"; heading: "course" or "yaw";
+    initial_curvature: kappa(0) of Eq. 3, "yaw-rate", "command" or "steering" (the lookahead floor is the measured
+    kappa(0)'s, "yaw-rate", whichever is chosen: `loop_analysis` models "command" too, whose loop has 25-36 deg of
+    phase margin on the truck and the car at 30 km/h, below 45 deg at any lookahead, and not "steering"); heading:
+    "course" or "yaw";
     prediction_time_s: pose prediction (s; 0: off); known_delay_s: the loop's dead time the controller knows,
     measurement latency (the pose measured is that long old) plus actuation dead time (a command reaches the
     steering that much later) (s; 0: none): the pose is predicted over it as well, the reference pose and the
