@@ -26,8 +26,9 @@ Added to the paper so that the loop keeps its margins on the vehicle it steers (
 
 A known dead time (issue 18, known_delay_s: measurement latency plus actuation dead time) is compensated by default
 with the identified lags driven by the commands already sent (`delay_predictor.py`, a Smith predictor): the start
-pose and kappa(0) are where the vehicle will be when the command now sent takes effect, the loop the clothoid law
-closes is the delay-free one, and so is the floor (the loop with its delay keeps 30 deg and 3 dB besides).
+pose and kappa(0) are where the vehicle will be when the command now sent takes effect, and the loop the clothoid law
+closes is the delay-free one. The floor keeps the margins on that loop, 30 deg and 3 dB on the loop with its delay,
+and half those with the delay 50 ms off either way (`loop_analysis.DelayRobustness`).
 """
 
 from __future__ import annotations
@@ -130,18 +131,17 @@ class ClothoidConfig:
     |CTE| or "absolute"; module docstring); frechet_point_spacing_m: sampling of the curves compared (m); tolerance_x_m,
     tolerance_y_m: delta_x, delta_y of Eq. 3 (m); max_curvature_rate_1pm2: saturation of the clothoid's kappa' (1/m^2);
     initial_curvature: kappa(0) of Eq. 3, "yaw-rate", "command" or "steering" (the lookahead floor is the measured
-    kappa(0)'s, "yaw-rate", whichever is chosen: `loop_analysis` models "command" too, whose loop has 25-36 deg of
-    phase margin on the truck and the car at 30 km/h, below 45 deg at any lookahead, and not "steering"); heading:
-    "course" or "yaw";
-    prediction_time_s: pose prediction (s; 0: off); known_delay_s: the loop's dead time the controller knows,
-    measurement latency (the pose measured is that long old) plus actuation dead time (a command reaches the
-    steering that much later) (s; 0: none): the pose is predicted over it as well, the reference pose and the
-    feed-forward point move ahead with it, and the lookahead floor's loop analysis has it
-    (`loop_analysis.LoopSettings`); delay_compensation: how the pose is predicted over the known delay, "model" (the
-    identified lags driven by the commands already sent, a Smith predictor, `delay_predictor.py`: the loop's nominal
-    dynamics are the delay-free ones, and so is the lookahead floor; needs the tuning and initial_curvature
-    "yaw-rate") or "arc" (on kappa(0) over prediction_time_s + known_delay_s; the delay stays in the loop, and the
-    floor is the delayed loop's);
+    kappa(0)'s, "yaw-rate", whichever is chosen: `loop_analysis` models "command" too, whose loop has 25-36 deg of phase
+    margin on the truck and the car at 30 km/h, below 45 deg at any lookahead, and not "steering"); heading: "course" or
+    "yaw"; prediction_time_s: pose prediction (s; 0: off); known_delay_s: the loop's dead time the controller knows,
+    measurement latency (the pose measured is that long old) plus actuation dead time (a command reaches the steering
+    that much later) (s; 0: none): the pose is predicted over it as well, the reference pose and the feed-forward point
+    move ahead with it, and the lookahead floor's loop analysis has it (`loop_analysis.LoopSettings`);
+    delay_compensation: how the pose is predicted over the known delay, "model" (the identified lags driven by the
+    commands already sent, a Smith predictor, `delay_predictor.py`: the loop's nominal dynamics are the delay-free ones,
+    and the lookahead floor keeps the margins on them and the min_delayed_* ones; needs the tuning and initial_curvature
+    "yaw-rate") or "arc" (on kappa(0) over prediction_time_s + known_delay_s; the delay stays in the loop, and the floor
+    is the delayed loop's);
     path_feedforward: the two-degree-of-freedom form (`path_feedforward.py`; False: Eq. 3 alone);
     feedforward_window_m: the window the path's curvature rate is averaged over (m); feedforward_time_s,
     reference_lead_s: its timings (s; None: from the vehicle's identified lags); tuning: the steered vehicle's own
@@ -342,7 +342,7 @@ class ClothoidController(Controller):
             self._lag_speeds, self._schedule, self._schedule_speeds, self._floor_table, self._filter_table,
             self._buffers, self._scores, self._results, self._scratch, self._diag, self._history,
         )  # fmt: skip
-        if path.speed_mps is not None:  # the floors of the planned speeds now, not inside a step (~0.1 s per band)
+        if path.speed_mps is not None:  # the planned speeds' floors now, not in a step (~0.04 s a band, model 0.5 s)
             for speed_mps in np.unique(np.round(path.speed_mps * 3.6 / FLOOR_SPEED_BAND_KMH)) * FLOOR_SPEED_BAND_KMH:
                 self.lookahead_floor_m(float(speed_mps) / 3.6)
 

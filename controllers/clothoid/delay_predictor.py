@@ -84,6 +84,25 @@ def _advance(
 
 
 @njit(cache=True)
+def _substep_lags(
+    period_s: float, path_lag: np.ndarray, measured_lag: np.ndarray, known_delay_s: float
+) -> tuple[
+    int, tuple[float, float, float, float, float, float], tuple[float, float, float, float, float, float], int, int
+]:  # pragma: no cover - compiled
+    """(substeps a period, path lag's and measured lag's `lag_transition` over a substep, each lag's input delay in
+    substeps: the known delay plus its own); the lags as (wn, zeta, delay s, K)."""
+    per = substeps_per_period(period_s)
+    h = period_s / per
+    return (
+        per,
+        lag_transition(path_lag[0], path_lag[1], h),
+        lag_transition(measured_lag[0], measured_lag[1], h),
+        round((known_delay_s + path_lag[2]) / h),
+        round((known_delay_s + measured_lag[2]) / h),
+    )
+
+
+@njit(cache=True)
 def _input(history: np.ndarray, head: int, offset: int, delay_substeps: int, per_period: int) -> float:
     """What a lag whose input is delay_substeps late gets in the substep `offset` substeps after now: the command
     sent then (each held over its period; the last one sent, before now, held on beyond it; the oldest kept before
@@ -108,8 +127,6 @@ def record_and_advance(
     starts at rest at initial_input (the kinematic curvature of the steering now), every slot of the history
     holding it; later, the periods since the last step pass with the commands then sent (a step the controller did
     not take held the last command). path_lag, measured_lag: (wn, zeta, delay s, K) at this speed."""
-    per = substeps_per_period(period_s)
-    h = period_s / per
     if math.isnan(model[M_TIME]):
         history[:] = initial_input
         model[M_PATH], model[M_PATH + 1] = initial_input, 0.0
@@ -123,10 +140,7 @@ def record_and_advance(
         history[head] = history[(head - 1) % n]
         head = (head + 1) % n
     model[M_HEAD] = head
-    path = lag_transition(path_lag[0], path_lag[1], h)
-    measured = lag_transition(measured_lag[0], measured_lag[1], h)
-    d_path = round((known_delay_s + path_lag[2]) / h)
-    d_measured = round((known_delay_s + measured_lag[2]) / h)
+    per, path, measured, d_path, d_measured = _substep_lags(period_s, path_lag, measured_lag, known_delay_s)
     yp, dyp, ym, dym = model[M_PATH], model[M_PATH + 1], model[M_MEASURED], model[M_MEASURED + 1]
     for offset in range(-periods * per, 0):
         yp, dyp = _advance(yp, dyp, path, _input(history, head, offset, d_path, per))
@@ -160,12 +174,8 @@ def predicted_start(
     known_delay_s: float,
 ) -> tuple[float, float, float, float]:  # pragma: no cover - compiled
     """(x, y, heading, kappa(0)) known_delay_s ahead (module docstring); the model is left as it was."""
-    per = substeps_per_period(period_s)
+    per, path, measured, d_path, d_measured = _substep_lags(period_s, path_lag, measured_lag, known_delay_s)
     h = period_s / per
-    path = lag_transition(path_lag[0], path_lag[1], h)
-    measured = lag_transition(measured_lag[0], measured_lag[1], h)
-    d_path = round((known_delay_s + path_lag[2]) / h)
-    d_measured = round((known_delay_s + measured_lag[2]) / h)
     head = int(model[M_HEAD])
     yp, dyp, ym, dym = model[M_PATH], model[M_PATH + 1], model[M_MEASURED], model[M_MEASURED + 1]
     yp0, ym0 = yp, ym

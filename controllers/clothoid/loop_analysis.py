@@ -311,6 +311,11 @@ def plant(lags: PlantLags, speed_mps: float, path_curvature_1pm: float, settings
     return control.ss(a_full, b_full, np.hstack([c, np.zeros((3, n))]), np.zeros((3, 1)), parts.dt)
 
 
+#: With the model's delay compensation, the controller's states before its line of commands sent: kappa_cmd, the
+#: lead filter (3), the lags' model (4) (`_controller_step`; `_response_with_line` eliminates the line).
+_MODEL_CORE_STATES = 8
+
+
 def _controller_step(
     settings: LoopSettings,
     lags: PlantLags,
@@ -338,18 +343,20 @@ def _controller_step(
         offset = np.zeros((6, 1))
         offset[2, 0] = v
         a_m, b_m, *_ = signal.cont2discrete((a_c, np.hstack([b_c, offset]), np.eye(6), np.zeros((6, 3))), dt)
-        k_path, k_measured = lags.path.steady_state_gain, (lags.measured or lags.path).steady_state_gain
+        measured_lag = lags.measured or lags.path
+        k_path, k_measured = lags.path.steady_state_gain, measured_lag.steady_state_gain
         taps = (_delay_steps(lags.path.delay_s + settings.known_delay_s, dt),
-                _delay_steps((lags.measured or lags.path).delay_s + settings.known_delay_s, dt))  # fmt: skip
+                _delay_steps(measured_lag.delay_s + settings.known_delay_s, dt))  # fmt: skip
         ahead, sent = _delay_steps(settings.known_delay_s, dt), max(*taps, 1)
         lag_states = [0, 1, 4, 5]
-    size = 4 + (4 + sent if model else 0)
+    core = _MODEL_CORE_STATES
+    size = core + sent if model else 4
 
     def step(s: np.ndarray, meas: np.ndarray) -> tuple[np.ndarray, float]:
         y, psi, kappa_meas = meas
         kappa0 = kappa_meas if measured else s[0]
         if model:  # the pose moved on the measured curvature plus the model's change, kappa(0) likewise
-            line = s[8:]
+            line = s[core:]
             z = np.array([s[4], s[5], psi, y, s[6], s[7]])
             held = kappa_meas - k_path * s[4]
             for j in range(ahead):  # the commands reaching each lag j periods from now (the last held beyond)
@@ -366,11 +373,11 @@ def _controller_step(
             nxt[1:4] = a_f @ f + b_f * kappa_cmd
             u = float(c_f @ f + d_f * kappa_cmd)
         if model:  # the model advances a period on what reached it; the command sent joins the line
-            reached = [s[8 + tap - 1] if tap else u for tap in taps]
+            reached = [s[core + tap - 1] if tap else u for tap in taps]
             z = np.array([s[4], s[5], 0.0, 0.0, s[6], s[7]])
-            nxt[4:8] = (a_m @ z + b_m @ np.array([*reached, 0.0]))[lag_states]
-            nxt[8] = u
-            nxt[9:] = s[8:-1]
+            nxt[4:core] = (a_m @ z + b_m @ np.array([*reached, 0.0]))[lag_states]
+            nxt[core] = u
+            nxt[core + 1 :] = s[core:-1]
         return nxt, u
 
     return size, step
@@ -536,10 +543,6 @@ def _controller_with_response(
     if not settings.predicts_with_model:
         return ctrl, _batched_response(ctrl, z)[:, 0, :]
     return ctrl, _response_with_line(ctrl, _MODEL_CORE_STATES, z)
-
-
-#: The controller's states before its line of commands sent, with the model's delay compensation (`_controller_step`).
-_MODEL_CORE_STATES = 8
 
 
 def _response_with_line(system: control.StateSpace, core: int, z: np.ndarray) -> np.ndarray:
