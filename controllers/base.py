@@ -11,11 +11,13 @@ and no I/O.
 The contract (issue 16), kept here once for every controller: a real steering ECU holds its last command on a
 bad sensor frame, and so does every controller. `Controller.step` is a template method:
 
-  1. it screens the measurement against a plausible envelope (the constants below: every field finite, the
-     steering sensor within STEER_SENSOR_MARGIN x the mechanical lock, speed, yaw rate, position and time
-     within their bounds, time not earlier than the last accepted frame's). An implausible measurement never
-     reaches the controller: the step returns the last command it returned since `reset` (0.0 before any) and
-     the diagnostics say `measurement_rejected` = 1. Any finite yaw is plausible; one beyond
+  1. it screens the measurement against a plausible envelope (the constants below: every field a real number,
+     i.e. a float, an int or a NumPy real scalar of any dtype, never a bool, complex number, string, None or
+     array; every field finite, the steering sensor within STEER_SENSOR_MARGIN x the mechanical lock, speed, yaw
+     rate, position and time within their bounds, time not earlier than the last accepted frame's). The controller
+     sees every field as a float. An implausible measurement never reaches the controller: the step returns the
+     last command it returned since `reset` (0.0 before any), the diagnostics say `measurement_rejected` = 1 and
+     `rejection` names the field and its value; no exception is raised. Any finite yaw is plausible; one beyond
      MAX_UNWRAPPED_YAW_RAD is wrapped to [-pi, pi) before the controller sees it.
   2. Otherwise it calls the controller's `_command`. If that returns a non-finite number, or the controller's own
      diagnostics are not all finite, the held command is returned and `command_rejected` = 1.
@@ -42,7 +44,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from workbench.base.errors import require_positive
+from workbench.base.errors import is_number, require_positive, value_text
 from workbench.base.path import ReferencePath, wrap_angle
 from workbench.simulation.control_interface import COMMAND_REJECTED, MEASUREMENT_REJECTED, Measurement
 from workbench.vehicles.geometry import VehicleGeometry
@@ -72,6 +74,10 @@ MAX_UNWRAPPED_YAW_RAD = 1e4
 #: without the restart one frame stamped far ahead would lock the controller out until the next `reset`.
 CLOCK_RESET_FRAMES = 5
 _FIELDS = ("t_s", "x_m", "y_m", "vx_mps", "vy_mps", "yaw_rad", "yaw_rate_rad_s", "steer_wheel_rad")
+#: What a measurement's field may be, for the rejection of one that is not.
+_REAL_NUMBERS = "a field must be a float, an int or a NumPy real scalar (not a bool, complex, string, None or array)"
+#: The most characters of a refused value a rejection shows (an array's repr can be long).
+_SHOWN_CHARS = 60
 
 
 class Controller(ABC):
@@ -198,20 +204,36 @@ class Controller(ABC):
         self._report[: self._own.size] = self._own
 
     def _screen(self, m: Measurement) -> Measurement | None:
-        """The measurement the controller may see (with its yaw wrapped when beyond MAX_UNWRAPPED_YAW_RAD), or
-        None when it lies outside the plausible envelope (then `self.rejection` says why)."""
-        try:  # one expression on the path every plausible step takes (a comparison with NaN is False)
-            plausible = (
-                abs(m.steer_wheel_rad) <= STEER_SENSOR_MARGIN * self.geometry.max_steer_wheel_angle_rad
-                and math.hypot(m.vx_mps, m.vy_mps) <= MAX_SPEED_MPS
-                and abs(m.yaw_rate_rad_s) <= MAX_YAW_RATE_RAD_S
-                and abs(m.x_m) <= MAX_POSITION_M
-                and abs(m.y_m) <= MAX_POSITION_M
-                and abs(m.t_s) <= MAX_TIME_S
-                and math.isfinite(m.yaw_rad)
+        """The measurement the controller may see (every field a float, its yaw wrapped when beyond
+        MAX_UNWRAPPED_YAW_RAD), or None when a field is not a real number or the frame lies outside the plausible
+        envelope (then `self.rejection` says why)."""
+        try:  # the simulator's fields are floats (numpy's float64 among them): one check, no conversion
+            floats = (
+                isinstance(m.t_s, float)
+                and isinstance(m.x_m, float)
+                and isinstance(m.y_m, float)
+                and isinstance(m.vx_mps, float)
+                and isinstance(m.vy_mps, float)
+                and isinstance(m.yaw_rad, float)
+                and isinstance(m.yaw_rate_rad_s, float)
+                and isinstance(m.steer_wheel_rad, float)
             )
-        except (TypeError, ValueError, OverflowError, AttributeError):  # not numbers at all
-            plausible = False
+        except AttributeError:
+            self.rejection = f"the measurement is a {type(m).__name__}, not a Measurement"
+            return None
+        if not floats:
+            m = self._as_floats(m)
+            if m is None:
+                return None
+        plausible = (  # one expression on the path every plausible step takes (a comparison with NaN is False)
+            abs(m.steer_wheel_rad) <= STEER_SENSOR_MARGIN * self.geometry.max_steer_wheel_angle_rad
+            and math.hypot(m.vx_mps, m.vy_mps) <= MAX_SPEED_MPS
+            and abs(m.yaw_rate_rad_s) <= MAX_YAW_RATE_RAD_S
+            and abs(m.x_m) <= MAX_POSITION_M
+            and abs(m.y_m) <= MAX_POSITION_M
+            and abs(m.t_s) <= MAX_TIME_S
+            and math.isfinite(m.yaw_rad)
+        )
         if not plausible:
             self.rejection = self._why_implausible(m)
             return None
@@ -222,13 +244,29 @@ class Controller(ABC):
             )  # fmt: skip
         return m
 
+    def _as_floats(self, m: Measurement) -> Measurement | None:
+        """The measurement with every field a float, when each is a real number (`is_number`: Python's or a NumPy
+        real scalar of any dtype, not a bool); None otherwise, `self.rejection` naming the first field that is not
+        (a complex number, a string, None, an array of any shape) or that no float can hold."""
+        values = []
+        for name in _FIELDS:
+            value = getattr(m, name)
+            if not is_number(value):
+                shown = value_text(value)
+                shown = shown if len(shown) <= _SHOWN_CHARS else shown[: _SHOWN_CHARS - 3] + "..."
+                self.rejection = f"{name} = {shown} ({type(value).__name__}) is not a real number; {_REAL_NUMBERS}"
+                return None
+            try:
+                values.append(float(value))
+            except OverflowError:  # an int (or a fraction) beyond any float: too long to show
+                self.rejection = f"{name} is a {type(value).__name__} beyond any float (above 1.8e308)"
+                return None
+        return Measurement(*values)
+
     def _why_implausible(self, m: Measurement) -> str:
-        """What puts the measurement outside the envelope, in words."""
-        try:
-            values = (m.t_s, m.x_m, m.y_m, m.vx_mps, m.vy_mps, m.yaw_rad, m.yaw_rate_rad_s, m.steer_wheel_rad)
-            bad = [name for name, v in zip(_FIELDS, values, strict=True) if not math.isfinite(v)]
-        except (TypeError, ValueError, OverflowError, AttributeError):
-            return "a field is not a number"
+        """What puts the measurement (every field a float) outside the envelope, in words."""
+        values = (m.t_s, m.x_m, m.y_m, m.vx_mps, m.vy_mps, m.yaw_rad, m.yaw_rate_rad_s, m.steer_wheel_rad)
+        bad = [name for name, v in zip(_FIELDS, values, strict=True) if not math.isfinite(v)]
         if bad:
             return f"{', '.join(bad)} not finite"
         lock = STEER_SENSOR_MARGIN * self.geometry.max_steer_wheel_angle_rad

@@ -3,14 +3,18 @@
 from __future__ import annotations
 
 import dataclasses
+import decimal
+import fractions
 import math
 from typing import ClassVar
 
+import numpy as np
 import pytest
 
 from controllers import base
 from controllers.base import Controller, Measurement
 from workbench.base.clothoid_chain import ClothoidChain
+from workbench.base.errors import value_text
 from workbench.base.path import ReferencePath
 from workbench.vehicles import KinematicBicycle
 
@@ -173,3 +177,77 @@ def test_a_clock_that_stays_behind_restarts_the_controller_instead_of_locking_it
     assert controller.seen == [restart] and controller.diagnostics["measurement_rejected"] == 0.0
     later = dataclasses.replace(GOOD, t_s=restart.t_s + 0.02)
     assert controller.step(later, PATH) == 0.1 and controller.seen == [restart, later]
+
+
+#: Values of a type no field may have: each is refused even where its magnitude would pass (abs() accepts a
+#: complex number, an array compares element-wise, a bool is an int).
+NOT_REAL = [
+    1.0 + 0.0j,
+    complex(0.5, 1e-12),
+    np.complex128(0.5),
+    "0.5",
+    None,
+    True,
+    np.bool_(False),
+    np.array(0.5),
+    np.array([0.5]),
+    np.array([0.5, 0.5]),
+    decimal.Decimal("0.5"),
+]
+
+
+@pytest.mark.parametrize("field", base._FIELDS)
+@pytest.mark.parametrize("value", NOT_REAL, ids=repr)
+def test_a_field_that_is_not_a_real_number_is_rejected_naming_field_and_value(field: str, value: object) -> None:
+    controller = _controller()
+    controller.step(GOOD, PATH)
+    controller.next_command, controller.signal = 0.2, 7.0
+    assert controller.step(dataclasses.replace(GOOD, **{field: value}), PATH) == 0.1
+    assert controller.seen == [GOOD]
+    assert controller.diagnostics == {"signal": 0.0, "measurement_rejected": 1.0, "command_rejected": 0.0}
+    assert controller.rejection.startswith(f"{field} = {value_text(value)} ({type(value).__name__}) is not a real")
+
+
+@pytest.mark.parametrize("field", base._FIELDS)
+def test_an_int_beyond_any_float_is_rejected(field: str) -> None:
+    controller = _controller()
+    controller.step(GOOD, PATH)
+    assert controller.step(dataclasses.replace(GOOD, **{field: 10**400}), PATH) == 0.1
+    assert controller.rejection == f"{field} is a int beyond any float (above 1.8e308)"
+    assert controller.seen == [GOOD]
+
+
+def test_a_long_value_is_shown_cut_short() -> None:
+    controller = _controller()
+    controller.step(dataclasses.replace(GOOD, x_m=np.zeros(100)), PATH)
+    shown = controller.rejection.split(" (ndarray)")[0].removeprefix("x_m = ")
+    assert len(shown) == base._SHOWN_CHARS and shown.endswith("...")
+    controller.step(dataclasses.replace(GOOD, x_m="x" * (base._SHOWN_CHARS - 2)), PATH)
+    assert controller.rejection.startswith(f"x_m = '{'x' * (base._SHOWN_CHARS - 2)}' (str)")
+
+
+def test_a_measurement_that_is_not_one_is_rejected() -> None:
+    controller = _controller()
+    assert controller.step((1.0, 5.0), PATH) == 0.0  # type: ignore[arg-type]
+    assert controller.rejection == "the measurement is a tuple, not a Measurement"
+
+
+@pytest.mark.parametrize(
+    "dtype", [np.float16, np.float32, np.float64, np.longdouble, np.int8, np.int16, np.int32, np.int64, np.uint8,
+              np.uint16, np.uint32, np.uint64, int, float, fractions.Fraction],
+)  # fmt: skip
+def test_real_numbers_of_any_type_reach_the_controller_as_floats(dtype: type) -> None:
+    controller = _controller()
+    typed = Measurement(*(dtype(v) for v in (1, 5, 0, 8, 0, 0, 0, 0)))
+    assert controller.step(typed, PATH) == 0.1
+    seen = controller.seen[-1]
+    assert all(isinstance(getattr(seen, name), float) for name in base._FIELDS), seen  # float64 is a float
+    assert seen == Measurement(1.0, 5.0, 0.0, 8.0, 0.0, 0.0, 0.0, 0.0)
+
+
+def test_a_measurement_of_floats_reaches_the_controller_as_it_is() -> None:
+    """numpy's float64 is a float: the simulator's measurements pass without a copy."""
+    controller = _controller()
+    measured = Measurement(*np.array([1.0, 5.0, 0.5, 8.0, 0.0, 0.0, 0.0, 0.0]))
+    controller.step(measured, PATH)
+    assert controller.seen[-1] is measured

@@ -26,6 +26,10 @@ class Measurement:
     x_m, y_m: position of the reference point (the tractor's rear-axle centre, where the paper measures CTE);
     vx_mps, vy_mps: its velocity in the vehicle frame; yaw_rad, yaw_rate_rad_s: heading and its rate;
     steer_wheel_rad: measured steering-wheel angle; t_s: time.
+
+    Each field is a real number: a float, an int or a NumPy real scalar. A controller's step (`controllers.base`)
+    holds its last command on a frame with a field that is not (a bool, a complex number, a string, None, an
+    array), as on a non-finite or implausible one, and says which field and value in its `rejection`.
     """
 
     t_s: float
