@@ -14,7 +14,7 @@ from controllers.base import Measurement
 from tuning.own_tuning import tuned_controller
 from workbench.base.clothoid_chain import ClothoidChain
 from workbench.base.errors import WorkbenchInputError
-from workbench.simulation.scenarios import make_scenario
+from workbench.simulation.scenarios import ScenarioOptions, make_scenario
 from workbench.simulation.simulator import Simulation, SimulationConfig
 from workbench.vehicles import KinematicBicycle
 
@@ -130,7 +130,7 @@ def test_turns_toward_the_path(name: str) -> None:
 @pytest.mark.parametrize("name", NAMES)
 def test_completes_the_dlc_closely(name: str) -> None:
     vehicle = KinematicBicycle()
-    scenario = make_scenario("dlc")
+    scenario = make_scenario("dlc", ScenarioOptions(vehicle_width_m=vehicle.geometry.width_m))
     result = Simulation(scenario, vehicle, tuned_controller(name, vehicle), SimulationConfig()).run()
     assert result.completed, result.message
     assert result.metrics.max_abs_cte_m < 0.3

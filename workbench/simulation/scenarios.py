@@ -47,15 +47,30 @@ ZANDVOORT_SOURCE = (
 class ScenarioOptions:
     """What a scenario factory may depend on.
 
-    vehicle_width_m: overall width b of the vehicle (m), which sizes the ISO 3888-1 lanes; track_file: a track CSV
-    for scenarios that read one (zandvoort).
+    vehicle_width_m: overall width b (m, 0.5-4.0) of the vehicle that will be driven on the scenario, which sizes
+    the ISO 3888-1 lanes of `dlc`; None for scenarios that do not depend on it. It has no default because a lane
+    sized for one vehicle and driven by another measures nothing the standard defines, and nothing in a run would
+    show the mismatch: `dlc` refuses to be built without it, from Python as from the command line (which passes
+    the width of the vehicle it runs). track_file: a track CSV for scenarios that read one (zandvoort).
     """
 
-    vehicle_width_m: float = 2.59
+    vehicle_width_m: float | None = None
     track_file: Path | None = None
 
     def __post_init__(self) -> None:
-        require_in_range("vehicle_width_m", self.vehicle_width_m, 0.5, 4.0, "m")
+        if self.vehicle_width_m is not None:
+            require_in_range("vehicle_width_m", self.vehicle_width_m, 0.5, 4.0, "m")
+
+    def required_width_m(self, scenario: str) -> float:
+        """The vehicle's width (m) for a scenario sized by it; WorkbenchInputError naming `vehicle_width_m` (and
+        how to give it) when it is missing."""
+        if self.vehicle_width_m is None:
+            raise WorkbenchInputError(
+                f"{scenario} sizes its lanes for the vehicle driven on it: give ScenarioOptions(vehicle_width_m=...), "
+                f"the vehicle's overall width in m, e.g. make_scenario({scenario!r}, "
+                "ScenarioOptions(vehicle_width_m=vehicle.geometry.width_m)); got vehicle_width_m=None"
+            )
+        return self.vehicle_width_m
 
 
 @dataclass(frozen=True, eq=False)
@@ -196,13 +211,18 @@ def double_lane_change(options: ScenarioOptions) -> Scenario:
     from workbench.base.path import ReferencePath
     from workbench.base.waypoints import Waypoints
 
-    layout = DoubleLaneChangeLayout(options.vehicle_width_m)
+    layout = DoubleLaneChangeLayout(options.required_width_m("dlc"))
     x = np.arange(0.0, layout.section_starts_m[-1] + layout.run_out_m + 1e-9, 0.5)
     path = ReferencePath.from_waypoints(Waypoints(x, layout.centre_line(x), source="dlc"), name="dlc")
     return Scenario("dlc", path, _dlc_description(options), cones_xy=layout.cones())
 
 
 def _dlc_description(options: ScenarioOptions) -> str:
+    if options.vehicle_width_m is None:
+        return (
+            "ISO 3888-1 double lane change, lanes sized for the vehicle driven on it (1.1 b + 0.25, 1.2 b + 0.25 "
+            "and 1.3 b + 0.25 m for a vehicle b m wide)"
+        )
     layout = DoubleLaneChangeLayout(options.vehicle_width_m)
     w1, w3, w5 = layout.lane_widths_m
     return (
@@ -323,7 +343,11 @@ SCENARIOS: dict[str, ScenarioFactory] = {
 
 
 def make_scenario(name_or_file: str, options: ScenarioOptions | None = None) -> Scenario:
-    """Build a named scenario, or one from a waypoint file when the argument is a path to a file."""
+    """Build a named scenario, or one from a waypoint file when the argument is a path to a file.
+
+    `dlc` needs `options.vehicle_width_m` (the width of the vehicle to be driven: its lanes are sized for it);
+    the other scenarios do not depend on the vehicle.
+    """
     options = options or ScenarioOptions()
     if name_or_file in SCENARIOS:
         return SCENARIOS[name_or_file](options)

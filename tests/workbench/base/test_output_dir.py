@@ -167,13 +167,14 @@ def test_a_result_saved_again_replaces_its_own_files(tmp_path: Path) -> None:
     """SimulationResult.save removes the files a run writes before writing them: a run saved without plots where
     one with plots was leaves no PNG of the earlier run beside the new trace."""
     from controllers import make_controller
-    from workbench.simulation.scenarios import make_scenario
+    from workbench.simulation.scenarios import ScenarioOptions, make_scenario
     from workbench.simulation.simulator import Simulation, SimulationConfig
     from workbench.vehicles import make_vehicle
 
     vehicle = make_vehicle("kinematic-bicycle")
     controller = make_controller("pure-pursuit", vehicle.geometry)
-    result = Simulation(make_scenario("dlc"), vehicle, controller, SimulationConfig()).run()
+    scenario = make_scenario("dlc", ScenarioOptions(vehicle_width_m=vehicle.geometry.width_m))
+    result = Simulation(scenario, vehicle, controller, SimulationConfig()).run()
     (tmp_path / "notes.txt").write_text("mine")
     assert len(result.save(tmp_path)) == 6
     assert sorted(p.name for p in result.save(tmp_path, with_plots=False)) == ["metrics.json", "trace.parquet"]

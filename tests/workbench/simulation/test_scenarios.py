@@ -346,3 +346,18 @@ def test_missing_waypoint_file(tmp_path: Path) -> None:
 def test_bad_vehicle_width(width: float) -> None:
     with pytest.raises(WorkbenchInputError, match=rf"vehicle_width_m must be .*got {width!r}"):
         ScenarioOptions(vehicle_width_m=width)
+
+
+def test_the_dlc_needs_the_width_of_the_vehicle_driven_on_it() -> None:
+    """No default width: a dlc built without one is refused, naming the argument, rather than sized for another
+    vehicle; each width gives its own lanes, and the scenarios that do not depend on the vehicle need none."""
+    for options in (None, ScenarioOptions(), ScenarioOptions(track_file=Path("unused.csv"))):
+        with pytest.raises(WorkbenchInputError, match=r"dlc sizes its lanes .*got vehicle_width_m=None"):
+            make_scenario("dlc", options)
+    car, truck = (make_scenario("dlc", ScenarioOptions(vehicle_width_m=b)) for b in (1.674, 2.59))
+    # The entry lane is 1.1 b + 0.25 m wide: its cones lie +-(1.1 b + 0.25) / 2 about the centre line.
+    assert np.ptp(car.cones_xy[:2, 1]) == pytest.approx(1.1 * 1.674 + 0.25, abs=1e-12)
+    assert np.ptp(truck.cones_xy[:2, 1]) == pytest.approx(1.1 * 2.59 + 0.25, abs=1e-12)
+    assert make_scenario("fig17").path.length_m > 0  # sized by nothing: no width needed
+    described = dict(describe_scenarios())
+    assert "lanes sized for the vehicle driven on it" in described["dlc"] and "2.59" not in described["dlc"]

@@ -14,19 +14,18 @@ from controllers.base import Controller, Measurement
 from workbench.base.errors import WorkbenchInputError
 from workbench.base.path import ReferencePath
 from workbench.simulation.conditions import CONDITIONS, Actuation, Conditions, Localisation, Road
-from workbench.simulation.scenarios import make_scenario
+from workbench.simulation.scenarios import ScenarioOptions, make_scenario
 from workbench.simulation.simulator import Simulation, SimulationConfig
 from workbench.vehicles import KinematicBicycle, make_vehicle
-
-DLC = make_scenario("dlc")
 
 
 def _run(conditions: Conditions | None = None, seed: int = 0, vehicle_name: str = "dynamic-bicycle", **config):
     vehicle = make_vehicle(vehicle_name)
+    dlc = make_scenario("dlc", ScenarioOptions(vehicle_width_m=vehicle.geometry.width_m))
     fields = {"speed_kmh": 40.0, **config}
     if conditions is not None:
         fields |= {"conditions": conditions, "seed": seed}
-    return Simulation(DLC, vehicle, PurePursuit(vehicle.geometry), SimulationConfig(**fields)).run()
+    return Simulation(dlc, vehicle, PurePursuit(vehicle.geometry), SimulationConfig(**fields)).run()
 
 
 def _same(a: dict[str, np.ndarray], b: dict[str, np.ndarray]) -> bool:
@@ -84,7 +83,7 @@ def test_the_actuators_dead_time_delays_the_command_reaching_the_plant() -> None
             return 0.0 if measurement.t_s < 0.5 - 1e-9 else np.radians(30.0)
 
     vehicle = KinematicBicycle()
-    straight = make_scenario("dlc")
+    straight = make_scenario("dlc", ScenarioOptions(vehicle_width_m=vehicle.geometry.width_m))
     delayed = Conditions(name="delay", actuation=Actuation(dead_time_s=0.1))
     config = SimulationConfig(speed_kmh=20.0, conditions=delayed, max_time_s=1.5)
     trace = Simulation(straight, vehicle, Step(vehicle.geometry, {}), config).run().trace
