@@ -32,6 +32,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from workbench.base.errors import WorkbenchInputError
+from workbench.base.user_cache import check_private_tree
 from workbench.vehicles.base import VehicleModel
 
 if TYPE_CHECKING:  # the clothoid controller and the tuning tools (python-control, SciPy: ~2 s to import) are
@@ -113,6 +114,16 @@ def generate_vehicle_tuning(vehicle: VehicleModel, directory: str | Path, option
     return target
 
 
+def _discard(directory: Path) -> None:
+    """Remove a cache entry: renamed aside first, so that a concurrent reader sees it whole or not at all."""
+    aside = Path(tempfile.mkdtemp(prefix=f".{directory.name}.", suffix=".discarded", dir=directory.parent))
+    try:
+        os.replace(directory, aside / directory.name)
+    except OSError:  # removed meanwhile by another process
+        pass
+    shutil.rmtree(aside, ignore_errors=True)
+
+
 def _estimate_s(vehicle: VehicleModel, options: PresetTuningOptions) -> float:
 
     resolved = options.for_model(vehicle.name)
@@ -131,6 +142,7 @@ def tuning_for(vehicle: VehicleModel, options: PresetTuningOptions | None = None
     (default `tuning.preset_tuning.PRESET_TUNING_OPTIONS`, those the shipped files were made with)."""
     from tuning.preset_tuning import PRESET_TUNING_OPTIONS
     from tuning.tuning_dirs import (
+        CACHE_ENV,
         MANIFEST_FILE,
         VEHICLE_FILE,
         cache_dir,
@@ -147,7 +159,12 @@ def tuning_for(vehicle: VehicleModel, options: PresetTuningOptions | None = None
     key = cache_key(vehicle, options)
     directory = base / key
     if (directory / MANIFEST_FILE).is_file():
-        return read_vehicle_tuning(directory)
+        check_private_tree(directory, CACHE_ENV)
+        try:
+            return read_vehicle_tuning(directory)
+        except WorkbenchInputError as exc:  # an edited or damaged entry: never used, made again
+            print(f"lateral-workbench: the cached tuning cannot be used ({exc}): making it again", file=sys.stderr)
+            _discard(directory)
     estimate = _estimate_s(vehicle, options)
     print(
         f"lateral-workbench: no clothoid-controller tuning yet for this {vehicle.name} (params sha256 "

@@ -54,6 +54,7 @@ from tuning.tuning_dirs import (
     LIMITS_FILE,
     MANIFEST_FILE,
     MANIFEST_FORMAT,
+    files_sha256,
     params_sha256,
     read_manifest,
     read_vehicle_tuning,
@@ -279,6 +280,7 @@ def write_manifest(
         "package_version": installed_version() or "unknown",
         "date": datetime.datetime.now(datetime.UTC).date().isoformat(),
         "generation_time_s": {k: round(v, 1) for k, v in seconds.items()},
+        "files_sha256": files_sha256(directory),
     }
     path = directory / MANIFEST_FILE
     path.write_text(json.dumps(manifest, indent=2) + "\n", encoding="utf-8")

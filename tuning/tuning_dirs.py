@@ -22,7 +22,7 @@ from tuning.filter_file import read_filter_file
 from tuning.limits_file import read_limits_file
 from workbench.base.errors import WorkbenchInputError, value_text
 from workbench.base.input_files import read_json
-from workbench.base.user_cache import user_cache_dir
+from workbench.base.user_cache import private_cache_dir
 from workbench.vehicles.base import VehicleModel
 from workbench.vehicles.presets import MODEL_TYPES, params_from_toml, preset_text
 from workbench.vehicles.steering_lag import SteeringLag
@@ -46,7 +46,10 @@ MANIFEST_KEYS = (
     "package_version",
     "date",
     "generation_time_s",
+    "files_sha256",
 )
+#: The files of a tuning directory whose SHA-256 its manifest records (`files_sha256`), checked on every read.
+DIGESTED_FILES = (LEAD_FILE, LIMITS_FILE)
 PAYLOAD_FIELD = "payload_kg"
 LAG_KEYS = ("speed_kmh", "omega_n_rad_s", "zeta")
 #: The per_speed keys of the measured lag (prefix + the path lag's key); the first two are required for it.
@@ -108,8 +111,14 @@ def shipped_tuning_root() -> Path:
 
 
 def cache_dir() -> Path:
-    """$WORKBENCH_TUNING_CACHE, else $XDG_CACHE_HOME/lateral-workbench/tuning (~/.cache/...)."""
-    return user_cache_dir(CACHE_ENV, "tuning")
+    """$WORKBENCH_TUNING_CACHE, else $XDG_CACHE_HOME/lateral-workbench/tuning (~/.cache/...): made private when
+    missing; UnsafeCacheError when it is not the user's own (`workbench.base.user_cache`)."""
+    return private_cache_dir(CACHE_ENV, "tuning")
+
+
+def files_sha256(directory: Path) -> dict[str, str]:
+    """SHA-256 (hex) of each of DIGESTED_FILES in `directory`, as a manifest records them."""
+    return {name: hashlib.sha256((directory / name).read_bytes()).hexdigest() for name in DIGESTED_FILES}
 
 
 def shipped_index() -> dict[tuple[str, str], Path]:
@@ -196,10 +205,29 @@ def _row_lag(path: Path, i: int, row: Mapping[str, Any], prefix: str, speed: flo
         raise WorkbenchInputError(f"{path}: design.per_speed[{i}] ({what}): {exc}") from None
 
 
+def _check_digests(path: Path, recorded: object) -> None:
+    """Refuse a tuning directory whose files are not the ones its manifest's files_sha256 records: a tuning is
+    used only as it was made."""
+    if not isinstance(recorded, Mapping) or sorted(recorded) != sorted(DIGESTED_FILES):
+        raise WorkbenchInputError(
+            f"tuning manifest {str(path / MANIFEST_FILE)!r}: files_sha256 must map each of {list(DIGESTED_FILES)} "
+            f"to its SHA-256; got {recorded!r}"
+        )
+    for name, actual in files_sha256(path).items():
+        if recorded[name] != actual:
+            raise WorkbenchInputError(
+                f"tuning directory {str(path)!r}: {name} is not the file its manifest records (SHA-256 "
+                f"{str(recorded[name])[:12]}..., the file's {actual[:12]}...): it was changed after the tuning was "
+                "made, and a tuning is used only as it was made; make it again, or give an edited filter as the "
+                "controller's filter_file"
+            )
+
+
 @functools.lru_cache(maxsize=64)
 def _read(directory: str, _stamp: tuple[int, ...]) -> VehicleTuning:
     path = Path(directory)
     manifest = read_manifest(path)
+    _check_digests(path, manifest["files_sha256"])
     lead = path / LEAD_FILE
     schedule = read_filter_file(lead)
     limits = read_limits_file(path / LIMITS_FILE)

@@ -6,6 +6,11 @@ bicycle; the compiled library in about 0.15 ms, and compiling takes about half a
 cached under `cache_dir()` by a hash of the generated source, the compiler and its flags, so later builds of the
 same problem (every test, every run) load them directly. Without a C compiler, or if compiling fails, the SX
 function is used as it is (same results, slower) and `CompiledFunction.compiled` says so.
+
+A cached library is code this process runs: the cache folder must be the user's own (`private_cache_dir`: made
+0700, refused with `UnsafeCacheError` when another user owns it or others may write it), and each library is
+loaded only when its SHA-256 is the one recorded beside it (`<library>.sha256`) when it was built here; a library
+without that record, or differing from it, is built again.
 """
 
 from __future__ import annotations
@@ -21,7 +26,7 @@ from pathlib import Path
 import casadi as ca
 import numpy as np
 
-from workbench.base.user_cache import user_cache_dir
+from workbench.base.user_cache import check_private, private_cache_dir
 
 #: Environment variable naming the directory compiled libraries are cached in.
 CACHE_ENV = "WORKBENCH_MPC_CACHE"
@@ -41,8 +46,34 @@ class CompiledFunction:
 
 
 def cache_dir() -> Path:
-    """$WORKBENCH_MPC_CACHE, else $XDG_CACHE_HOME/lateral-workbench/casadi (~/.cache/...), else a temp dir."""
-    return user_cache_dir(CACHE_ENV, "casadi")
+    """$WORKBENCH_MPC_CACHE, else $XDG_CACHE_HOME/lateral-workbench/casadi (~/.cache/...): made private when
+    missing; UnsafeCacheError when it is not the user's own."""
+    return private_cache_dir(CACHE_ENV, "casadi")
+
+
+def file_sha256(path: Path) -> str:
+    """SHA-256 (hex) of a file's bytes."""
+    return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
+def _digest_file(library: Path) -> Path:
+    return library.with_name(library.name + ".sha256")
+
+
+def _verified(library: Path) -> bool:
+    """Whether `library` is a file of the user's own whose SHA-256 is the one recorded when it was built here."""
+    record = _digest_file(library)
+    if not (library.is_file() and record.is_file()):
+        return False
+    check_private(library, CACHE_ENV)
+    check_private(record, CACHE_ENV)
+    return record.read_text(encoding="ascii").strip() == file_sha256(library)
+
+
+def _write_atomically(path: Path, data: bytes, work: Path) -> None:
+    tmp = work / (path.name + ".tmp")
+    tmp.write_bytes(data)
+    os.replace(tmp, path)
 
 
 def find_compiler() -> str | None:
@@ -66,11 +97,13 @@ def compile_function(function: ca.Function, enabled: bool = True) -> CompiledFun
     key = hashlib.sha256("\n".join((source, compiler, " ".join(COMPILE_FLAGS), ca.__version__)).encode()).hexdigest()[
         :20
     ]
-    directory = cache_dir()
+    try:
+        directory = cache_dir()
+    except OSError as exc:
+        return CompiledFunction(function, False, f"no cache folder ({type(exc).__name__}: {exc})")
     library = directory / f"{function.name()}_{key}.so"
-    if not library.is_file():
+    if not _verified(library):
         try:
-            directory.mkdir(parents=True, exist_ok=True)
             with tempfile.TemporaryDirectory(dir=directory) as work:
                 c_file = Path(work) / f"{function.name()}.c"
                 c_file.write_text(source)
@@ -81,6 +114,9 @@ def compile_function(function: ca.Function, enabled: bool = True) -> CompiledFun
                     capture_output=True,
                     timeout=COMPILE_TIMEOUT_S,
                 )
+                digest = file_sha256(tmp_library)
+                # the record first: a library is never there without the digest of what was built
+                _write_atomically(_digest_file(library), digest.encode("ascii"), Path(work))
                 os.replace(tmp_library, library)  # atomic: parallel builds never see a partial file
         except (OSError, subprocess.SubprocessError) as exc:
             return CompiledFunction(function, False, f"compiling failed ({type(exc).__name__}: {exc})")

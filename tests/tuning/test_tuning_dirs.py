@@ -8,6 +8,7 @@ import dataclasses
 import itertools
 import json
 import math
+import shutil
 from pathlib import Path
 
 import pytest
@@ -29,12 +30,14 @@ from tuning.tuning_dirs import (
     MANIFEST_FILE,
     VEHICLE_FILE,
     canonical_vehicle_toml,
+    files_sha256,
     params_sha256,
     read_manifest,
     read_vehicle_tuning,
     shipped_tuning_root,
 )
 from workbench.base.errors import WorkbenchInputError
+from workbench.base.user_cache import UnsafeCacheError
 from workbench.vehicles import list_presets, make_vehicle, preset_text
 from workbench.vehicles.presets import params_from_toml
 from workbench.vehicles.steering_lag import SteeringLag
@@ -208,6 +211,14 @@ def _copy_shipped(name: str, directory: Path) -> Path:
     return directory
 
 
+def _write_lead(directory: Path, doc: dict) -> None:
+    """Write lead.json and record its digest in the manifest, as a tuning made with that file would have it."""
+    (directory / LEAD_FILE).write_text(json.dumps(doc))
+    manifest = json.loads((directory / MANIFEST_FILE).read_text())
+    manifest["files_sha256"] = files_sha256(directory)
+    (directory / MANIFEST_FILE).write_text(json.dumps(manifest))
+
+
 def test_a_lead_file_without_measured_lags_still_reads(tmp_path: Path) -> None:
     """Files made before the measured lag was recorded: no measured_* keys in per_speed."""
     directory = _copy_shipped("tractor-semitrailer", tmp_path / "old")
@@ -215,7 +226,7 @@ def test_a_lead_file_without_measured_lags_still_reads(tmp_path: Path) -> None:
     for row in doc["design"]["per_speed"]:
         for key in [k for k in row if k.startswith("measured_")]:
             del row[key]
-    (directory / LEAD_FILE).write_text(json.dumps(doc))
+    _write_lead(directory, doc)
     tuning = read_vehicle_tuning(directory)
     assert tuning.measured_lags == () and tuning.measured_lag_at(60.0) is None
     shipped = read_vehicle_tuning(shipped_tuning_root() / "tractor-semitrailer").lag_at(60.0)
@@ -226,13 +237,13 @@ def test_a_lead_file_with_the_measured_lag_at_some_speeds_only_is_refused(tmp_pa
     directory = _copy_shipped("tractor-semitrailer", tmp_path / "partial")
     doc = json.loads((directory / LEAD_FILE).read_text())
     del doc["design"]["per_speed"][3]["measured_zeta"]
-    (directory / LEAD_FILE).write_text(json.dumps(doc))
+    _write_lead(directory, doc)
     with pytest.raises(WorkbenchInputError, match=r"per_speed\[3\] must hold both of"):
         read_vehicle_tuning(directory)
     for row in doc["design"]["per_speed"][3:]:
         for key in [k for k in row if k.startswith("measured_")]:
             del row[key]
-    (directory / LEAD_FILE).write_text(json.dumps(doc))
+    _write_lead(directory, doc)
     with pytest.raises(WorkbenchInputError, match=r"holds the measured lag .* at 3 of 10 speeds"):
         read_vehicle_tuning(directory)
 
@@ -353,3 +364,38 @@ def test_a_generation_finishing_second_keeps_the_first_ones_files(tmp_path: Path
     assert generate_vehicle_tuning(car, target, QUICK) == target
     assert read_vehicle_tuning(target) == before
     assert sorted(p.name for p in target.parent.iterdir()) == ["key"]  # the loser's temporary directory is gone
+
+
+def test_an_edited_tuning_directory_is_refused(tmp_path: Path) -> None:
+    directory = tmp_path / "tuning"
+    shutil.copytree(shipped_tuning_root() / "kinematic-bicycle", directory)
+    read_vehicle_tuning(directory)  # as made: read
+    lead = directory / LEAD_FILE
+    lead.write_text(lead.read_text().replace('"omega_p_rad_s": ', '"omega_p_rad_s": 1', 1))
+    with pytest.raises(WorkbenchInputError, match=r"lead\.json is not the file its manifest records .* filter_file"):
+        read_vehicle_tuning(directory)
+
+
+def test_an_edited_cache_entry_is_made_again_never_used(tmp_path: Path, _private_cache: Path, monkeypatch, capsys):
+    car = make_vehicle(vehicle_file=_longer_car(tmp_path))
+    first = tuning_for(car, QUICK)
+    directory = _private_cache / cache_key(car, QUICK)
+    limits = directory / LIMITS_FILE
+    limits.write_text(limits.read_text() + "\n")  # any change, even one that reads the same
+    capsys.readouterr()
+    assert tuning_for(car, QUICK) == first  # made again, the same
+    assert "the cached tuning cannot be used" in capsys.readouterr().err
+    assert sorted(p.name for p in _private_cache.iterdir()) == [directory.name]  # the old entry is gone
+    read_vehicle_tuning(directory)  # and the new one matches its manifest
+
+
+def test_a_cache_others_may_write_is_refused(tmp_path: Path, _private_cache: Path) -> None:
+    _private_cache.mkdir()
+    _private_cache.chmod(0o777)
+    with pytest.raises(UnsafeCacheError, match="is writable by others"):
+        tuning_for(make_vehicle(vehicle_file=_longer_car(tmp_path)), QUICK)
+
+
+def test_the_cache_is_made_private(tmp_path: Path, _private_cache: Path) -> None:
+    tuning_for(make_vehicle(vehicle_file=_longer_car(tmp_path)), QUICK)
+    assert _private_cache.stat().st_mode & 0o777 == 0o700

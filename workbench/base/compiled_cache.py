@@ -10,17 +10,24 @@ $WORKBENCH_NUMBA_CACHE): a changed file means a fresh compile (tens of seconds, 
 `use_versioned_numba_cache` sets NUMBA_CACHE_DIR to that folder; the packages call it before anything imports
 numba. It leaves an explicit NUMBA_CACHE_DIR alone, does nothing when numba is already imported (its settings are
 read then), and leaves numba's own default (`__pycache__` beside the sources) when the folder cannot be written.
+
+numba loads its index files with pickle, so a file in that folder is code the run executes: the folder is made
+private to the user, and a folder, or a file in it, that another user owns or others may write is not used
+(`workbench.base.user_cache.check_private`). Then a warning on stderr says which and why, and the kernels are
+compiled into a fresh private temporary folder instead, removed at exit: slower, never foreign code.
 """
 
 from __future__ import annotations
 
+import atexit
 import hashlib
 import os
+import shutil
 import sys
 import tempfile
 from pathlib import Path
 
-from workbench.base.user_cache import user_cache_dir
+from workbench.base.user_cache import UnsafeCacheError, check_private_tree, private_cache_dir
 
 #: The packages whose modules may hold compiled kernels, relative to the folder holding this project's packages.
 PACKAGES = ("workbench", "controllers")
@@ -43,18 +50,33 @@ def compiled_sources_digest(root: Path = _SOURCE_ROOT) -> str:
 
 def _writable(folder: Path) -> bool:
     try:
-        folder.mkdir(parents=True, exist_ok=True)
         with tempfile.TemporaryFile(dir=folder):
             return True
     except OSError:
         return False
 
 
+def _private_temporary_folder() -> Path:
+    """A fresh folder of this user's alone (mkdtemp: 0700), removed when the process that made it exits."""
+    folder = Path(tempfile.mkdtemp(prefix="lateral-workbench-numba-"))
+    maker = os.getpid()
+    atexit.register(lambda: os.getpid() == maker and shutil.rmtree(folder, ignore_errors=True))
+    return folder
+
+
 def use_versioned_numba_cache() -> None:
     """Point NUMBA_CACHE_DIR at this version's folder (module docstring), unless set, numba already imported, or
-    the folder not writable."""
+    the folder not writable; at a private temporary folder, with a warning on stderr, when the cache is not the
+    user's own."""
     if os.environ.get("NUMBA_CACHE_DIR") or "numba" in sys.modules:
         return
-    folder = user_cache_dir(CACHE_ENV, "numba") / compiled_sources_digest()[:16]
+    try:
+        folder = private_cache_dir(CACHE_ENV, "numba", compiled_sources_digest()[:16])
+        check_private_tree(folder, CACHE_ENV)
+    except UnsafeCacheError as exc:
+        folder = _private_temporary_folder()
+        print(f"lateral-workbench: warning: {exc}; compiling into {folder} instead", file=sys.stderr, flush=True)
+    except OSError:
+        return
     if _writable(folder):
         os.environ["NUMBA_CACHE_DIR"] = str(folder)

@@ -2,11 +2,14 @@
 
 from __future__ import annotations
 
+import hashlib
+
 import casadi as ca
 import numpy as np
 import pytest
 
 from controllers.mpc.codegen import CACHE_ENV, FastFunction, compile_function, find_compiler
+from workbench.base.user_cache import UnsafeCacheError
 
 
 def _function() -> ca.Function:
@@ -47,3 +50,30 @@ def test_fast_function_evaluates_on_buffers() -> None:
     expected_value, expected_jacobian = _function()(x, p)
     np.testing.assert_allclose(value, np.asarray(expected_value).ravel())
     np.testing.assert_allclose(jacobian, np.asarray(expected_jacobian).ravel(order="F"))
+
+
+@pytest.mark.skipif(find_compiler() is None, reason="no C compiler on this machine")
+@pytest.mark.parametrize("record", ["none", "other"])
+def test_a_library_planted_under_the_cached_name_is_never_loaded(tmp_path, monkeypatch, record: str) -> None:
+    """A library whose SHA-256 is not the one recorded when it was built here is built again before loading."""
+    monkeypatch.setenv(CACHE_ENV, str(tmp_path))
+    assert compile_function(_function()).compiled
+    (library,) = tmp_path.glob("probe_*.so")
+    built = library.read_bytes()
+    digest_file = library.with_name(library.name + ".sha256")
+    assert digest_file.read_text() == hashlib.sha256(built).hexdigest()
+    library.write_bytes(b"\x7fELF planted")  # not loadable: loading it would fail, not silently compute
+    if record == "none":
+        digest_file.unlink()
+    again = compile_function(_function())
+    assert again.compiled, again.note
+    assert library.read_bytes() == built and digest_file.read_text() == hashlib.sha256(built).hexdigest()
+
+
+def test_a_cache_folder_others_may_write_is_refused(tmp_path, monkeypatch) -> None:
+    shared = tmp_path / "shared"
+    shared.mkdir()
+    shared.chmod(0o777)
+    monkeypatch.setenv(CACHE_ENV, str(shared))
+    with pytest.raises(UnsafeCacheError, match=rf"cache folder '{shared}' is writable by others"):
+        compile_function(_function())

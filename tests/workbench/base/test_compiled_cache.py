@@ -45,3 +45,25 @@ def test_the_folder_is_set_unless_chosen_already_or_too_late(monkeypatch, tmp_pa
     monkeypatch.setitem(sys.modules, "numba", object())  # numba has read its settings: too late to change them
     use_versioned_numba_cache()
     assert "NUMBA_CACHE_DIR" not in os.environ
+
+
+def test_a_folder_holding_a_file_others_may_write_is_not_used(monkeypatch, tmp_path: Path, capsys) -> None:
+    """numba unpickles its index files: a planted one is code. The folder is refused, the kernels compiled into a
+    private temporary folder instead, and a warning says which folder and why."""
+    versions = tmp_path / "versions"
+    monkeypatch.setenv("WORKBENCH_NUMBA_CACHE", str(versions))
+    monkeypatch.delitem(sys.modules, "numba", raising=False)
+    monkeypatch.delenv("NUMBA_CACHE_DIR", raising=False)
+    use_versioned_numba_cache()
+    folder = Path(os.environ["NUMBA_CACHE_DIR"])
+    assert (folder.stat().st_mode & 0o777) == 0o700  # made private
+    planted = folder / "kernel.step-1.py311.nbi"
+    planted.write_bytes(b"not numba's")
+    planted.chmod(0o666)
+    monkeypatch.delenv("NUMBA_CACHE_DIR")
+    use_versioned_numba_cache()
+    used = Path(os.environ["NUMBA_CACHE_DIR"])
+    assert used != folder and not used.is_relative_to(versions) and (used.stat().st_mode & 0o777) == 0o700
+    assert list(used.iterdir()) == []
+    err = capsys.readouterr().err
+    assert f"cache file '{planted}' is writable by others (mode 0666)" in err and f"compiling into {used}" in err
