@@ -368,10 +368,12 @@ def _print_summary(comparison: Comparison) -> None:
 def _controller_configs(values: Sequence[str], controllers: Sequence[str]) -> dict[str, Path]:
     """Each controller's --controller-config file in compare: NAME=FILE.toml for that controller (the file must
     have its [NAME] table), else the one FILE.toml given for all (a table per controller name; a controller without
-    one gets its defaults); a controller with neither is left out (its defaults). Each file is checked readable. A
+    one gets its defaults, with a warning); a controller with neither is left out (its defaults). Each file is read
+    and checked (`controller_config.read_config_tables`: no key outside a table, no table naming no controller). A
     text whose part before "=" is shaped like a name, and which is not itself a file, is taken as NAME=FILE, so
     that a misspelt name is refused as such rather than as a missing file."""
-    from workbench.base.input_files import check_input_file, read_toml
+    from workbench.apps.controller_config import missing_table_warning, read_config_tables
+    from workbench.base.input_files import check_input_file
 
     shared: list[str] = []
     named: dict[str, Path] = {}
@@ -386,7 +388,7 @@ def _controller_configs(values: Sequence[str], controllers: Sequence[str]) -> di
         if name in named:
             raise WorkbenchInputError(f"{what}: {name} has a file already ({str(named[name])!r}); give one each")
         check_input_file(file, what)
-        if name not in read_toml(Path(file), what):
+        if name not in read_config_tables(Path(file)):
             raise WorkbenchInputError(
                 f"{what}: the file has no [{name}] table (`workbench controllers --show {name}` writes one)"
             )
@@ -398,6 +400,10 @@ def _controller_configs(values: Sequence[str], controllers: Sequence[str]) -> di
         )
     for text in shared:
         check_input_file(text, f"--controller-config {text!r}")
+        for controller in (c for c in controllers if c not in named):
+            warning = missing_table_warning(Path(text), controller)
+            if warning is not None:
+                warn_on_stderr(warning)
     every = {c: Path(shared[0]) for c in controllers} if shared else {}
     return every | named
 
@@ -694,7 +700,12 @@ def _run_with(args: argparse.Namespace, plot_worker: PlotWorker | None) -> int:
     if args.controller not in CONTROLLERS:
         make_controller(args.controller, vehicle.geometry)  # raises the unknown-name error
     options = read_controller_config(
-        args.controller_config, args.controller, CONTROLLERS[args.controller].config_type, args.set, vehicle.geometry
+        args.controller_config,
+        args.controller,
+        CONTROLLERS[args.controller].config_type,
+        args.set,
+        vehicle.geometry,
+        warn=warn_on_stderr,
     )
     controller = tuned_controller(args.controller, vehicle, options)
     scenario = make_scenario(

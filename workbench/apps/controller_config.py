@@ -12,12 +12,19 @@ A config file holds one table per controller name, so one file can configure sev
 
 Overrides (`--set frechet_threshold_m=0.3` on the command line) apply on top. Keys are the config dataclass's field
 names; a key that is not one, or a value of the wrong type, is an error that lists what is allowed. Fields may be
-float, int, bool, str, Path or `Path | None` (written "none" to clear).
+float, int, bool, str, Path or `Path | None` (written "none" to clear). A file's values are TOML values, taken as they
+are (`0.3`, `false`; the text `"0.3"` is refused); only override text is parsed.
+
+A file holds tables only, each named by a registered controller: a key outside any table, or a table that names no
+controller (`[stanly]`), is refused, so that options meant for a controller are never dropped unread. Tables of
+other controllers are allowed (one file for several controllers); a file without the chosen controller's table is
+read as its defaults, with a warning naming the tables it has (`missing_table_warning`).
 """
 
 from __future__ import annotations
 
 import dataclasses
+import difflib
 from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -99,21 +106,22 @@ def build_config(
     base_dir: Path | None = None,
     geometry: VehicleGeometry | None = None,
 ) -> Any:
-    """An instance of `config_type` from `values` (a TOML table) and `key=value` overrides; its defaults otherwise.
-    File options are read into their objects here (`FILE_OPTIONS`; `geometry`: the steered vehicle's, which a
-    limits file without a rate column needs)."""
+    """An instance of `config_type` from `values` (a TOML table, its values typed as they are) and `key=value`
+    overrides (text, parsed as each option's type); its defaults otherwise. File options are read into their
+    objects here (`FILE_OPTIONS`; `geometry`: the steered vehicle's, which a limits file without a rate column
+    needs)."""
     types = option_types(config_type)
     merged: dict[str, Any] = {}
-    items = list((values or {}).items())
+    items = [(key, value, False) for key, value in (values or {}).items()]  # TOML values: typed as they are
     for override in overrides:
         key, sep, text = override.partition("=")
         if not sep:
             raise WorkbenchInputError(f"an option override must look like key=value; got {override!r}")
-        items.append((key.strip(), text.strip()))
-    for key, value in items:
+        items.append((key.strip(), text.strip(), True))  # text: parsed
+    for key, value, is_text in items:
         if key not in types:
             raise WorkbenchInputError(f"unknown option {key!r} for {config_type.__name__}; allowed: {', '.join(types)}")
-        typed = typed_value(f"option {key!r}", value, types[key], base_dir, from_text=True)
+        typed = typed_value(f"option {key!r}", value, types[key], base_dir, from_text=is_text)
         option = FILE_OPTIONS.get(key)
         if option is not None:
             merged[option.field] = None if typed is None else option.read(typed, geometry)
@@ -122,25 +130,73 @@ def build_config(
     return config_type(**merged)
 
 
+def read_config_tables(path: str | Path) -> dict[str, dict[str, Any]]:
+    """The tables of the controller-config file at `path`, by controller name. Refused (WorkbenchInputError naming
+    the file): a key outside any table, and a table whose name is no registered controller (the close one
+    suggested), so that no option in the file goes unread."""
+    from controllers import CONTROLLERS
+
+    what = f"controller config file {str(path)!r}"
+    document = read_toml(path, what)
+    loose = [f"{key} = {value_text(value)}" for key, value in document.items() if not isinstance(value, dict)]
+    if loose:
+        raise WorkbenchInputError(
+            f"{what}: {'; '.join(loose)} outside any table; options go in their controller's table, [NAME] with NAME "
+            f"one of {', '.join(CONTROLLERS)}"
+        )
+    for name in document:
+        if name not in CONTROLLERS:
+            raise WorkbenchInputError(f"{what}: [{name}] names no controller; {_suggestion(name, CONTROLLERS)}")
+    return document
+
+
+def _suggestion(name: str, names: Iterable[str]) -> str:
+    """"did you mean [x]? " (the closest of `names`, case aside) and the list of `names`."""
+    names = list(names)
+    by_lower = {n.lower(): n for n in names}
+    close = difflib.get_close_matches(name.lower(), list(by_lower), n=1)
+    hint = f"did you mean [{by_lower[close[0]]}]? " if close else ""
+    return f"{hint}the tables a file may hold: {', '.join(f'[{n}]' for n in names)}"
+
+
+def missing_table_warning(path: str | Path, controller_name: str) -> str | None:
+    """A warning when the controller-config file at `path` has no table for `controller_name` (which then runs
+    with its defaults), naming the tables it has; None when it has one. The file is read and checked as
+    `read_config_tables` does."""
+    return _missing_table_text(path, controller_name, read_config_tables(path))
+
+
+def _missing_table_text(path: str | Path, controller_name: str, tables: Mapping[str, Any]) -> str | None:
+    if controller_name in tables:
+        return None
+    has = f"only {', '.join(f'[{n}]' for n in tables)}" if tables else "no tables"
+    return (
+        f"controller config file {str(path)!r} has no [{controller_name}] table ({has}): {controller_name} runs "
+        "with its default options"
+    )
+
+
 def read_controller_config(
     path: str | Path | None,
     controller_name: str,
     config_type: type,
     overrides: Iterable[str] = (),
     geometry: VehicleGeometry | None = None,
+    warn: Callable[[str], None] | None = None,
 ) -> Any:
     """The config of `controller_name` from the table of that name in the TOML file at `path` (None: no file),
-    with `overrides` applied on top; file options read into objects (`build_config`)."""
+    with `overrides` applied on top; file options read into objects (`build_config`). The file is checked as
+    `read_config_tables` does; `warn` (None: silent) is told when it has no table for the controller
+    (`missing_table_warning`)."""
     table: Mapping[str, Any] = {}
     base_dir = None
     if path is not None:
         path = Path(path)
-        document = read_toml(path, f"controller config file {str(path)!r}")
-        table = document.get(controller_name, {})
-        if not isinstance(table, dict):
-            raise WorkbenchInputError(
-                f"controller config file {str(path)!r}: [{controller_name}] must be a table; got {table!r}"
-            )
+        tables = read_config_tables(path)
+        table = tables.get(controller_name, {})
+        warning = _missing_table_text(path, controller_name, tables)
+        if warning is not None and warn is not None:
+            warn(warning)
         base_dir = path.resolve().parent
     try:
         return build_config(config_type, table, overrides, base_dir, geometry)

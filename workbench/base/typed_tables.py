@@ -3,8 +3,9 @@
 Controller configs, vehicle presets, lead-filter files and study specs all read tables whose keys must be a
 dataclass's fields (or a fixed set) and whose values must have each field's type. This module is the one home of
 those rules: `check_keys` refuses unknown and missing keys with the allowed list; `typed_value` converts a value
-strictly (an integer is taken for a float, nothing else is converted; non-finite numbers are refused) or, for text
-from a command line, parses it; `dataclass_from_table` does both for a dataclass. Every problem is a
+strictly (an integer is taken for a float, nothing else is converted: the text `"0.1"` or `"false"` in a file is
+refused, naming the key, the value and the type; non-finite numbers are refused) or, for text from a command line
+(`--set`), parses it; `dataclass_from_table` does both for a dataclass. Every problem is a
 WorkbenchInputError naming the key, the value and what is allowed.
 
 Field types handled: float, int, bool, str, Path (relative to a base folder), and any of them `| None` (written
@@ -75,7 +76,9 @@ def typed_value(where: str, value: Any, annotation: Any, base_dir: Path | None =
         raise WorkbenchInputError(f"{where} has type {annotation!r}, which cannot be given in a file")
     parsed = _parsed(base, value, text if from_text else None)
     if parsed is None:
-        raise WorkbenchInputError(f"{where} must be a {type_name(annotation)}; got {value_text(value)}")
+        quoted = text is not None and base in (float, int, bool) and _parsed(base, value, text) is not None
+        hint = " (a file's numbers and booleans are written without quotes)" if quoted else ""
+        raise WorkbenchInputError(f"{where} must be a {type_name(annotation)}; got {value_text(value)}{hint}")
     if base is float and not math.isfinite(parsed):
         raise WorkbenchInputError(f"{where} must be a finite number; got {value_text(value)}")
     if base is Path:

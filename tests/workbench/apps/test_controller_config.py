@@ -11,7 +11,12 @@ from controllers import CONTROLLERS
 from controllers.clothoid import ClothoidConfig
 from controllers.clothoid.filter_schedule import DEFAULT_FILTER
 from tuning.filter_file import read_filter_file, write_filter_file
-from workbench.apps.controller_config import build_config, config_template, read_controller_config
+from workbench.apps.controller_config import (
+    build_config,
+    config_template,
+    missing_table_warning,
+    read_controller_config,
+)
 from workbench.base.errors import WorkbenchInputError
 
 
@@ -70,3 +75,119 @@ def test_every_controller_template_reads_back_to_its_defaults(name: str, tmp_pat
     path = tmp_path / "template.toml"
     path.write_text(text)
     assert read_controller_config(path, name, config_type) == config_type()
+
+
+@pytest.mark.parametrize(
+    ("text", "needle"),
+    [
+        ("[stanly]\ngain_per_s = 3.0\n", r"\[stanly\] names no controller; did you mean \[stanley\]\?"),
+        ("[Clothoid]\nfrechet_threshold_m = 0.1\n", r"\[Clothoid\] names no controller; did you mean \[clothoid\]\?"),
+        ("[nothing-alike]\n", r"\[nothing-alike\] names no controller; the tables a file may hold: \[clothoid\]"),
+        ("frechet_threshold_m = 0.1\n[clothoid]\n", r"frechet_threshold_m = 0\.1 outside any table"),
+    ],
+)
+def test_tables_naming_no_controller_and_keys_outside_tables_are_refused(
+    text: str, needle: str, tmp_path: Path
+) -> None:
+    path = tmp_path / "options.toml"
+    path.write_text(text)
+    with pytest.raises(WorkbenchInputError, match=r"options\.toml'.*" + needle):
+        read_controller_config(path, "clothoid", ClothoidConfig)
+
+
+def test_other_controllers_tables_are_allowed_and_a_missing_table_is_warned_about(tmp_path: Path) -> None:
+    path = tmp_path / "options.toml"
+    path.write_text("[stanley]\ngain_per_s = 3.0\n\n[pure-pursuit]\nlookahead_gain_s = 0.5\n")
+    warnings: list[str] = []
+    assert read_controller_config(path, "clothoid", ClothoidConfig, warn=warnings.append) == ClothoidConfig()
+    assert warnings == [
+        f"controller config file {str(path)!r} has no [clothoid] table (only [stanley], [pure-pursuit]): clothoid "
+        "runs with its default options"
+    ]
+    stanley = CONTROLLERS["stanley"].config_type
+    assert read_controller_config(path, "stanley", stanley, warn=warnings.append).gain_per_s == 3.0
+    assert len(warnings) == 1  # its table is there: no warning
+    empty = tmp_path / "empty.toml"
+    empty.write_text("")
+    assert "has no [stanley] table (no tables)" in str(missing_table_warning(empty, "stanley"))
+
+
+@pytest.mark.parametrize(
+    ("line", "message"),
+    [
+        ('frechet_threshold_m = "0.1"', "option 'frechet_threshold_m' must be a number; got '0.1' (a file's numbers"),
+        ('use_lead_filter = "false"', "option 'use_lead_filter' must be a boolean; got 'false' (a file's numbers"),
+        ("use_lead_filter = 0", "option 'use_lead_filter' must be a boolean; got 0"),
+        ("lookahead_mode = 3", "option 'lookahead_mode' must be a text; got 3"),
+    ],
+)
+def test_a_files_values_are_taken_as_typed_not_parsed_from_text(line: str, message: str, tmp_path: Path) -> None:
+    path = tmp_path / "options.toml"
+    path.write_text(f"[clothoid]\n{line}\n")
+    with pytest.raises(WorkbenchInputError) as info:
+        read_controller_config(path, "clothoid", ClothoidConfig)
+    assert f"[clothoid]: {message}" in str(info.value)
+
+
+def test_override_text_is_parsed() -> None:
+    overrides = ["frechet_threshold_m=0.1", "use_lead_filter=false"]
+    config = read_controller_config(None, "clothoid", ClothoidConfig, overrides)
+    assert config.frechet_threshold_m == pytest.approx(0.1, abs=0.0) and config.use_lead_filter is False
+
+
+def test_run_warns_of_a_file_without_its_table_and_refuses_a_misspelt_one(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from workbench.apps.cli import main
+
+    shared = tmp_path / "pp.toml"
+    shared.write_text("[pure-pursuit]\nlookahead_gain_s = 0.5\n")
+    argv = ["run", "dlc", "--controller", "stanley", "--out", str(tmp_path / "out"), "--no-plots", "--max-time-s", "1"]
+    main([*argv, "--controller-config", str(shared)])
+    err = capsys.readouterr().err
+    assert "workbench: warning: controller config file" in err and "has no [stanley] table (only [pure-pursuit])" in err
+    misspelt = tmp_path / "bad.toml"
+    misspelt.write_text("[stanly]\ngain_per_s = 3.0\n")
+    assert main([*argv, "--overwrite", "--controller-config", str(misspelt)]) == 2
+    err = capsys.readouterr().err
+    assert "workbench: error: " in err and "[stanly] names no controller; did you mean [stanley]?" in err
+
+
+def test_compare_checks_both_forms_of_its_config_files(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    from workbench.apps.cli import main
+
+    shared = tmp_path / "pp.toml"
+    shared.write_text("[pure-pursuit]\nlookahead_gain_s = 0.5\n")
+    misspelt = tmp_path / "bad.toml"
+    misspelt.write_text("[pure-pursuit]\n[Stanley]\n")
+    # A missing --track stops compare after its configs are checked: no run is needed to see the warning.
+    argv = ["compare", "dlc", "--controllers", "stanley,pure-pursuit", "--out", str(tmp_path / "out")]
+    argv += ["--track", str(tmp_path / "none.csv")]
+    assert main([*argv, "--controller-config", str(shared)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("workbench: warning:") == 1 and "has no [stanley] table (only [pure-pursuit])" in err
+    for form in (str(misspelt), f"pure-pursuit={misspelt}"):
+        assert main([*argv, "--controller-config", form]) == 2
+        assert "[Stanley] names no controller; did you mean [stanley]?" in capsys.readouterr().err
+    # Its own file for stanley: no warning about the shared file's missing table.
+    own = tmp_path / "stanley.toml"
+    own.write_text("[stanley]\ngain_per_s = 2.0\n")
+    assert main([*argv, "--controller-config", str(shared), "--controller-config", f"stanley={own}"]) == 2
+    assert "warning" not in capsys.readouterr().err
+
+
+def test_a_study_specs_controller_config_is_checked_alike(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    from workbench.apps.studies import load_spec
+
+    spec = tmp_path / "spec.toml"
+    study = '[study]\nscenarios = ["dlc"]\ncontrollers = ["stanley"]\nvehicles = ["kinematic-bicycle"]\n'
+    spec.write_text(study + 'controller_config = "options.toml"\n')
+    (tmp_path / "options.toml").write_text("[stanly]\ngain_per_s = 3.0\n")
+    with pytest.raises(WorkbenchInputError, match=r"\[stanly\] names no controller; did you mean \[stanley\]\?"):
+        load_spec(spec)
+    (tmp_path / "options.toml").write_text('[stanley]\ngain_per_s = "3.0"\n')
+    with pytest.raises(WorkbenchInputError, match=r"option 'gain_per_s' must be a number; got '3\.0'"):
+        load_spec(spec)
+    (tmp_path / "options.toml").write_text("[pure-pursuit]\n")
+    load_spec(spec)
+    assert "has no [stanley] table (only [pure-pursuit])" in capsys.readouterr().err

@@ -15,6 +15,8 @@ from hypothesis import strategies as st
 from workbench.base.errors import WorkbenchInputError
 from workbench.base.typed_tables import check_keys, dataclass_from_table, type_name, typed_value
 
+QUOTED = " (a file's numbers and booleans are written without quotes)"
+
 
 @dataclass(frozen=True)
 class _Options:
@@ -37,7 +39,10 @@ def test_values_of_the_right_type_are_taken(value: object, annotation: object, e
 @pytest.mark.parametrize(
     ("value", "annotation", "message"),
     [
-        ("0.5", float, "k must be a number; got '0.5'"),  # text only from a command line
+        ("0.5", float, f"k must be a number; got '0.5'{QUOTED}"),  # text only from a command line
+        ("7", int, f"k must be a whole number; got '7'{QUOTED}"),
+        ("false", bool, f"k must be a boolean; got 'false'{QUOTED}"),
+        ("maybe", bool, "k must be a boolean; got 'maybe'"),  # no hint where the text is no boolean either
         (True, float, "k must be a number; got True"),
         (2.0, int, "k must be a whole number; got 2.0"),
         (1, bool, "k must be a boolean; got 1"),
@@ -90,3 +95,20 @@ def test_a_dataclass_from_a_table_uses_its_defaults_and_its_field_types(tmp_path
     with pytest.raises(WorkbenchInputError, match=r"^opts: missing key 'gain'"):
         dataclass_from_table(_Options, {}, "opts", required=True)
     assert type_name(Path | None) == 'file path or "none"'
+
+
+def test_every_toml_loader_takes_a_files_values_as_typed(tmp_path: Path) -> None:
+    """Vehicle and conditions files refuse a quoted number as controller configs and study specs do
+    (tests/workbench/apps/test_controller_config.py)."""
+    from workbench.simulation.conditions import conditions_to_toml, load_conditions
+    from workbench.vehicles.presets import load_vehicle, preset_text
+
+    vehicle = tmp_path / "car.toml"
+    vehicle.write_text(preset_text("kinematic-bicycle").replace("width_m = 1.61 ", 'width_m = "1.61" '))
+    with pytest.raises(WorkbenchInputError, match=r"\[parameters\]: 'width_m' must be a number; got '1\.61'"):
+        load_vehicle(str(vehicle))
+    conditions = tmp_path / "conditions.toml"
+    text = conditions_to_toml(load_conditions("automotive"))
+    conditions.write_text(text.replace("friction_scale = 1.0", 'friction_scale = "1.0"'))
+    with pytest.raises(WorkbenchInputError, match=r"\[road\]: 'friction_scale' must be a number; got '1\.0'"):
+        load_conditions(conditions)

@@ -521,8 +521,10 @@ class StudySpec:
     def _check_files(self, models: Mapping[str, Any]) -> None:
         """Read every file the runs will read, as they will: the controller-config file for each controller
         (its keys and values), waypoint and track files, and each file a controller option names (in the config
-        file, the grid or a choice). A WorkbenchInputError names the key and the file."""
+        file, the grid or a choice). A WorkbenchInputError names the key and the file; a controller-config file
+        without a controller's table is warned about on stderr (`controller_config.missing_table_warning`)."""
         from workbench.apps.controller_config import read_controller_config
+        from workbench.base.console import warn_on_stderr
         from workbench.simulation.scenarios import make_scenario
 
         for scenario in self.scenarios:
@@ -543,7 +545,7 @@ class StudySpec:
             file_options = [k for k, t in params.items() if unwrap(t)[0] is Path]
             # Its file options are read here, into the config's objects, as a run will read them.
             config_type = CONTROLLERS[controller].config_type
-            read_controller_config(self.controller_config, controller, config_type, (), geometry)
+            read_controller_config(self.controller_config, controller, config_type, (), geometry, warn_on_stderr)
             named: list[tuple[str, str, Any]] = []
             for where, table in (("grid", self.controller_grid), ("random", self.controller_random)):
                 for key, values in table.get(controller, {}).items():
