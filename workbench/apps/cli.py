@@ -504,15 +504,17 @@ def _compare(args: argparse.Namespace) -> int:
 
 
 def _paper(args: argparse.Namespace) -> int:
-    from workbench.apps.paper import reproduce_paper
+    from workbench.apps.paper import reproduce_paper, zandvoort_skip_reason
     from workbench.base.output_dir import OutputDir
-    from workbench.simulation.scenarios import ScenarioOptions, make_scenario
+    from workbench.simulation.scenarios import ScenarioOptions
 
     out = OutputDir(args.out, "paper", args.overwrite)
     _check_inputs(args)
     options = ScenarioOptions(track_file=args.track)
-    if args.track is not None:
-        make_scenario("zandvoort", options)  # a track that cannot be used is refused before any work
+    if args.track is not None:  # a track that cannot be used is refused, and another track named, before any work
+        why_not = zandvoort_skip_reason(options)
+        if why_not is not None:
+            warn_on_stderr(f"skipping {why_not}")
     with _writing(out):
         result = reproduce_paper(args.out, options)
     print(result.table.to_string(index=False, float_format=lambda v: f"{v:.3g}"))

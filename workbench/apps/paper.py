@@ -11,7 +11,8 @@ Shaju, Southward & Ahmadian (2024), all on the loaded tractor-semitrailer at 30 
   10   Bode plot of lag, lead filter and cascade                (tuning.lead_design)
   11-16 the clothoid controller on the figure-8, the DLC and Zandvoort: (a) tracked trajectory, (b) CTE against
        time; then (a) speed against arc length, (b) steering-wheel angle against time.
-Zandvoort (Figures 15, 16 and its table row) needs the TUMFTM track file and is skipped, saying so, without it.
+Zandvoort (Figures 15, 16 and its table row) needs the TUMFTM track file and is skipped, saying so, without it
+or when the file given or found is another (`zandvoort_skip_reason`).
 
 Beside the PNGs and paper_vs_ours.csv (the values the paper reports, ours beside them) it writes report.html: one
 self-contained page (figures embedded, as the other reports) with each figure under the paper's caption, what the
@@ -39,7 +40,13 @@ from workbench.apps.lookahead_study import frechet_vs_lookahead, min_frechet_vs_
 from workbench.base.errors import WorkbenchInputError
 from workbench.simulation import plots
 from workbench.simulation.result import SimulationResult
-from workbench.simulation.scenarios import ZANDVOORT_ENV, ScenarioOptions, make_scenario, zandvoort_track_file
+from workbench.simulation.scenarios import (
+    ZANDVOORT_ENV,
+    ScenarioOptions,
+    is_zandvoort_file,
+    make_scenario,
+    zandvoort_track_file,
+)
 from workbench.simulation.simulator import Simulation, SimulationConfig
 from workbench.vehicles import make_vehicle
 
@@ -379,14 +386,11 @@ def reproduce_paper(
     show = sys.stderr.isatty() if progress is None else progress
     skipped = []
     scenarios = ["figure8", "dlc"]
-    if _track_given(options):  # a track given must be usable: a broken one is refused before any work
-        make_scenario("zandvoort", options)
+    why_not = zandvoort_skip_reason(options)
+    if why_not is None:
         scenarios.append("zandvoort")
     else:
-        skipped.append(
-            "Figures 15-16 and the Zandvoort row: no track file (give --track or $WORKBENCH_ZANDVOORT_CSV, or put "
-            "Zandvoort_track.csv in ./tracks or ../shared/tracks)"
-        )
+        skipped.append(why_not)
     out.mkdir(parents=True, exist_ok=True)
     steps: list[tuple[str, Callable[[], StepOutput]]] = [
         ("Figures 4b-5b: lookahead", lambda: _lookahead_figures(out)),
@@ -424,6 +428,27 @@ def reproduce_paper(
     return result
 
 
+def zandvoort_skip_reason(options: ScenarioOptions) -> str | None:
+    """Why Figures 15-16 and the Zandvoort row cannot be given, or None when they can: the paper's verdict on
+    Zandvoort is given for the TUMFTM Zandvoort file only (`scenarios.is_zandvoort_file`), never for another file
+    given or found in its place, which is named instead. A track file given must be usable: a broken one is refused
+    (WorkbenchInputError) before any work."""
+    if not _track_given(options):
+        return (
+            "Figures 15-16 and the Zandvoort row: no track file (give --track or $WORKBENCH_ZANDVOORT_CSV, or put "
+            "Zandvoort_track.csv in ./tracks or ../shared/tracks)"
+        )
+    track = zandvoort_track_file(options.track_file)
+    make_scenario("zandvoort", options)
+    if is_zandvoort_file(track):
+        return None
+    return (
+        f"Figures 15-16 and the Zandvoort row: the track file {track} is not the TUMFTM Zandvoort track (its "
+        f"SHA-256 differs), and the paper's Zandvoort results are compared on that track only; `workbench run "
+        f"{track}` runs the controller on this one"
+    )
+
+
 def _track_given(options: ScenarioOptions) -> bool:
     """Whether there is a Zandvoort track file: given (`--track` or $WORKBENCH_ZANDVOORT_CSV; then it must be
     usable, checked by the caller) or found where `scenarios.zandvoort_track_file` looks."""
@@ -444,4 +469,5 @@ __all__ = [
     "reproduce_paper",
     "speed_at_largest_curvature_rate_mps",
     "write_paper_report",
+    "zandvoort_skip_reason",
 ]

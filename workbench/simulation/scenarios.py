@@ -41,6 +41,10 @@ ZANDVOORT_SOURCE = (
     "the TUMFTM racetrack-database file tracks/Zandvoort.csv "
     "(https://github.com/TUMFTM/racetrack-database/blob/master/tracks/Zandvoort.csv, LGPL-3.0)"
 )
+#: SHA-256 (hex) of the bytes of that file (the database's commit e59595d1f3573b30d1ded6a08984935b957688e0, also
+#: ../shared/tracks/Zandvoort_track.csv): the one track file the `zandvoort` scenario is named after and the
+#: paper's Zandvoort figures and verdict are given for. Any other file given for it is run under its own name.
+ZANDVOORT_SHA256 = "f3f2a82c9f41bcee8d7161a6ad6c0b8e6d4b902dd772459918c9fe7f7451bc59"
 
 
 @dataclass(frozen=True)
@@ -268,10 +272,25 @@ def zandvoort(options: ScenarioOptions) -> Scenario:
 
     The file is third-party data (LGPL-3.0) and is not shipped: pass it with --track FILE, set the environment
     variable WORKBENCH_ZANDVOORT_CSV, or keep it where `zandvoort_track_file` looks (tracks/ of the current
-    directory, ../shared/tracks/ beside the checkout).
+    directory, ../shared/tracks/ beside the checkout). Only that file (recognised by `is_zandvoort_file`, its
+    content's digest) makes the scenario named "zandvoort"; any other waypoint file given for it is read as it is
+    and named by the file (its stem), so that no result on another track is labelled, or judged, as Zandvoort.
     """
-    scenario = from_file(_zandvoort_track(options), options)
+    track = _zandvoort_track(options)
+    scenario = from_file(track, options)
+    if not is_zandvoort_file(track):
+        return dataclasses.replace(scenario, description=_zandvoort_description(options))
     return Scenario("zandvoort", scenario.path, _zandvoort_description(options))
+
+
+def is_zandvoort_file(track_file: Path) -> bool:
+    """Whether this file holds exactly the bytes of the TUMFTM Zandvoort track file (SHA-256 `ZANDVOORT_SHA256`)."""
+    import hashlib
+
+    try:
+        return hashlib.sha256(Path(track_file).read_bytes()).hexdigest() == ZANDVOORT_SHA256
+    except OSError as exc:
+        raise WorkbenchInputError(f"zandvoort: cannot read the track file {str(track_file)!r} ({exc})") from None
 
 
 def zandvoort_places() -> list[Path]:
@@ -315,6 +334,11 @@ def _zandvoort_track(options: ScenarioOptions) -> Path:
 
 def _zandvoort_description(options: ScenarioOptions) -> str:
     track = _zandvoort_track(options)
+    if not is_zandvoort_file(track):
+        return (
+            f"waypoints from {track}, given for zandvoort but not the TUMFTM Zandvoort track file (its SHA-256 "
+            f"differs), so named {track.stem} and compared with none of the paper's Zandvoort results"
+        )
     return f"Zandvoort (TUMFTM racetrack-database centre line and track widths, closed loop) from {track}"
 
 

@@ -66,3 +66,26 @@ def test_paper_writes_every_figure_and_the_table(with_track: bool, tmp_path: Pat
     assert ("Figure 15</h2>" in report) == with_track and ("Skipped: Figures 15-16" in report) != with_track
     for quantity, (reported, _) in PAPER_REPORTS.items():  # under its figure (if drawn), our number beside it
         assert (html.escape(f"{quantity}: {reported}") in report) == (with_track or "zandvoort" not in quantity)
+
+
+def test_paper_names_another_track_and_gives_it_no_verdict(tmp_path: Path, capsys, monkeypatch) -> None:
+    """`paper --track good.csv` (a 60 m line): said before any work to be another track than the paper's, by its
+    file; Figures 15-16 and the Zandvoort row are skipped for it, naming it."""
+    from workbench.apps import paper
+    from workbench.apps.paper import PaperResult, zandvoort_skip_reason
+
+    good = tmp_path / "good.csv"
+    good.write_text("x,y\n" + "".join(f"{x},0\n" for x in range(0, 61, 5)))
+    seen = []
+
+    def reproduce(out_dir: Path, options) -> PaperResult:  # the figures themselves: test_paper_writes_every_figure
+        seen.append(zandvoort_skip_reason(options))
+        return PaperResult([], pd.DataFrame({"quantity": []}), [seen[-1]])
+
+    monkeypatch.setattr(paper, "reproduce_paper", reproduce)
+    assert main(["paper", "--out", str(tmp_path / "out"), "--track", str(good)]) == 0
+    captured = capsys.readouterr()
+    expected = f"Figures 15-16 and the Zandvoort row: the track file {good} is not the TUMFTM Zandvoort track"
+    assert seen[0].startswith(expected)
+    assert captured.err.startswith(f"workbench: warning: skipping {expected}")
+    assert f"skipped: {expected}" in captured.out
