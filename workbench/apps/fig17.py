@@ -85,12 +85,22 @@ PAPER_STATEMENTS: tuple[tuple[str, str, str, str, str], ...] = (
 )
 
 
+#: The step-time columns, the replication's headline (section 6.6: the clothoid controller's cost against the MPC's).
+STEP_TIME_COLUMNS = ("step_time_ratio", "step_time_median_us", "step_time_p99_us")
+
+
 def _fig17_columns() -> tuple[tuple[str, str], ...]:
-    """The report's columns with max |CTE| named as the start offset it is, and the approach's overshoot and the
-    max |CTE| once converged beside the distance to converge."""
+    """The report's columns: the step times first after the run's status (the headline, in view without scrolling),
+    max |CTE| named as the start offset it is, and the approach's overshoot and the max |CTE| once converged beside
+    the distance to converge."""
+    titles = dict(TABLE_COLUMNS)
     columns = []
     for key, title in TABLE_COLUMNS:
+        if key in STEP_TIME_COLUMNS:
+            continue
         columns.append((key, "max |CTE| (m; the 1 m start offset)" if key == "max_abs_cte_m" else title))
+        if key == "status":
+            columns += [(step, titles[step]) for step in STEP_TIME_COLUMNS]
         if key == "converge_distance_m":
             columns += [
                 ("overshoot_m", "overshoot (m)"),

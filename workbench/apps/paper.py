@@ -328,13 +328,13 @@ def figure_number(path: Path) -> int:
 
 
 def _report_figure_section(number: int, pngs: list[Path], table: pd.DataFrame, note: str | None) -> list[str]:
-    from workbench.apps.report import png_figure, text_table
+    from workbench.apps.report import number_text, png_figure, text_table
 
     caption, said = PAPER_FIGURES[number]
     rows = [{"the paper": said, "ours": note or "see the figure"}]
     for row in table.itertuples():
         if re.search(rf"\bFigure {number}[ab]?\b", row.paper):
-            ours = "–" if pd.isna(row.ours) else f"{row.ours:.3g} {row.unit}"
+            ours = number_text(row.ours) + ("" if pd.isna(row.ours) else f" {row.unit}")
             rows.append({"the paper": f"{row.quantity}: {row.paper}", "ours": ours})
     parts = [
         f"<h2 id='fig{number}'>Figure {number}</h2>",
@@ -353,11 +353,10 @@ def write_paper_report(path: Path, result: PaperResult) -> Path:
     for file in result.files:
         if file.suffix == ".png":
             by_figure.setdefault(figure_number(file), []).append(file)
-    shown = result.table.assign(ours=[_number(v) for v in result.table["ours"]])
     body = [
         "<h2>Our numbers beside the paper's</h2>",
         "<p>The values the paper's text reports (section 6), ours on the open truck model (paper_vs_ours.csv).</p>",
-        text_table(shown),
+        text_table(result.table),
         *(f"<p class='warning'>Skipped: {html.escape(reason)}.</p>" for reason in result.skipped),
         "<p>" + " · ".join(f"<a href='#fig{n}'>Figure {n}</a>" for n in sorted(by_figure)) + "</p>",
     ]
@@ -369,10 +368,6 @@ def write_paper_report(path: Path, result: PaperResult) -> Path:
     )
     path.write_text(html_page("The paper's figures, regenerated", body, intro), encoding="utf-8")
     return path
-
-
-def _number(value: float) -> str:
-    return "–" if pd.isna(value) else f"{value:.3g}"
 
 
 def reproduce_paper(

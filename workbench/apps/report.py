@@ -19,12 +19,14 @@ import base64
 import html
 import io
 import math
+import re
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from datetime import UTC, datetime
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+import numpy as np
 import pandas as pd
 
 from workbench.apps.comparison import CONVERGED_CTE_M, FIGURES, Comparison
@@ -57,12 +59,18 @@ TABLE_COLUMNS: tuple[tuple[str, str], ...] = (
 #: size (one to a row) so that its legend reads as it was drawn.
 FIGURE_DPI = 100
 
+#: Class of the element every table of a page sits in: it scrolls sideways when the table is wider than the page,
+#: so the page itself never does (`html_page` puts each table in one).
+TABLE_SCROLL_CLASS = "table-scroll"
+
 _STYLE = """
-body { font-family: system-ui, sans-serif; margin: 2em auto; max-width: 72em; color: #222; }
-table { border-collapse: collapse; margin: 1em 0; font-size: 0.9em; }
-th, td { border: 1px solid #bbb; padding: 0.3em 0.6em; text-align: right; }
-th { background: #eee; } td:nth-child(-n+3) { text-align: left; }
-table.text td { text-align: left; vertical-align: top; }
+body { font-family: system-ui, sans-serif; margin: 2em auto; padding: 0 1.5em; max-width: 110em; color: #222; }
+p, ul, h1, h2, figcaption { max-width: 72em; }
+.table-scroll { overflow-x: auto; max-width: 100%; margin: 1em 0; }
+table { border-collapse: collapse; font-size: 0.85em; font-variant-numeric: tabular-nums; }
+th, td { border: 1px solid #bbb; padding: 0.2em 0.35em; text-align: right; }
+th { background: #eee; vertical-align: bottom; } td:nth-child(-n+3) { text-align: left; }
+table.text th, table.text td { text-align: left; vertical-align: top; } table.text td.number { text-align: right; }
 figure { display: block; margin: 1em 0; } img { max-width: 100%; }
 figcaption { font-size: 0.9em; color: #444; }
 .failed, .warning { color: #b00; }
@@ -103,11 +111,36 @@ class ReportSection:
     figures: tuple[ReportFigure, ...] = field(default=())
 
 
-def _cell(value: object) -> str:
-    if value is None or (isinstance(value, float) and math.isnan(value)):
-        return "–"
-    if isinstance(value, float):
-        return f"{value:.3g}" if abs(value) < 1000 else f"{value:.0f}"
+#: What a table shows for a missing number (None or NaN), unless the table says otherwise.
+MISSING = "–"
+#: Numbers from this magnitude on are shown whole, their thousands grouped (12,345 rather than 1.23e+04).
+WHOLE_FROM = 999.5
+
+
+def number_text(value: float | None, missing: str = MISSING) -> str:
+    """A number as a table shows it: three significant digits (0.0466, 23.8, 269), whole with its thousands grouped
+    from WHOLE_FROM on (1,234), `missing` for None or NaN."""
+    if value is None or math.isnan(value):
+        return missing
+    if abs(value) >= WHOLE_FROM:
+        return f"{value:,.0f}"
+    return f"{value:.3g}"
+
+
+def _is_number(value: object) -> bool:
+    """Whether a cell holds a number (not a flag: True shows as True)."""
+    return isinstance(value, float | int | np.number) and not isinstance(value, bool | np.bool_)
+
+
+def _is_missing(value: object) -> bool:
+    return value is None or value is pd.NA or (_is_number(value) and math.isnan(float(value)))  # type: ignore[arg-type]
+
+
+def _cell(value: object, missing: str = MISSING) -> str:
+    if _is_missing(value):
+        return missing
+    if _is_number(value):
+        return number_text(float(value), missing)  # type: ignore[arg-type]
     return html.escape(str(value))
 
 
@@ -129,12 +162,16 @@ def _table(summary: pd.DataFrame, cycles: Sequence[LimitCycle], columns: Sequenc
     return f"<table><tr>{head}</tr>{''.join(rows)}</table>{notes}"
 
 
-def text_table(frame: pd.DataFrame) -> str:
-    """A table of text cells (escaped), its columns as headings; NaN shows as a dash."""
+def text_table(frame: pd.DataFrame, missing: str = MISSING) -> str:
+    """A table of text cells (escaped) and numbers (`number_text`, right-aligned), its columns as headings; a missing
+    number shows as `missing`."""
     head = "".join(f"<th>{html.escape(str(c))}</th>" for c in frame.columns)
-    rows = "".join(
-        "<tr>" + "".join(f"<td>{_cell(v)}</td>" for v in row) + "</tr>" for row in frame.itertuples(index=False)
-    )
+
+    def cell(value: object) -> str:
+        numeric = _is_missing(value) or _is_number(value)
+        return f"<td class='number'>{_cell(value, missing)}</td>" if numeric else f"<td>{_cell(value)}</td>"
+
+    rows = "".join("<tr>" + "".join(cell(v) for v in row) + "</tr>" for row in frame.itertuples(index=False))
     return f"<table class='text'><tr>{head}</tr>{rows}</table>"
 
 
@@ -155,8 +192,19 @@ def figure_png(fig: Figure) -> bytes:
     return buffer.getvalue()
 
 
+_TABLE = re.compile(r"<table\b.*?</table>", re.DOTALL | re.IGNORECASE)
+
+
+def scrolling_tables(body: str) -> str:
+    """body with each table put in a TABLE_SCROLL_CLASS element, which scrolls sideways when the table is wider than
+    the page (tables are not nested in these reports: each runs to its first closing tag)."""
+    return _TABLE.sub(lambda table: f'<div class="{TABLE_SCROLL_CLASS}">{table.group(0)}</div>', body)
+
+
 def html_page(title: str, body: Sequence[str], intro: str = "") -> str:
-    """A whole HTML document: the title, the intro (plain), when it was generated, then the body's parts (HTML)."""
+    """A whole HTML document: the title, the intro (plain), when it was generated, then the body's parts (HTML), each
+    of its tables in a sideways-scrolling element (`scrolling_tables`). Every report of the workbench is written as
+    such a page, so that no table runs off the page."""
     parts = [
         "<!DOCTYPE html>",
         '<html lang="en"><head><meta charset="utf-8">',
@@ -164,7 +212,7 @@ def html_page(title: str, body: Sequence[str], intro: str = "") -> str:
         f"<h1>{html.escape(title)}</h1>",
         f"<p>{html.escape(intro)}</p>" if intro else "",
         f"<p><small>Generated {datetime.now(UTC):%Y-%m-%d %H:%M} UTC by the lateral-control workbench.</small></p>",
-        *body,
+        *(scrolling_tables(part) for part in body),
         "</body></html>",
     ]
     return "\n".join(p for p in parts if p)
@@ -260,14 +308,19 @@ def write_report(
 
 __all__ = [
     "FIGURE_DPI",
+    "MISSING",
     "TABLE_COLUMNS",
+    "TABLE_SCROLL_CLASS",
+    "WHOLE_FROM",
     "ReportFigure",
     "ReportSection",
     "ReportTable",
     "figure_png",
     "html_page",
+    "number_text",
     "png_figure",
     "render_report",
+    "scrolling_tables",
     "text_table",
     "write_report",
 ]

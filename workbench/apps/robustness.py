@@ -8,16 +8,11 @@ which each controller stops completing or starts to limit-cycle.
 
 from __future__ import annotations
 
-import base64
 import dataclasses
-import html
-import io
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
-from datetime import UTC, datetime
 from pathlib import Path
-from typing import Any
 
 import pandas as pd
 
@@ -199,39 +194,24 @@ class RobustnessResult:
         return fig
 
     def report_html(self) -> str:
-        """The self-contained report (figures embedded as base64 PNG)."""
-        import matplotlib.pyplot as plt
+        """The self-contained report (figures embedded as base64 PNG), a page of `report.html_page`."""
+        from workbench.apps.report import figure_png, html_page, png_figure, text_table
 
         title = f"Robustness: {', '.join(self.controllers)} on {self.vehicle}, {self.scenario}"
-        parts = [
-            "<!DOCTYPE html>",
-            '<html lang="en"><head><meta charset="utf-8">',
-            f"<title>{html.escape(title)}</title><style>{_STYLE}</style></head><body>",
-            f"<h1>{html.escape(title)}</h1>",
-            f"<p>Target speed {self.speed_kmh:g} km/h; each factor varied on its own around the base conditions "
-            f"<b>{html.escape(self.conditions)}</b>. A run passes when it completes, its steering does not "
-            f"limit-cycle and its max |CTE| stays within {self.max_cte_m:g} m.</p>",
-            f"<p><small>Generated {datetime.now(UTC):%Y-%m-%d %H:%M} UTC by the lateral-control workbench.</small></p>",
-            "<h2>Where each controller stops passing</h2>",
-            _html_table(self.tolerance()),
-        ]
+        intro = (
+            f"Target speed {self.speed_kmh:g} km/h; each factor varied on its own around the base conditions "
+            f"{self.conditions}. A run passes when it completes, its steering does not limit-cycle and its max |CTE| "
+            f"stays within {self.max_cte_m:g} m."
+        )
+        parts = ["<h2>Where each controller stops passing</h2>", text_table(self.tolerance(), missing="none")]
         mismatch = self.mismatch()
         if len(mismatch):
-            parts += ["<h2>Payload mismatch</h2>", _html_table(mismatch)]
+            parts += ["<h2>Payload mismatch</h2>", text_table(mismatch, missing="none")]
         for axis in self.axes:
             if all(len(self.axis_rows(axis, c)) <= 1 for c in self.controllers):
                 continue  # not varied (the friction of a model without tyres)
-            fig = self.figure(axis)
-            buffer = io.BytesIO()
-            fig.savefig(buffer, format="png", dpi=90)
-            plt.close(fig)
-            alt = html.escape(f"degradation against {axis.label}")
-            png = base64.b64encode(buffer.getvalue()).decode("ascii")
-            parts.append(
-                f'<figure><img alt="{alt}" src="data:image/png;base64,{png}"><figcaption>{alt}</figcaption></figure>'
-            )
-        parts.append("</body></html>")
-        return "\n".join(parts)
+            parts.append(png_figure(figure_png(self.figure(axis)), f"degradation against {axis.label}"))
+        return html_page(title, parts, intro)
 
     def save(self, out_dir: str | Path) -> list[Path]:
         """DIR/report.html and DIR/tolerance.csv (results.parquet is written as the runs finish)."""
@@ -240,26 +220,6 @@ class RobustnessResult:
         report.write_text(self.report_html(), encoding="utf-8")
         self.tolerance().to_csv(table, index=False)
         return [report, table]
-
-
-_STYLE = (
-    "body{font-family:sans-serif;max-width:1300px;margin:2em auto;color:#222}"
-    "table{border-collapse:collapse;margin:1em 0}td,th{border:1px solid #bbb;padding:3px 8px;text-align:right}"
-    "th{background:#eee}figure{margin:1em 0}img{max-width:100%}"
-)
-
-
-def _html_table(frame: pd.DataFrame) -> str:
-    def cell(value: Any) -> str:
-        if value is None or (isinstance(value, float) and math.isnan(value)):
-            return "none"
-        if isinstance(value, float):
-            return f"{value:.3g}"
-        return html.escape(str(value))
-
-    head = "".join(f"<th>{html.escape(str(c))}</th>" for c in frame.columns)
-    body = "".join("<tr>" + "".join(f"<td>{cell(v)}</td>" for v in row) + "</tr>" for row in frame.itertuples(False))
-    return f"<table><tr>{head}</tr>{body}</table>"
 
 
 def run_robustness(

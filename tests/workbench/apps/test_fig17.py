@@ -15,6 +15,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
 import pytest
+from report_helpers import tables_scrolling
 
 from workbench.apps.cli import main
 from workbench.apps.fig17 import (
@@ -122,6 +123,15 @@ def test_the_report_names_the_start_offset_and_shows_the_convergence_view(fig17:
     assert list(fair["max |CTE| after convergence (m)"]) == [
         f"{v:.3g}" for v in summary["max_abs_cte_after_convergence_m"]
     ]
+
+
+def test_the_tables_scroll_in_the_page_and_show_the_step_times_first(fig17: SimpleNamespace) -> None:
+    """The step-time columns (the headline) follow the run's status, in view at the table's left; every table sits
+    in the element that scrolls it sideways when it is wider than the page."""
+    page = (fig17.out / "report.html").read_text(encoding="utf-8")
+    assert tables_scrolling(page) == [True, True, True]  # beside the paper, published, fair
+    for table in list(_tables(page).values())[1:]:
+        assert list(table.columns)[2:6] == ["status", "step time / clothoid's", "step median (µs)", "step p99 (µs)"]
 
 
 def test_the_published_ratio_is_over_the_clothoid_on_the_same_plant(fig17: SimpleNamespace) -> None:

@@ -7,6 +7,7 @@ from pathlib import Path
 
 import pandas as pd
 import pytest
+from report_helpers import tables_scrolling
 
 from workbench.apps.cli import main
 from workbench.apps.robustness import AXES, Axis, RobustnessResult, plan_robustness
@@ -61,6 +62,12 @@ def test_the_tolerance_is_the_last_value_passed_going_outward_and_says_why_it_fa
     assert pd.isna(_result([_row(None), _row(0.1)]).tolerance().iloc[0]["fails_at"])
 
 
+def test_the_report_is_a_page_of_the_report_writer_its_tables_scrolling() -> None:
+    page = _result([_row(None), _row(0.1)]).report_html()
+    assert page.startswith("<!DOCTYPE html>") and tables_scrolling(page) == [True]
+    assert "<td class='number'>none</td>" in page  # never failed: no value it fails at
+
+
 def test_the_command_runs_the_study_and_writes_a_self_contained_report(tmp_path: Path, capsys) -> None:
     out = tmp_path / "rob"
     code = main(
@@ -82,6 +89,7 @@ def test_the_command_runs_the_study_and_writes_a_self_contained_report(tmp_path:
     assert code == 0
     report = (out / "report.html").read_text()
     assert "data:image/png;base64," in report and "http" not in report.split("<body>")[1]
+    assert tables_scrolling(report) and all(tables_scrolling(report))  # each table scrolls inside the page
     results = pd.read_parquet(out / "results.parquet")
     assert len(results) == len(plan_robustness("dlc", ["stanley"], "kinematic-bicycle"))
     tolerance = pd.read_csv(out / "tolerance.csv")
