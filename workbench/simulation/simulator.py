@@ -30,10 +30,11 @@ from workbench.simulation.control_interface import (
 from workbench.simulation.feasibility import VehicleLimits, check_path, feasibility_warnings
 from workbench.simulation.result import SimulationResult, Status
 from workbench.simulation.run_config import SimulationConfig
+from workbench.simulation.run_size import RunSize
 from workbench.simulation.scenarios import Scenario
 from workbench.simulation.sensing import ActuatorModel, SensorModel
 from workbench.simulation.speed_control import PISpeedController, PISpeedGains
-from workbench.simulation.speed_profile import G_MPS2, SpeedLimits, plan_speed_profile
+from workbench.simulation.speed_profile import G_MPS2, SpeedLimits, TopSpeed, TopSpeedLimit, plan_speed_profile
 from workbench.simulation.step_kernel import (
     FOOT_AT_END,
     FOOT_DISTANCE,
@@ -54,20 +55,20 @@ from workbench.vehicles.base import VehicleModel
 
 #: Spacing (m) of the points the speed profile is planned on (the paper plans on its waypoints).
 SPEED_PLAN_SPACING_M = 1.0
-#: A run that may take more controller steps than this before its time-out is announced with a warning (at 50 Hz
-#: about 83 simulated minutes; a dlc at 30 km/h may take 5 700, a Zandvoort lap 79 000).
-LONG_RUN_STEPS = 250_000
 #: The first seven of a vehicle's outputs (`STANDARD_OUTPUTS`: x, y, yaw, vx, vy, yaw rate, steering-wheel angle),
 #: what the measurement holds: indexed, as numpy scalars, at half the cost of unpacking a slice.
 _MEASURED = operator.itemgetter(0, 1, 2, 3, 4, 5, 6)
-#: Trace columns besides the vehicle's outputs, estimated generously for the trace-size warning: the simulator's
-#: 11 signals and up to 29 controller diagnostics (`ctrl_*`).
-EXTRA_TRACE_COLUMNS = 40
 
 
 def plan_path_speed(path: ReferencePath, config: SimulationConfig) -> ReferencePath:
     """The path carrying the planned speed: the paper's smart velocity waypoints (section 6), capped by any speed
-    the path's waypoints already carry."""
+    the path's waypoints already carry (`plan_path_speed_and_top`)."""
+    return plan_path_speed_and_top(path, config)[0]
+
+
+def plan_path_speed_and_top(path: ReferencePath, config: SimulationConfig) -> tuple[ReferencePath, TopSpeed]:
+    """The path carrying the planned speed (`plan_path_speed`) and its top speed with what limited it: the speed
+    profile's (`SpeedProfile.top_speed`), or the path's own speeds where they lower the top."""
     n = max(3, math.ceil(path.length_m / SPEED_PLAN_SPACING_M))
     s_plan = np.linspace(0.0, path.length_m, n + 1)
     if path.closed:
@@ -93,8 +94,13 @@ def plan_path_speed(path: ReferencePath, config: SimulationConfig) -> ReferenceP
                 f"{path.name}: the path's speed must be > 0 m/s everywhere (a run follows it without stopping); "
                 f"it is {float(path.speed_mps[i]):g} m/s at s = {float(path.s_m[i]):.1f} m"
             )
-        speed = np.minimum(speed, path.speed_mps)
-    return path.with_speed(speed)
+        capped = np.minimum(speed, path.speed_mps)
+        if capped.max() < speed.max() * (1.0 - 1e-9):
+            i = int(np.argmax(capped))
+            top = TopSpeed(limits.max_speed_mps, float(capped[i]), float(path.s_m[i]), TopSpeedLimit.PATH_SPEED, limits)
+            return path.with_speed(capped), top
+        speed = capped
+    return path.with_speed(speed), profile.top_speed()
 
 
 class Simulation:
@@ -111,32 +117,30 @@ class Simulation:
         self.vehicle = vehicle
         self.controller = controller
         self.config = config or SimulationConfig()
-        self.path = plan_path_speed(scenario.path, self.config)
+        if self.config.laps > 1 and not scenario.path.closed:
+            raise WorkbenchInputError(
+                f"laps = {self.config.laps}: {scenario.path.name} is an open path (it has two ends); laps apply to "
+                "closed paths only, so give 1"
+            )
+        self.path, self.top_speed = plan_path_speed_and_top(scenario.path, self.config)
+        #: The most this run may simulate before it times out (`run_size.RunSize`: time, steps, trace size).
+        self.size = RunSize.of(self.path, self.config, len(vehicle.output_names))
         #: Where the vehicle cannot follow the path at its planned speed (`feasibility.py`), said before the run
         #: and written to metrics.json.
         self.infeasible_curvature = check_path(self.path, vehicle)
 
     def warnings(self, label: str = "the run") -> list[str]:
-        """What to tell a person before this run: `path_warnings` and `long_run_warning`."""
-        long_run = self.long_run_warning(label)
-        return self.path_warnings() + ([long_run] if long_run is not None else [])
+        """What to tell a person before this run: `path_warnings`, and the planned top speed when it falls short of
+        the speed asked for (`top_speed_warning`)."""
+        top = self.top_speed_warning(label)
+        return self.path_warnings() + ([top] if top is not None else [])
 
-    def long_run_warning(self, label: str = "the run") -> str | None:
-        """A warning for a run that may take more than LONG_RUN_STEPS controller steps before its time-out (a very
-        low speed, many laps): the simulated time, the steps and the trace's size (rows x columns x 8 bytes, the
-        columns estimated generously), and what shortens it; None for a run of ordinary length."""
-        steps = self.max_steps
-        if steps <= LONG_RUN_STEPS:
+    def top_speed_warning(self, label: str = "the run") -> str | None:
+        """The planned top speed and what limited it, when it falls short of the speed asked for (`TopSpeed`);
+        None when the profile reaches it."""
+        if self.top_speed.reached:
             return None
-        columns = len(self.vehicle.output_names) + EXTRA_TRACE_COLUMNS
-        size = steps * columns * 8
-        size_text = f"{size / 1e9:,.1f} GB" if size >= 1e9 else f"{size / 1e6:,.0f} MB"
-        return (
-            f"{label} may simulate up to {_duration_text(self.max_time_s)} "
-            f"({steps:,} controller steps at {self.config.controller_rate_hz:g} Hz) before it times out, with a "
-            f"trace of up to {steps:,} rows x about {columns} columns (about {size_text} at 8 bytes a value); it may "
-            f"take a long time. A higher --speed (now {self.config.speed_kmh:g} km/h) or fewer --laps shortens it"
-        )
+        return f"{label}: {self.top_speed.describe()}"
 
     def path_warnings(self) -> list[str]:
         """What about the path this vehicle cannot do, to say before the run: stretches curving tighter than its
@@ -151,14 +155,14 @@ class Simulation:
 
     @property
     def max_time_s(self) -> float:
-        """Simulated time before the run times out: the config's, or three times the planned time plus 30 s."""
-        mean_speed = float(np.mean(self.path.speed_mps))
-        return self.config.max_time_s or 3.0 * self.total_length_m / mean_speed + 30.0
+        """Simulated time before the run times out: the config's, or three times the planned time plus 30 s
+        (`RunSize`)."""
+        return self.size.max_time_s
 
     @property
     def max_steps(self) -> int:
         """Controller steps the run may take before its time-out: the trace's row capacity."""
-        return math.ceil(self.max_time_s * self.config.controller_rate_hz) + 1
+        return self.size.steps
 
     def run(self, progress: bool = False) -> SimulationResult:
         """Simulate until the run ends (the module docstring says how); `progress` shows the metres covered on a bar.
@@ -301,16 +305,6 @@ def _projection_end(where: int, foot: list[float], t: float, cfg: SimulationConf
             f"|CTE| = {distance:.1f} m exceeds max_abs_cte_m = {cfg.max_abs_cte_m:g} m at t = {t:.2f} s"
         )
     return Status.COMPLETED, "completed"
-
-
-def _duration_text(seconds: float) -> str:
-    if seconds < 120:
-        return f"{seconds:.0f} s"
-    if seconds < 2 * 3600:
-        return f"{seconds / 60:.0f} min"
-    if seconds < 2 * 86400:
-        return f"{seconds / 3600:.0f} h"
-    return f"{seconds / 86400:,.0f} days"
 
 
 class _TraceLog:

@@ -11,6 +11,7 @@ first; the path returns from the last point to the first.
 
 from __future__ import annotations
 
+import enum
 import math
 from dataclasses import dataclass, fields
 from typing import TYPE_CHECKING, ClassVar
@@ -141,6 +142,70 @@ def local_quadratic_geometry(
     return s, heading, curvature
 
 
+class TopSpeedLimit(enum.Enum):
+    """What holds a planned profile's top speed where it is: the profile's top waypoint is capped by one of these."""
+
+    #: The top speed asked for (`SpeedLimits.max_speed_mps`) is reached.
+    TARGET = "target"
+    #: The lateral-acceleration bound on the curvature: the path curves even where it is fastest.
+    LATERAL_ACCELERATION = "lateral acceleration"
+    #: The acceleration bound: the path is too short after a slower stretch (or its start) to speed up further.
+    ACCELERATION = "acceleration"
+    #: The braking bound: the path is too short before a slower stretch (or its end) to brake from faster.
+    BRAKING = "braking"
+    #: Both: the stretch between two slower ones is too short to speed up and brake again from faster.
+    ACCELERATION_AND_BRAKING = "acceleration and braking"
+    #: The speeds the path's own waypoints carry (a waypoint file's speed column), below the planned ones.
+    PATH_SPEED = "path speed"
+
+
+@dataclass(frozen=True)
+class TopSpeed:
+    """A planned profile's top speed and what limited it: target_mps, the top speed asked for (m/s); top_mps, the
+    planned top (m/s); s_m, where along the path it is (m); limit, what holds it there; limits, the bounds it was
+    planned with."""
+
+    target_mps: float
+    top_mps: float
+    s_m: float
+    limit: TopSpeedLimit
+    limits: SpeedLimits
+
+    #: A top within this fraction of the target counts as reaching it.
+    REACHED_TOLERANCE: ClassVar[float] = 1e-3
+
+    @property
+    def reached(self) -> bool:
+        """The planned top is the target (within REACHED_TOLERANCE)."""
+        return self.top_mps >= self.target_mps * (1.0 - self.REACHED_TOLERANCE)
+
+    def reason(self) -> str:
+        """What limited the top speed, in words with the bounds' values."""
+        lim = self.limits
+        lateral = f"the lateral-acceleration bound of {lim.max_lateral_accel_mps2 / G_MPS2:.3g} g"
+        if self.limit is TopSpeedLimit.TARGET:
+            return "the target speed"
+        if self.limit is TopSpeedLimit.LATERAL_ACCELERATION:
+            return f"{lateral} on the path's curvature, which curves even where it is fastest"
+        if self.limit is TopSpeedLimit.ACCELERATION:
+            return f"the acceleration bound of {lim.max_accel_mps2:g} m/s^2 after the curves slowed by {lateral}"
+        if self.limit is TopSpeedLimit.BRAKING:
+            return f"the braking bound of {lim.max_decel_mps2:g} m/s^2 before the curves ahead, slowed by {lateral}"
+        if self.limit is TopSpeedLimit.ACCELERATION_AND_BRAKING:
+            return (
+                f"the acceleration and braking bounds ({lim.max_accel_mps2:g} and {lim.max_decel_mps2:g} m/s^2) "
+                f"between the curves slowed by {lateral}"
+            )
+        return "the speeds the path's waypoints carry"
+
+    def describe(self) -> str:
+        """E.g. "target 200 km/h, planned top 69.6 km/h at s = 0 m (limited by ...)"."""
+        return (
+            f"target {self.target_mps * 3.6:.4g} km/h, planned top {self.top_mps * 3.6:.3g} km/h at s = "
+            f"{self.s_m:.0f} m (limited by {self.reason()})"
+        )
+
+
 @dataclass(frozen=True)
 class SpeedProfile:
     """Planned speed at every waypoint.
@@ -148,7 +213,7 @@ class SpeedProfile:
     s_m: path distance of each waypoint (m); speed_mps: planned speed (m/s); curvature_1pm: estimated
     curvature (1/m, left positive); closed: the path is a loop; limits: the limits it was planned for;
     length_m: total path length (m), for loops including the segment from the last waypoint back to the
-    first.
+    first; top_limit: what holds the top speed (`TopSpeedLimit`; `top_speed()`).
     """
 
     s_m: np.ndarray
@@ -157,6 +222,7 @@ class SpeedProfile:
     closed: bool
     limits: SpeedLimits
     length_m: float
+    top_limit: TopSpeedLimit = TopSpeedLimit.TARGET
 
     _ARRAYS: ClassVar[tuple[str, ...]] = ("s_m", "speed_mps", "curvature_1pm")
 
@@ -172,6 +238,15 @@ class SpeedProfile:
             require_finite(f"SpeedProfile.{name}", arr)
             object.__setattr__(self, name, arr)
         require_in_range("SpeedProfile.length_m", self.length_m, float(arrays["s_m"][-1]), math.inf, "m")
+        if not isinstance(self.top_limit, TopSpeedLimit):
+            raise WorkbenchInputError(f"SpeedProfile.top_limit must be a TopSpeedLimit; got {self.top_limit!r}")
+
+    def top_speed(self) -> TopSpeed:
+        """The planned top speed, where it is and what limited it."""
+        i = int(np.argmax(self.speed_mps))
+        return TopSpeed(
+            self.limits.max_speed_mps, float(self.speed_mps[i]), float(self.s_m[i]), self.top_limit, self.limits
+        )
 
     def speed_at(self, s_m: float | np.ndarray) -> float | np.ndarray:
         """Planned speed (m/s) at path distance s_m (m), linearly interpolated between waypoints.
@@ -206,11 +281,37 @@ def _forward_pass(v2_cap: np.ndarray, s: np.ndarray, accel: float) -> np.ndarray
     return np.minimum(v2_cap, np.concatenate(([np.inf], 2.0 * accel * s[1:] + reach[:-1])))
 
 
-def _forward_backward(v2_cap: np.ndarray, ds: np.ndarray, limits: SpeedLimits) -> np.ndarray:
-    """Squared speeds under the cap after the forward (acceleration) and backward (braking) passes."""
+def _forward_backward(v2_cap: np.ndarray, ds: np.ndarray, limits: SpeedLimits) -> tuple[np.ndarray, np.ndarray]:
+    """Squared speeds under the cap after the forward (acceleration) pass, and after the backward (braking) pass
+    too."""
     s = np.concatenate(([0.0], np.cumsum(ds)))
     w = _forward_pass(v2_cap, s, limits.max_accel_mps2)
-    return _forward_pass(w[::-1], s[-1] - s[::-1], limits.max_decel_mps2)[::-1]
+    return w, _forward_pass(w[::-1], s[-1] - s[::-1], limits.max_decel_mps2)[::-1]
+
+
+def _top_limit(
+    v2_cap: np.ndarray, forward: np.ndarray, v2: np.ndarray, v2_max: float, closed: bool
+) -> TopSpeedLimit:
+    """What holds the top of a planned profile (squared speeds: the cap, after the forward pass, final) where it
+    is: the target, the cap there (the lateral bound; an open path's initial or final speed asked for counts as
+    that cap), or the acceleration ramp rising into it and/or the braking ramp falling from it (on waypoints the
+    two ramps meet between the top and a neighbour, so the ramp into the top is looked for at it and the waypoint
+    before, the ramp out of it at it and the waypoint after)."""
+    i = int(np.argmax(v2))
+    close = 1.0 - 1e-9
+    if v2[i] >= v2_max * close:
+        return TopSpeedLimit.TARGET
+    if v2[i] >= v2_cap[i] * close:
+        return TopSpeedLimit.LATERAL_ACCELERATION
+    n = v2.size
+    before, after = ((i - 1) % n, (i + 1) % n) if closed else (max(i - 1, 0), min(i + 1, n - 1))
+    braking = v2 < forward * close  # the backward pass lowered these
+    accelerating = (forward < v2_cap * close) & ~braking  # the forward pass holds these
+    up = bool(accelerating[i] or accelerating[before])
+    down = bool(braking[i] or braking[after])
+    if up and down:
+        return TopSpeedLimit.ACCELERATION_AND_BRAKING
+    return TopSpeedLimit.BRAKING if down else TopSpeedLimit.ACCELERATION
 
 
 def plan_speed_profile(
@@ -249,9 +350,9 @@ def plan_speed_profile(
             )
         # Neither pass can lower the slowest waypoint, so one lap starting and ending there is exact.
         order = np.roll(np.arange(x.size), -int(np.argmin(v2_cap)))
-        lap = _forward_backward(np.append(v2_cap[order], v2_cap[order[0]]), ds[order], limits)
-        v2 = np.empty_like(lap[:-1])
-        v2[order] = lap[:-1]
+        lap_forward, lap = _forward_backward(np.append(v2_cap[order], v2_cap[order[0]]), ds[order], limits)
+        v2, forward = np.empty_like(lap[:-1]), np.empty_like(lap[:-1])
+        v2[order], forward[order] = lap[:-1], lap_forward[:-1]
     else:
         for name, cap, index in (
             ("initial_speed_mps", initial_speed_mps, 0),
@@ -260,7 +361,8 @@ def plan_speed_profile(
             if cap is not None:
                 require_in_range(name, cap, v_min, v_max, "m/s")
                 v2_cap[index] = min(v2_cap[index], float(cap) ** 2)
-        v2 = _forward_backward(v2_cap, ds, limits)
+        forward, v2 = _forward_backward(v2_cap, ds, limits)
 
     length = float(s[-1] + ds[-1]) if closed else float(s[-1])
-    return SpeedProfile(s, np.sqrt(v2), curvature, closed, limits, length)
+    top_limit = _top_limit(v2_cap, forward, v2, v_max**2, closed)
+    return SpeedProfile(s, np.sqrt(v2), curvature, closed, limits, length, top_limit)
