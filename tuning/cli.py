@@ -12,7 +12,7 @@
 
 Every input file and output file is checked before any work (`workbench.base.input_files`, `workbench.base.output_dir`):
 a missing or unreadable input, a folder where a file is wanted, a parent that is a file, an unwritable folder or
-file are refused.
+file are refused, and so is an output file that exists already unless --overwrite is given.
 
 `tuning --version` (as `workbench --version`: `workbench.base.version`) prints the installed distribution's
 version and, run from a git checkout, its commit.
@@ -75,6 +75,14 @@ def _geometry_options(parser: argparse.ArgumentParser) -> None:
 
 def _format_option(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--format", choices=FORMATS, help="file format (default: by the --out suffix, .json or .toml)")
+
+
+def _overwrite_option(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--overwrite",
+        action="store_true",
+        help="replace output files (--out, --plot, ...) that exist already (default: an existing one is refused)",
+    )
 
 
 def _design_options(parser: argparse.ArgumentParser) -> None:
@@ -142,6 +150,7 @@ def _parser(command: str | None = None) -> argparse.ArgumentParser:
         )
         gen.add_argument("--sample-rate-hz", type=float, default=100.0, help="log sample rate (default 100 Hz)")
         gen.add_argument("--out", type=Path, required=True, metavar="FILE.csv", help="output CSV")
+        _overwrite_option(gen)
 
     fit = sub.add_parser("fit-lag", help="fit the steering lag of Eq. 5 to vehicle logs; write lag.json")
     if _builds(command, "fit-lag"):
@@ -150,6 +159,7 @@ def _parser(command: str | None = None) -> argparse.ArgumentParser:
         fit.add_argument("logs", type=Path, nargs="+", metavar="FILE.csv", help="vehicle logs at one speed")
         fit.add_argument("--out", type=Path, required=True, metavar="lag.json", help="output steering-lag file")
         fit.add_argument("--plot", type=Path, metavar="FILE.png", help="Figure 8: kinematic, actual, with lag")
+        _overwrite_option(fit)
         _geometry_options(fit)
         fit.add_argument(
             "--curvature-from",
@@ -173,6 +183,7 @@ def _parser(command: str | None = None) -> argparse.ArgumentParser:
         lead.add_argument("--out", type=Path, required=True, metavar="lead.json", help="output lead-filter file")
         _format_option(lead)
         lead.add_argument("--plot", type=Path, metavar="FILE.png", help="Figure 10: Bode of plant, filter, cascade")
+        _overwrite_option(lead)
         _design_options(lead)
         lead.add_argument(
             "--phase-at-rad-s", type=float, help="report the phases at this frequency (default: the plant's bandwidth)"
@@ -191,6 +202,7 @@ def _parser(command: str | None = None) -> argparse.ArgumentParser:
         roll.add_argument("--speeds", required=True, metavar="10,20,...,100", help="speeds, km/h")
         roll.add_argument("--out", type=Path, required=True, metavar="limits.csv", help="output curvature-limits CSV")
         roll.add_argument("--plot", type=Path, metavar="FILE.png", help="Figure 6")
+        _overwrite_option(roll)
 
     steer = sub.add_parser(
         "steering-limits",
@@ -209,6 +221,7 @@ def _parser(command: str | None = None) -> argparse.ArgumentParser:
             help=f"lateral-acceleration bound (default {DEFAULT_LIMIT_LATERAL_ACCEL_G:g} g, the controller's default)",
         )
         steer.add_argument("--out", type=Path, required=True, metavar="limits.csv", help="output curvature-limits CSV")
+        _overwrite_option(steer)
 
     sched = sub.add_parser("schedule", help="lag and lead filter at each speed; write a scheduled lead-filter file")
     if _builds(command, "schedule"):
@@ -218,6 +231,7 @@ def _parser(command: str | None = None) -> argparse.ArgumentParser:
         sched.add_argument("--speeds", required=True, metavar="20,30,...,90", help="speeds, km/h")
         sched.add_argument("--out", type=Path, required=True, metavar="schedule.json", help="output lead-filter file")
         _format_option(sched)
+        _overwrite_option(sched)
         sched.add_argument(
             "--delay",
             action="store_true",
@@ -259,8 +273,8 @@ def _parser(command: str | None = None) -> argparse.ArgumentParser:
             "--nominal-speed",
             type=float,
             metavar="KMH",
-            help="speed of the top-level filter and of --compare's fixed filter (default: the first speed; with "
-            "--compare, 30 km/h, the paper's, when it is one of the speeds)",
+            help="speed of the top-level filter and of --compare's fixed filter, one of --speeds (default: the first "
+            "speed; with --compare, 30 km/h, the paper's, when it is one of the speeds)",
         )
         _design_options(sched)
         sched.add_argument("--plot", type=Path, metavar="FILE.png", help="lag and filter against speed")
@@ -320,8 +334,9 @@ def _prepare(path: Path) -> Path:
 
 
 def _check_paths(args: argparse.Namespace) -> None:
-    """Every input file must be a readable file and every output file writable (INPUT_FILES, OUTPUT_FILES; and the
-    default place of design-lead's validation figure): checked before any work."""
+    """Every input file must be a readable file and every output file writable and, without --overwrite, not there
+    yet (INPUT_FILES, OUTPUT_FILES; and the default place of design-lead's validation figure): checked before any
+    work."""
     from workbench.base.input_files import check_input_file
     from workbench.base.output_dir import check_output_file
 
@@ -332,9 +347,9 @@ def _check_paths(args: argparse.Namespace) -> None:
     for dest, flag in OUTPUT_FILES.items():
         value = getattr(args, dest, None)
         if value is not None:
-            check_output_file(value, flag)
+            check_output_file(value, flag, args.overwrite)
     if getattr(args, "validate", None) and getattr(args, "validate_plot", None) is None:
-        check_output_file(_validation_plot(args.out), "the --validate figure")
+        check_output_file(_validation_plot(args.out), "the --validate figure", args.overwrite)
 
 
 def _validation_plot(out: Path) -> Path:
@@ -356,10 +371,11 @@ def _read_lag(flag: str, path: Path):
 
 
 def _generate_data(args: argparse.Namespace) -> int:
-    from tuning.data_generation import generate_open_loop_log
+    from tuning.data_generation import check_log_size, generate_open_loop_log
     from tuning.maneuvers import Maneuver
     from tuning.schedule import steer_amplitude_deg
 
+    check_log_size(args.duration_s, args.sample_rate_hz, names=("--duration-s", "--sample-rate-hz"))
     vehicle = _vehicle(args)
     amplitude = args.amplitude_deg if args.amplitude_deg is not None else 90.0
     if args.lat_accel_g is not None:
@@ -508,7 +524,7 @@ def _steering_limits(args: argparse.Namespace) -> int:
 def _schedule(args: argparse.Namespace) -> int:
     from tuning.filter_comparison import compare_closed_loop, fixed_and_scheduled_filters, scheduled_against_fixed
     from tuning.lag_fit import LagFitOptions
-    from tuning.schedule import PAPER_SPEED_KMH, identify_schedule
+    from tuning.schedule import PAPER_SPEED_KMH, SPEED_MATCH_KMH, identify_schedule
     from tuning.speeds import parse_speeds
 
     out = _filter_path(args)
@@ -518,10 +534,16 @@ def _schedule(args: argparse.Namespace) -> int:
     nominal = args.nominal_speed
     if compare_speeds and nominal is None and PAPER_SPEED_KMH in speeds:
         nominal = PAPER_SPEED_KMH  # the paper's fixed filter
-    if compare_speeds and nominal not in speeds:
+    if compare_speeds and nominal is None:
         raise WorkbenchInputError(
             f"--compare needs --nominal-speed, one of the --speeds {speeds}, for the fixed filter to compare with "
             f"(default {PAPER_SPEED_KMH:g} km/h, the paper's, when it is one of them)"
+        )
+    if nominal is not None and not any(abs(nominal - s) <= SPEED_MATCH_KMH for s in speeds):
+        raise WorkbenchInputError(
+            f"--nominal-speed {nominal:g} km/h is not one of the --speeds ({', '.join(f'{s:g}' for s in speeds)} "
+            "km/h); the nominal (top-level) filter is the one designed at one of the speeds identified: give one "
+            "of them, or add it to --speeds"
         )
     with _progress_bar(len(speeds), "speed", "tuning schedule") as bar:
         bar.set_postfix_str(f"{speeds[0]:g} km/h")
@@ -546,8 +568,8 @@ def _schedule(args: argparse.Namespace) -> int:
             controller_rate_hz=args.controller_rate_hz,
             prediction_time_s=args.prediction_time_s,
         )
-    if compare_speeds and nominal not in result.speeds_kmh:
-        raise WorkbenchInputError(f"--compare: the nominal speed {nominal:g} km/h was dropped from the schedule")
+    if nominal is not None:
+        result.entry_at(nominal, "--nominal-speed")  # dropped by --drop-refused: refused, saying why
     result.write(_prepare(out), nominal_speed_kmh=nominal)
     print(result.table())
     print(f"wrote {out}")
@@ -630,6 +652,7 @@ def _add_margins_parser(sub: argparse._SubParsersAction, command: str | None = N
     )
     marg.add_argument("--out", type=Path, required=True, metavar="margins.csv", help="output table (CSV)")
     marg.add_argument("--plot", type=Path, metavar="FILE.png", help="margins against lookahead per speed")
+    _overwrite_option(marg)
     marg.add_argument("--prediction-time-s", type=float, default=0.2, help="pose prediction (default 0.2 s)")
     marg.add_argument("--controller-rate-hz", type=float, default=50.0, help="controller rate (default 50 Hz)")
     marg.add_argument(

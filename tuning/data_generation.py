@@ -14,11 +14,53 @@ import pandas as pd
 
 from tuning.log_file import LOG_COLUMNS
 from tuning.maneuvers import Maneuver
-from workbench.base.errors import require_in_range
+from workbench.base.errors import WorkbenchInputError, require_in_range, require_positive, value_text
 from workbench.simulation.speed_control import PISpeedController
 from workbench.vehicles.base import VehicleModel
 
-__all__ = ["LOG_COLUMNS", "generate_open_loop_log"]
+__all__ = ["LOG_COLUMNS", "MAX_LOG_SAMPLES", "MAX_PLANT_STEPS", "check_log_size", "generate_open_loop_log"]
+
+#: Rate (Hz) the plant is integrated at while a log is generated.
+PLANT_RATE_HZ = 1000.0
+#: Most rows (samples) a generated log may hold: 7 columns of 8 bytes, 112 MB in memory (about 5.6 h at 100 Hz).
+MAX_LOG_SAMPLES = 2_000_000
+#: Most plant steps (log samples x plant steps per sample) a generated log may take: the steering profile is
+#: evaluated at each (8 bytes a step, 80 MB), and they are integrated one by one, about 15 us a step on the
+#: truck (10 000 s of driving at 1 kHz: a few minutes).
+MAX_PLANT_STEPS = 10_000_000
+
+
+def _planned_steps(duration_s: float, sample_rate_hz: float, plant_rate_hz: float) -> tuple[int, int]:
+    """(log samples, plant steps) of a log of duration_s sampled at sample_rate_hz (`generate_open_loop_log`'s
+    grid: 0 to duration_s inclusive, plant_rate_hz / sample_rate_hz plant steps a sample, at least one)."""
+    samples = math.floor(duration_s * sample_rate_hz + 0.5) + 1
+    return samples, samples * max(1, round(plant_rate_hz / sample_rate_hz))
+
+
+def check_log_size(
+    duration_s: float,
+    sample_rate_hz: float,
+    plant_rate_hz: float = PLANT_RATE_HZ,
+    names: tuple[str, str] = ("duration_s", "sample_rate_hz"),
+) -> None:
+    """Refuse, before anything is allocated, a log longer than MAX_LOG_SAMPLES samples or MAX_PLANT_STEPS plant
+    steps: the planned samples, steps and memory, the longest duration allowed at this rate, and the options
+    (`names`: how the caller calls duration_s and sample_rate_hz) that shorten it."""
+    duration_name, rate_name = names
+    require_positive(duration_name, duration_s)
+    require_in_range(rate_name, sample_rate_hz, 1.0, 10_000.0, "Hz")
+    samples, steps = _planned_steps(duration_s, sample_rate_hz, plant_rate_hz)
+    if samples <= MAX_LOG_SAMPLES and steps <= MAX_PLANT_STEPS:
+        return
+    per_sample = steps // samples
+    longest_s = min((MAX_LOG_SAMPLES - 1) / sample_rate_hz, (MAX_PLANT_STEPS // per_sample - 1) / sample_rate_hz)
+    memory_gb = (samples * len(LOG_COLUMNS) + steps) * 8 / 1e9
+    raise WorkbenchInputError(
+        f"{duration_name} {value_text(duration_s)} s at {rate_name} {value_text(sample_rate_hz)} Hz plans "
+        f"{samples:,} log samples and {steps:,} plant steps at {plant_rate_hz:g} Hz (about {memory_gb:,.3g} GB); "
+        f"at most {MAX_LOG_SAMPLES:,} samples and {MAX_PLANT_STEPS:,} plant steps, {longest_s:,.6g} s at this rate: "
+        f"give a shorter {duration_name} or a lower {rate_name}"
+    )
 
 
 def generate_open_loop_log(
@@ -26,14 +68,16 @@ def generate_open_loop_log(
     maneuver: Maneuver,
     speed_kmh: float,
     sample_rate_hz: float = 100.0,
-    plant_rate_hz: float = 1000.0,
+    plant_rate_hz: float = PLANT_RATE_HZ,
 ) -> pd.DataFrame:
     """Simulate the maneuver at a held speed (PI speed control) and return the log, one row per sample. The plant
     is driven at plant_rate_hz with the profile at each plant step's midpoint, so that the steering between two
     log samples is the profile's, as a real steering wheel's is (not held from one sample to the next, which would
-    delay the logged steering by half a sample: the fit interpolates the logged steering linearly)."""
+    delay the logged steering by half a sample: the fit interpolates the logged steering linearly). A log longer
+    than `check_log_size` allows is refused before anything is allocated."""
     require_in_range("speed_kmh", speed_kmh, 1e-3, 400.0, "km/h (must be > 0)")
-    require_in_range("sample_rate_hz", sample_rate_hz, 1.0, 10_000.0, "Hz")
+    require_in_range("plant_rate_hz", plant_rate_hz, 1.0, 100_000.0, "Hz")
+    check_log_size(maneuver.duration_s, sample_rate_hz, plant_rate_hz)
     substeps = max(1, round(plant_rate_hz / sample_rate_hz))
     dt = 1.0 / sample_rate_hz
     speed_ref = speed_kmh / 3.6

@@ -14,6 +14,7 @@ import numpy as np
 import pandas as pd
 
 from controllers.clothoid.curvature_limits import RATE_COLUMN, REQUIRED_COLUMNS, CurvatureLimits
+from tuning.csv_columns import column_key, require_unique_columns
 from workbench.base.errors import WorkbenchInputError, value_text
 from workbench.base.input_files import check_input_file
 from workbench.vehicles.geometry import VehicleGeometry
@@ -26,7 +27,8 @@ def read_limits_file(path: str | Path, geometry: VehicleGeometry | None = None) 
         table = pd.read_csv(path, comment="#")
     except (OSError, ValueError, UnicodeDecodeError) as exc:
         raise WorkbenchInputError(f"{path.name}: not a readable CSV file ({exc})") from None
-    table.columns = [str(c).strip().lower() for c in table.columns]
+    require_unique_columns(table.columns, path.name)
+    table.columns = [column_key(c) for c in table.columns]
     missing = [c for c in REQUIRED_COLUMNS if c not in table.columns]
     if missing:
         raise WorkbenchInputError(

@@ -1,7 +1,7 @@
 """The vehicle log: what `tuning generate-data` writes and `tuning fit-lag` / `design-lead --validate` read.
 
 A CSV file with a header row, one row per sample, SI units with the unit in the column name (names are
-case-insensitive, other columns are ignored):
+case-insensitive, each column at most once, other columns are ignored):
 
     t_s              time (s), strictly increasing; uniform sampling is best, jitter is resampled (see below)
     steer_wheel_deg  steering-wheel angle (deg), the steering sensor
@@ -30,6 +30,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from tuning.csv_columns import column_key, require_unique_columns
 from workbench.base.errors import WorkbenchInputError, value_text
 from workbench.base.input_files import check_input_file
 
@@ -82,8 +83,10 @@ class VehicleLog:
 
     @classmethod
     def from_frame(cls, frame: pd.DataFrame, name: str = "log") -> VehicleLog:
-        """Validate a table in the log format (columns above) and return it, uniformly sampled."""
-        columns = {str(c).strip().lower(): c for c in frame.columns}
+        """Validate a table in the log format (columns above) and return it, uniformly sampled. A column named twice
+        is refused (`csv_columns.require_unique_columns`)."""
+        require_unique_columns(frame.columns, name)
+        columns = {column_key(c): c for c in frame.columns}
         missing = [c for c in REQUIRED_COLUMNS if c not in columns]
         has_xy = all(c in columns for c in POSITION_COLUMNS)
         if not has_xy and YAW_RATE_COLUMN not in columns:

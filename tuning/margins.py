@@ -60,6 +60,9 @@ COLUMNS = (
 MAX_CURVATURE_LOOKAHEAD = 1.8
 #: Most lookaheads a study may hold.
 MAX_LOOKAHEADS = 2000
+#: Most (speed, lookahead) pairs a study may analyse: each is one loop analysis per path curvature, about 20 ms
+#: (20 000 pairs about a straight and an arc: some 15 minutes).
+MAX_STUDY_PAIRS = 20_000
 
 
 @dataclass(frozen=True)
@@ -99,6 +102,13 @@ class MarginStudy:
                 require_in_range(name, v, low, high, unit)
         if len(self.lookaheads_m) > MAX_LOOKAHEADS:
             raise WorkbenchInputError(f"lookaheads_m: at most {MAX_LOOKAHEADS}; got {len(self.lookaheads_m)}")
+        pairs = len(self.speeds_kmh) * len(self.lookaheads_m)
+        if pairs > MAX_STUDY_PAIRS:
+            raise WorkbenchInputError(
+                f"{len(self.speeds_kmh)} speeds x {len(self.lookaheads_m)} lookaheads = {pairs:,} cases to analyse; "
+                f"at most {MAX_STUDY_PAIRS:,} (about 20 ms each): fewer speeds (--speeds) or a larger lookahead step "
+                "(--lookahead LOW:HIGH:STEP)"
+            )
         for k in self.path_curvatures_1pm:
             require_in_range("path_curvatures_1pm", k, -1.0, 1.0, "1/m")
         if self.arc_lateral_accel_g is not None:

@@ -48,7 +48,7 @@ from tuning.lead_design import (
 from tuning.log_file import VehicleLog
 from tuning.maneuvers import Maneuver
 from tuning.speeds import check_speeds
-from workbench.base.errors import WorkbenchInputError, require_in_range
+from workbench.base.errors import WorkbenchInputError, require_in_range, value_text
 from workbench.vehicles.base import VehicleModel
 from workbench.vehicles.steering_lag import SteeringLag
 
@@ -71,6 +71,8 @@ MARGINS_LOOKAHEAD_M = (3.0, 40.0, 0.5)
 SPEED_RANGE_KMH = (5.0, 200.0)
 #: The speed the paper tuned its lead filter at: the fixed filter the schedule is compared with by default.
 PAPER_SPEED_KMH = 30.0
+#: Two speeds closer than this (km/h) are the same speed of a schedule (the --speeds and --nominal-speed texts).
+SPEED_MATCH_KMH = 1e-6
 
 
 @dataclass(frozen=True)
@@ -165,6 +167,20 @@ class ScheduleResult:
     def speeds_kmh(self) -> tuple[float, ...]:
         return tuple(e.speed_kmh for e in self.entries)
 
+    def entry_at(self, speed_kmh: float, what: str) -> ScheduleEntry:
+        """The entry identified at speed_kmh (km/h); WorkbenchInputError naming `what`, the speeds kept and, when
+        it was left out (`drop_refused`), why."""
+        for entry in self.entries:
+            if abs(entry.speed_kmh - speed_kmh) <= SPEED_MATCH_KMH:
+                return entry
+        kept = ", ".join(f"{s:g}" for s in self.speeds_kmh)
+        dropped = [d.reason for d in self.dropped if abs(d.speed_kmh - speed_kmh) <= SPEED_MATCH_KMH]
+        why = f" (it was dropped: {dropped[0]})" if dropped else ""
+        raise WorkbenchInputError(
+            f"{what} {value_text(speed_kmh)} km/h is not a speed of the schedule{why}; it must be one of the speeds "
+            f"identified: {kept} km/h"
+        )
+
     def filter_schedule(self) -> FilterSchedule:
         return FilterSchedule(self.speeds_kmh, tuple(e.design.params for e in self.entries), source=self._source())
 
@@ -182,10 +198,11 @@ class ScheduleResult:
 
     def write(self, path: str | Path, nominal_speed_kmh: float | None = None) -> Path:
         """Write the lead-filter file (JSON, or TOML by suffix). The top-level filter and `plant` are those of the
-        speed nearest nominal_speed_kmh (default: the first speed)."""
+        speed nominal_speed_kmh, which must be one of the schedule's speeds (default: the first speed): a filter is
+        designed only at the speeds identified, so another speed's would be a different filter under its name."""
         nominal = self.entries[0]
         if nominal_speed_kmh is not None:
-            nominal = min(self.entries, key=lambda e: abs(e.speed_kmh - nominal_speed_kmh))
+            nominal = self.entry_at(nominal_speed_kmh, "the nominal speed")
         first = self.entries[0].design
         design: dict[str, object] = {"method": first.method, "max_lead_gain": first.max_lead_gain}
         if math.isfinite(first.max_cascade_peak_db):  # the margins design bounds the peak gain only

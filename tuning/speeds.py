@@ -9,14 +9,18 @@ from collections.abc import Sequence
 from workbench.base.errors import WorkbenchInputError, require_in_range
 
 ELLIPSIS = "..."
+#: Most speeds a command sweeps (each is a few seconds of identification or analysis).
 MAX_SPEEDS = 200
 
 
 def check_speeds(speeds_kmh: Sequence[float], low: float, high: float) -> list[float]:
-    """The speeds (km/h) as floats: at least one, each in [low, high], strictly increasing."""
+    """The speeds (km/h) as floats: at least one and at most MAX_SPEEDS, each in [low, high], strictly
+    increasing."""
     speeds = [float(s) for s in speeds_kmh]
     if not speeds:
         raise WorkbenchInputError("give at least one speed")
+    if len(speeds) > MAX_SPEEDS:
+        raise WorkbenchInputError(f"{len(speeds)} speeds given; at most {MAX_SPEEDS}")
     for i, s in enumerate(speeds):
         require_in_range(f"speed {i + 1}", s, low, high, "km/h")
     if any(b <= a for a, b in itertools.pairwise(speeds)):

@@ -10,7 +10,7 @@ import pandas as pd
 import pytest
 
 from tuning.cli import main
-from tuning.data_generation import LOG_COLUMNS, generate_open_loop_log
+from tuning.data_generation import LOG_COLUMNS, MAX_LOG_SAMPLES, MAX_PLANT_STEPS, check_log_size, generate_open_loop_log
 from tuning.maneuvers import Maneuver
 from workbench.base.errors import WorkbenchInputError
 from workbench.vehicles import KinematicBicycle
@@ -129,3 +129,41 @@ def test_cli_writes_a_chirp(tmp_path: Path) -> None:
     log = pd.read_csv(out)
     assert np.max(np.abs(np.diff(log["steer_wheel_deg"]))) / 0.01 <= 100.0 * 1.01
     assert main([*argv[:-2], "--chirp-hz", "fast", "--out", str(out)]) == 2
+
+
+def test_the_log_size_is_bounded_at_its_stated_limits() -> None:
+    # 100 Hz with the plant at 1 kHz: 10 plant steps a sample, so the plant steps bind first: 1e6 samples, 9999.99 s
+    check_log_size(9999.99, 100.0)
+    with pytest.raises(WorkbenchInputError, match=r"1,000,001 log samples and 10,000,010 plant steps"):
+        check_log_size(10_000.0, 100.0)
+    # at 1 kHz and above one plant step a sample: the samples bind
+    check_log_size((MAX_LOG_SAMPLES - 1) / 1000.0, 1000.0)
+    with pytest.raises(WorkbenchInputError, match=f"at most {MAX_LOG_SAMPLES:,} samples and {MAX_PLANT_STEPS:,}"):
+        check_log_size(MAX_LOG_SAMPLES / 1000.0, 1000.0)
+
+
+def test_a_huge_duration_is_refused_before_anything_is_allocated(monkeypatch) -> None:
+    monkeypatch.setattr(np, "arange", lambda *a, **k: pytest.fail("allocated before the size was checked"))
+    maneuver = Maneuver("step", duration_s=1e9)
+    with pytest.raises(WorkbenchInputError, match=r"duration_s 1000000000.0 s at sample_rate_hz 100.0 Hz plans "
+                       r"100,000,000,001 log samples"):  # fmt: skip
+        generate_open_loop_log(KinematicBicycle(), maneuver, 30.0)
+
+
+@pytest.mark.parametrize(
+    ("args", "needle"),
+    [
+        (["--duration-s", "1e9"], "--duration-s 1000000000.0 s at --sample-rate-hz 100.0 Hz plans 100,000,000,001 log "
+         "samples and 1,000,000,000,010 plant steps at 1000 Hz (about 1.36e+04 GB); at most 2,000,000 samples and "
+         "10,000,000 plant steps, 9,999.99 s at this rate: give a shorter --duration-s or a lower --sample-rate-hz"),
+        (["--duration-s", "100", "--sample-rate-hz", "1e5"],
+         "--sample-rate-hz must be in [1.0, 10000.0] Hz; got 100000.0"),
+        (["--duration-s", "inf"], "--duration-s must be a finite number > 0; got inf"),
+        (["--duration-s", "-1"], "--duration-s must be a finite number > 0; got -1.0"),
+    ],
+)  # fmt: skip
+def test_cli_refuses_a_log_too_long_naming_the_options(args: list[str], needle: str, tmp_path: Path, capsys) -> None:
+    argv = ["generate-data", "--vehicle", "kinematic-bicycle", "--maneuver", "step", "--speed", "30", *args]
+    assert main([*argv, "--out", str(tmp_path / "x.csv")]) == 2
+    assert capsys.readouterr().err == f"tuning: error: {needle}\n"
+    assert not (tmp_path / "x.csv").exists()

@@ -38,6 +38,8 @@ def test_csv_without_rate_column_takes_the_rate_from_the_vehicle(tmp_path: Path)
         ("speed_kmh,max_curvature_1pm\n10,0.1\n5,0.2\n", "increase strictly"),
         ("speed_kmh,max_curvature_1pm\n10,-0.1\n", "must be finite and > 0"),
         ("speed_kmh,max_curvature_1pm\n", "one curvature and one rate per speed"),
+        ("speed_kmh,max_curvature_1pm,max_curvature_1pm\n10,0.1,0.2\n", "column 'max_curvature_1pm' appears 2 times"),
+        ("speed_kmh,max_curvature_1pm,Speed_kmh\n10,0.1,20\n", "column 'speed_kmh' appears 2 times"),
     ],
 )
 def test_bad_tables_are_rejected(text: str, needle: str, tmp_path: Path) -> None:

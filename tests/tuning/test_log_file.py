@@ -86,3 +86,25 @@ def test_unreadable_and_absent_files(tmp_path: Path) -> None:
     (tmp_path / "one.csv").write_text("t_s,steer_wheel_deg,speed_mps,yaw_rate_rad_s\n0,1,10,0\n")
     with pytest.raises(WorkbenchInputError, match="1 row"):
         read_log(tmp_path / "one.csv")
+
+
+@pytest.mark.parametrize(
+    ("header", "column"),
+    [
+        ("t_s,steer_wheel_deg,speed_mps,yaw_rate_rad_s,speed_mps", "speed_mps"),  # read as speed_mps.1
+        ("t_s,steer_wheel_deg,speed_mps,yaw_rate_rad_s,SPEED_MPS", "speed_mps"),  # names are case-insensitive
+        ("t_s,steer_wheel_deg,speed_mps,yaw_rate_rad_s, Speed_mps ", "speed_mps"),  # and stripped
+        ("t_s,steer_wheel_deg,speed_mps,yaw_rate_rad_s,note,note", "note"),  # an ignored column too: ambiguous
+    ],
+)
+def test_a_column_named_twice_is_refused_naming_it(tmp_path: Path, header: str, column: str) -> None:
+    rows = "".join(f"{0.01 * i:.2f},{i % 7},10,0.1,10,{i}\n" for i in range(300))
+    (tmp_path / "twice.csv").write_text(header + "\n" + rows)
+    with pytest.raises(WorkbenchInputError, match=rf"twice\.csv: column '{column}' appears 2 times"):
+        read_log(tmp_path / "twice.csv")
+
+
+def test_a_column_named_like_a_repeat_of_no_column_is_kept(tmp_path: Path) -> None:
+    rows = "".join(f"{0.01 * i:.2f},{i % 7},10,0.1,{i}\n" for i in range(300))
+    (tmp_path / "dotted.csv").write_text("t_s,steer_wheel_deg,speed_mps,yaw_rate_rad_s,gps.1\n" + rows)
+    assert len(read_log(tmp_path / "dotted.csv")) == 300

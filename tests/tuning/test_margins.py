@@ -19,8 +19,9 @@ from controllers.clothoid.lead_filter import LeadFilterParams
 from controllers.clothoid.loop_analysis import LoopSettings, PlantLags, lookahead_floor, loop_margins, loop_transfer
 from tuning.cli import main
 from tuning.filter_file import write_filter_file
-from tuning.margins import COLUMNS, G_MPS2, MarginStudy, run_margins
+from tuning.margins import COLUMNS, G_MPS2, MAX_LOOKAHEADS, MAX_STUDY_PAIRS, MarginStudy, run_margins
 from tuning.own_tuning import tuning_for
+from workbench.base.errors import WorkbenchInputError
 from workbench.vehicles import make_vehicle
 from workbench.vehicles.steering_lag import SteeringLag, write_lag_file
 
@@ -170,6 +171,8 @@ def test_study_predicts_limit_cycles_where_the_loop_is_unstable() -> None:
         (["--lag", "LAG", "--controller-rate-hz", "0"], "--controller-rate-hz"),
         (["--lag", "LAG", "--arc-lateral-accel-g", "-1"], "--arc-lateral-accel-g"),
         (["--lag", "LAG", "--phase-margin-deg", "inf"], "--phase-margin-deg"),
+        (["--lag", "LAG", "--speeds", "1,2,...,200", "--lookahead", "3:40:0.25"],
+         "200 speeds x 149 lookaheads = 29,800 cases to analyse; at most 20,000 (about 20 ms each): fewer speeds"),
     ],
 )
 def test_bad_input_exits_2_naming_it(files, tmp_path: Path, capsys, extra: list[str], message: str) -> None:
@@ -180,3 +183,11 @@ def test_bad_input_exits_2_naming_it(files, tmp_path: Path, capsys, extra: list[
     assert err.startswith("tuning: error: ") and message in err
     assert err.count("\n") == 1
     assert not (tmp_path / "m.csv").exists()
+
+
+def test_a_study_is_bounded_in_speeds_x_lookaheads() -> None:
+    lookaheads = tuple(0.5 + 0.05 * i for i in range(MAX_LOOKAHEADS))
+    speeds = tuple(float(s) for s in range(1, MAX_STUDY_PAIRS // MAX_LOOKAHEADS + 1))
+    assert len(MarginStudy(lambda _s: LAGS, None, speeds, lookaheads).speeds_kmh) * MAX_LOOKAHEADS == MAX_STUDY_PAIRS
+    with pytest.raises(WorkbenchInputError, match=f"= {MAX_STUDY_PAIRS + MAX_LOOKAHEADS:,} cases to analyse; at most"):
+        MarginStudy(lambda _s: LAGS, None, (*speeds, 100.0), lookaheads)

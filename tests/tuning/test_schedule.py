@@ -37,6 +37,20 @@ def test_the_schedule_round_trips_through_read_filter_file(result, tmp_path: Pat
     assert mid.omega_z_rad_s == pytest.approx(0.5 * (p30.omega_z_rad_s + p60.omega_z_rad_s))
 
 
+def test_the_nominal_filter_is_the_one_of_the_nominal_speed(result, tmp_path: Path) -> None:
+    schedule = read_filter_file(result.write(tmp_path / "s60.json", nominal_speed_kmh=60.0))
+    assert schedule.metadata["speed_kmh"] == 60.0
+    assert schedule.metadata["plant"]["omega_n_rad_s"] == result.entries[1].fit.lag.omega_n_rad_s
+
+
+@pytest.mark.parametrize("speed", [50.0, 59.9, 0.0, float("nan")])
+def test_a_nominal_speed_not_identified_is_refused_naming_the_speeds(result, tmp_path: Path, speed: float) -> None:
+    with pytest.raises(WorkbenchInputError, match=r"is not a speed of the schedule; .* one of the speeds identified: "
+                       r"30, 60, 90 km/h"):  # fmt: skip
+        result.write(tmp_path / "s.json", nominal_speed_kmh=speed)
+    assert not (tmp_path / "s.json").exists()
+
+
 def test_identification_amplitude_gives_the_asked_lateral_acceleration(truck) -> None:
     # 0.1 g at 60 km/h: kappa = 0.981 / 16.67^2 = 0.00353 1/m; Ackermann x steering ratio 22.
     assert steer_amplitude_deg(truck, 60.0, 0.1) == pytest.approx(25.1, abs=0.1)

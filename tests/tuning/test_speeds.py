@@ -6,7 +6,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from tuning.speeds import parse_speeds
+from tuning.speeds import MAX_SPEEDS, parse_speeds
 from workbench.base.errors import WorkbenchInputError
 
 
@@ -42,3 +42,9 @@ def test_bad_lists_are_explained(text: str, needle: str) -> None:
     with pytest.raises(WorkbenchInputError) as info:
         parse_speeds(text)
     assert needle in str(info.value)
+
+
+def test_a_plain_list_is_bounded_like_an_ellipsis() -> None:
+    assert len(parse_speeds(",".join(f"{1 + 0.5 * i:g}" for i in range(MAX_SPEEDS)))) == MAX_SPEEDS
+    with pytest.raises(WorkbenchInputError, match=f"{MAX_SPEEDS + 1} speeds given; at most {MAX_SPEEDS}"):
+        parse_speeds(",".join(f"{1 + 0.5 * i:g}" for i in range(MAX_SPEEDS + 1)))

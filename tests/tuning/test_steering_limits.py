@@ -69,5 +69,5 @@ def test_the_schedule_fits_a_delay_and_drops_a_refused_speed(tmp_path: Path, cap
     assert dropped["speed_kmh"] == 10.0 and "bound of zeta" in dropped["reason"]
     assert "10 km/h: dropped: the fit ran to the bound of zeta" in capsys.readouterr().err
     # without --drop-refused the refusal refuses the schedule, naming the speed
-    assert main(["schedule", "--vehicle", "kinematic-bicycle", "--speeds", "10", "--out", str(out)]) == 2
+    assert main(["schedule", "--vehicle", "kinematic-bicycle", "--speeds", "10", "--out", str(out), "--overwrite"]) == 2
     assert "at 10 km/h: the fit ran to the bound of zeta" in capsys.readouterr().err

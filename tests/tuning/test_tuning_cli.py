@@ -164,6 +164,7 @@ def write(tmp_path: Path, frame: pd.DataFrame, name: str = "bad.csv") -> str:
         (lambda f: f.assign(speed_mps=np.where(f.index == 40, math.nan, f["speed_mps"])), "column speed_mps row 41"),
         (lambda f: f.iloc[:150], "too short to identify a lag"),
         (lambda f: f.assign(speed_mps=np.linspace(5.0, 10.0, len(f))), "speed varies over the log from 5 to 10 m/s"),
+        (lambda f: pd.concat([f, 2.0 * f[["speed_mps"]]], axis=1), "bad.csv: column 'speed_mps' appears 2 times"),
     ],
 )
 def test_fit_lag_refuses_bad_logs(logs, tmp_path: Path, capsys, edit, needle: str) -> None:
@@ -192,6 +193,10 @@ def test_fit_lag_refuses_bad_logs(logs, tmp_path: Path, capsys, edit, needle: st
         (["schedule", "--vehicle", "zeppelin", "--speeds", "30", "--out", "{tmp}/s.json"], "unknown vehicle"),
         (["schedule", *TRUCK, "--speeds", "30,abc", "--out", "{tmp}/s.json"], "'abc' is not a number"),
         (["schedule", *TRUCK, "--speeds", "40", "--out", "{tmp}/s.json", "--compare", "60"], "--compare needs"),
+        (["schedule", *TRUCK, "--speeds", "30", "--out", "{tmp}/s.json", "--nominal-speed", "50"],
+         "--nominal-speed 50 km/h is not one of the --speeds (30 km/h)"),
+        (["schedule", *TRUCK, "--speeds", "30,60", "--out", "{tmp}/s.json", "--nominal-speed", "50", "--compare", "60"],
+         "--nominal-speed 50 km/h is not one of the --speeds (30, 60 km/h)"),
         (["generate-data", "--maneuver", "dlc", "--speed", "30", "--out", "{tmp}/g.csv"], "give --vehicle NAME"),
         (["generate-data", *TRUCK, "--maneuver", "dlc", "--speed", "30", "--lat-accel-g", "2", "--out", "{tmp}/g.csv"],
          "--lat-accel-g must be in (0, 1] g"),
@@ -253,3 +258,53 @@ def test_amplitude_and_lateral_acceleration_exclude_each_other(tmp_path: Path) -
     with pytest.raises(SystemExit) as info:
         main([*argv, "--lat-accel-g", "0.1", "--out", str(tmp_path / "g.csv")])
     assert info.value.code == 2
+
+
+# --- existing output files ---------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("argv", "existing"),
+    [
+        ([*GENERATE, "--out", "{tmp}/old"], "--out"),
+        (["fit-lag", "{dlc}", *TRUCK, "--out", "{tmp}/old"], "--out"),
+        (["fit-lag", "{dlc}", *TRUCK, "--out", "{tmp}/l.json", "--plot", "{tmp}/old"], "--plot"),
+        (["design-lead", "--lag", "{lag}", "--out", "{tmp}/old.json"], "--out"),
+        (["design-lead", "--lag", "{lag}", "--out", "{tmp}/f.json", "--validate", "{dlc}", "--validate-plot",
+          "{tmp}/old", *TRUCK], "--validate-plot"),
+        (["design-lead", "--lag", "{lag}", "--out", "{tmp}/old.json", "--validate", "{dlc}", *TRUCK], "--out"),
+        (["rollover-limits", *TRUCK, "--speeds", "40", "--out", "{tmp}/old"], "--out"),
+        (["steering-limits", "--vehicle", "kinematic-bicycle", "--speeds", "40", "--out", "{tmp}/old"], "--out"),
+        (["schedule", *TRUCK, "--speeds", "40", "--out", "{tmp}/old.json"], "--out"),
+        (["margins", "--lag", "{lag}", "--speeds", "30", "--out", "{tmp}/old"], "--out"),
+        (["margins", "--lag", "{lag}", "--speeds", "30", "--out", "{tmp}/m.csv", "--plot", "{tmp}/old"], "--plot"),
+    ],
+)  # fmt: skip
+def test_an_existing_output_file_is_refused_without_overwrite(
+    logs, lag_file, tmp_path: Path, capsys, argv, existing: str
+) -> None:
+    fields = {"dlc": logs["dlc"], "lag": lag_file, "tmp": tmp_path}
+    argv = [a.format(**fields) for a in argv]
+    old = Path(argv[argv.index(existing) + 1])
+    old.write_text("the user's own\n")
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err == f"tuning: error: {existing} {str(old)!r} exists; give --overwrite to replace it, or choose another " \
+        "file name\n"  # fmt: skip
+    assert old.read_text() == "the user's own\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == [old.name]  # refused before any work: nothing else written
+
+
+def test_design_leads_default_validation_figure_is_protected_too(logs, lag_file, tmp_path: Path, capsys) -> None:
+    figure = tmp_path / "lead_validation.png"
+    figure.write_text("x")
+    argv = ["design-lead", "--lag", str(lag_file), "--out", str(tmp_path / "lead.json"), "--validate", str(logs["dlc"])]
+    assert main([*argv, *TRUCK]) == 2
+    assert f"the --validate figure {str(figure)!r} exists; give --overwrite" in capsys.readouterr().err
+
+
+def test_overwrite_replaces_an_existing_output_file(tmp_path: Path, capsys) -> None:
+    out = tmp_path / "log.csv"
+    out.write_text("the user's own\n")
+    assert main([*GENERATE, "--duration-s", "2", "--out", str(out), "--overwrite"]) == 0
+    assert pd.read_csv(out)["t_s"].iloc[-1] == pytest.approx(2.0, abs=0.011)

@@ -78,9 +78,10 @@ def check_output_dir(path: str | os.PathLike[str], label: str = "--out") -> Path
     return path
 
 
-def check_output_file(path: str | os.PathLike[str], label: str = "--out") -> Path:
+def check_output_file(path: str | os.PathLike[str], label: str = "--out", overwrite: bool = True) -> Path:
     """`path` as a Path if a file can be written there: not a folder, no parent a file, the file (if it exists) or
-    the nearest existing parent writable. Creates nothing."""
+    the nearest existing parent writable; with overwrite False, no file (or link) there at all, so that a command's
+    output never replaces an earlier file unasked (its `--overwrite` allows it). Creates nothing."""
     path = Path(path)
     where = f"{label} {str(path)!r}"
     try:
@@ -89,6 +90,8 @@ def check_output_file(path: str | os.PathLike[str], label: str = "--out") -> Pat
             raise WorkbenchInputError(f"{where}: {str(blocker)!r} is a file, not a folder")
         if path.is_dir():
             raise WorkbenchInputError(f"{where} is a folder, not a file; give the name of the file to write")
+        if not overwrite and os.path.lexists(path):
+            raise WorkbenchInputError(f"{where} exists; give --overwrite to replace it, or choose another file name")
         if path.exists():
             if not os.access(path, os.W_OK):
                 raise WorkbenchInputError(f"{where}: the file is not writable (permission denied)")
