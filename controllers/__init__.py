@@ -3,7 +3,16 @@
 Every controller implements `controllers.base.Controller`; `make_controller(name, geometry)` builds one by its
 registered name and `CONTROLLERS` lists them.
 
-Importing this package is cheap (issue 17): `CONTROLLERS` knows each controller's name and where it lives, and
+A controller written outside this repository is registered by the package that holds it, through the entry-point
+group `lateral_workbench.controllers` (`CONTROLLER_ENTRY_POINTS`): in its pyproject.toml,
+
+    [project.entry-points."lateral_workbench.controllers"]
+    my-controller = "my_package.my_module:MyController"
+
+once that package is installed, `my-controller` is run by `workbench run/compare`, the studies and
+`make_controller` like the controllers here (examples/plugin/ is such a package).
+
+Importing this package is cheap: `CONTROLLERS` knows each controller's name and where it lives, and
 imports a controller's module (python-control for the clothoid controller's lead filter, CasADi and OSQP for the
 MPCs) only when that controller is looked up by name (`CONTROLLERS[name]`, `.items()`, `.values()`). The classes
 and configs exported here (`from controllers import PurePursuit`) are imported on first access too.
@@ -11,6 +20,7 @@ and configs exported here (`from controllers import PurePursuit`) are imported o
 
 from __future__ import annotations
 
+import dataclasses
 import importlib
 from collections.abc import Iterator, Mapping
 from typing import TYPE_CHECKING, Any
@@ -44,16 +54,38 @@ _EXPORTS = {
 }
 
 
-class ControllerRegistry(Mapping[str, "type[Controller]"]):
-    """name -> controller class, in a fixed order; a class's module is imported when it is first looked up.
+#: The entry-point group in which an installed package registers controllers (name = "module:Class").
+CONTROLLER_ENTRY_POINTS = "lateral_workbench.controllers"
 
-    `name in CONTROLLERS`, `len(CONTROLLERS)` and iterating the names import nothing; `CONTROLLERS[name]`,
-    `.get`, `.items()` and `.values()` import the modules of the classes they return.
+
+class ControllerRegistry(Mapping[str, "type[Controller]"]):
+    """name -> controller class, in a fixed order: the built-in ones, then those installed packages register in
+    `entry_point_group`; a class's module is imported when it is first looked up.
+
+    `name in CONTROLLERS`, `len(CONTROLLERS)` and iterating the names import nothing (the installed packages'
+    entry points are read, once); `CONTROLLERS[name]`, `.get`, `.items()` and `.values()` import the modules of the
+    classes they return. A registered controller that cannot be imported, is no `Controller`, or whose `name` is
+    not the one it is registered under is refused when looked up, naming the package.
     """
 
-    def __init__(self, entries: Mapping[str, tuple[str, str]]) -> None:
-        self._entries = dict(entries)  # name -> (module, class name)
+    def __init__(self, entries: Mapping[str, tuple[str, str]], entry_point_group: str | None = None) -> None:
+        self._builtin = dict(entries)  # name -> (module, class name)
+        self._group = entry_point_group
+        self._found: dict[str, tuple[str, str]] | None = None
+        self._packages: dict[str, str] = {}  # name -> the installed package that registers it
         self._loaded: dict[str, type[Controller]] = {}
+
+    @property
+    def _entries(self) -> dict[str, tuple[str, str]]:
+        if self._found is None:
+            self._found = dict(self._builtin)
+            from workbench.base.entry_points import installed_entry_points
+
+            found = installed_entry_points(self._group, set(self._builtin)) if self._group else {}
+            for name, (module, attr, package) in found.items():
+                self._found[name] = (module, attr)
+                self._packages[name] = package
+        return self._found
 
     def __getitem__(self, name: str) -> type[Controller]:
         try:
@@ -61,9 +93,13 @@ class ControllerRegistry(Mapping[str, "type[Controller]"]):
         except KeyError:
             pass
         module, attr = self._entries[name]  # KeyError for an unknown name, as a dict
-        cls = getattr(importlib.import_module(module), attr)
-        if cls.name != name:
-            raise RuntimeError(f"controllers: {module}.{attr}.name is {cls.name!r}, registered as {name!r}")
+        package = self._packages.get(name)
+        if package is None:
+            cls = getattr(importlib.import_module(module), attr)
+            if cls.name != name:
+                raise RuntimeError(f"controllers: {module}.{attr}.name is {cls.name!r}, registered as {name!r}")
+        else:
+            cls = _plugin_controller(name, module, attr, package)
         self._loaded[name] = cls
         return cls
 
@@ -80,6 +116,25 @@ class ControllerRegistry(Mapping[str, "type[Controller]"]):
         return f"ControllerRegistry({', '.join(self._entries)})"
 
 
+def _plugin_controller(name: str, module: str, attr: str, package: str) -> type[Controller]:
+    """The class an installed package registers as controller `name`, checked to be a Controller of that name."""
+    from controllers.base import Controller
+    from workbench.base.errors import WorkbenchInputError
+
+    where = f"controller {name!r} (registered by {package} as {module}:{attr})"
+    try:
+        cls = getattr(importlib.import_module(module), attr)
+    except (ImportError, AttributeError) as exc:
+        raise WorkbenchInputError(f"{where} cannot be imported: {type(exc).__name__}: {exc}") from None
+    if not (isinstance(cls, type) and issubclass(cls, Controller)):
+        raise WorkbenchInputError(f"{where} is not a controllers.base.Controller subclass; got {cls!r}")
+    if getattr(cls, "name", None) != name:
+        raise WorkbenchInputError(f"{where}: its class's name is {getattr(cls, 'name', None)!r}, not {name!r}")
+    if not dataclasses.is_dataclass(getattr(cls, "config_type", None)):
+        raise WorkbenchInputError(f"{where}: its config_type must be a dataclass; got {cls.config_type!r}")
+    return cls
+
+
 #: name -> controller class, in the order `workbench controllers` lists them.
 CONTROLLERS: ControllerRegistry = ControllerRegistry(
     {
@@ -88,7 +143,8 @@ CONTROLLERS: ControllerRegistry = ControllerRegistry(
         "stanley": ("controllers.stanley", "Stanley"),
         "nmpc": ("controllers.mpc", "NMPCController"),
         "lmpc": ("controllers.mpc", "LMPCController"),
-    }
+    },
+    CONTROLLER_ENTRY_POINTS,
 )
 
 
@@ -119,6 +175,7 @@ def __dir__() -> list[str]:
 
 __all__ = [
     "CONTROLLERS",
+    "CONTROLLER_ENTRY_POINTS",
     "ClothoidConfig",
     "ClothoidController",
     "Controller",

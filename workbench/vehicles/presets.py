@@ -10,16 +10,26 @@ A preset (workbench/presets/<name>.toml, shipped with the package) or a user's c
 
 Unknown or missing keys are rejected naming the key, the file and the allowed keys; values are then validated
 by the params dataclass (which names the field and its allowed range).
+
+A vehicle model written outside this repository is registered by the package that holds it, through the
+entry-point group `lateral_workbench.vehicles` (`VEHICLE_ENTRY_POINTS`): `name = "module:ModelClass"`, where the
+class is a `VehicleModel` whose `name` is that name and whose `params_type` is its params dataclass, every field
+with a default. Its preset is those defaults (`workbench vehicles --show NAME` prints it as a vehicle file), and a
+vehicle file of its type works as any other (examples/plugin/ is such a package).
 """
 
 from __future__ import annotations
 
 import dataclasses
+import importlib
+import json
 import os
+import sys
 from importlib import resources
 from pathlib import Path
 from typing import Any
 
+from workbench.base.entry_points import installed_entry_points
 from workbench.base.errors import WorkbenchInputError, value_text
 from workbench.base.input_files import parse_toml, read_text
 from workbench.base.typed_tables import check_keys, dataclass_from_table
@@ -36,8 +46,40 @@ MODEL_TYPES: dict[str, tuple[type[VehicleModel], type]] = {
     TractorSemitrailer.name: (TractorSemitrailer, TractorSemitrailerParams),
     CommonRoadMB.name: (CommonRoadMB, CommonRoadMBParams),
 }
+#: The entry-point group in which an installed package registers vehicle models ("module:ModelClass").
+VEHICLE_ENTRY_POINTS = "lateral_workbench.vehicles"
 _TOP_KEYS = ("model", "parameters")
 _MODEL_KEYS = ("type", "description")
+
+
+def _installed_model_types() -> dict[str, tuple[type[VehicleModel], type]]:
+    """The vehicle models installed packages register (`VEHICLE_ENTRY_POINTS`), each checked; one that cannot be
+    imported or breaks the rules (module docstring) is left out with a warning on stderr saying why."""
+    found = {}
+    for name, (module, attr, package) in installed_entry_points(VEHICLE_ENTRY_POINTS, set(MODEL_TYPES)).items():
+        where = f"vehicle {name!r} (registered by {package} as {module}:{attr})"
+        try:
+            cls = getattr(importlib.import_module(module), attr)
+        except Exception as exc:  # a third-party import may raise anything: it must not stop the workbench
+            why = f"cannot be imported: {type(exc).__name__}: {exc}"
+        else:
+            params_type = getattr(cls, "params_type", None)
+            if not (isinstance(cls, type) and issubclass(cls, VehicleModel)):
+                why = f"is not a workbench.vehicles.base.VehicleModel subclass; got {cls!r}"
+            elif getattr(cls, "name", None) != name:
+                why = f"its class's name is {getattr(cls, 'name', None)!r}, not {name!r}"
+            elif not (isinstance(params_type, type) and dataclasses.is_dataclass(params_type)):
+                why = f"its params_type must be a dataclass; got {params_type!r}"
+            else:
+                found[name] = (cls, params_type)
+                continue
+        print(f"lateral-workbench: warning: {where} left out: {why}", file=sys.stderr)
+    return found
+
+
+#: model type -> (model class, params dataclass) of the models installed packages register.
+INSTALLED_MODEL_TYPES = _installed_model_types()
+MODEL_TYPES.update(INSTALLED_MODEL_TYPES)
 
 
 def _preset_dir() -> Any:
@@ -45,20 +87,36 @@ def _preset_dir() -> Any:
 
 
 def list_presets() -> dict[str, str]:
-    """Preset name -> its description, for every TOML file shipped in workbench/presets."""
+    """Preset name -> its description, for every TOML file shipped in workbench/presets, then every installed
+    package's vehicle model (its preset: its params' defaults)."""
     found = {}
     for entry in sorted(_preset_dir().iterdir(), key=lambda e: e.name):
         if entry.name.endswith(".toml"):
             model = parse_toml(entry.read_text(encoding="utf-8"), f"preset {entry.name}").get("model", {})
             found[entry.name.removesuffix(".toml")] = str(model.get("description", model.get("type", "")))
+    for name, (cls, _) in INSTALLED_MODEL_TYPES.items():
+        found[name] = (cls.__doc__ or name).strip().splitlines()[0]
     return found
 
 
 def preset_text(name: str) -> str:
-    """The TOML text of a shipped preset (to copy and edit)."""
+    """The TOML text of a preset (to copy and edit): a shipped file, or an installed model's defaults."""
     if name not in list_presets():
         raise WorkbenchInputError(f"unknown vehicle preset {name!r}; choose one of {', '.join(list_presets())}")
+    if name in INSTALLED_MODEL_TYPES:
+        defaults = INSTALLED_MODEL_TYPES[name][1]()
+        lines = ["[model]", f'type = "{name}"', f"description = {json.dumps(list_presets()[name])}", "", "[parameters]"]
+        lines += [f"{f.name} = {_toml_value(getattr(defaults, f.name))}" for f in dataclasses.fields(defaults)]
+        return "\n".join(lines) + "\n"
     return _preset_dir().joinpath(f"{name}.toml").read_text(encoding="utf-8")
+
+
+def _toml_value(value: object) -> str:
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, str):
+        return json.dumps(value)
+    return repr(value)
 
 
 def carries_payload(model_type: str) -> bool:
@@ -83,7 +141,7 @@ def load_vehicle(name_or_file: str, payload_kg: float | None = None) -> VehicleM
     """Build a vehicle from a shipped preset name or a TOML file; payload_kg overrides the preset's payload."""
     if name_or_file in list_presets():
         source = f"preset {name_or_file!r}"
-        text = _preset_dir().joinpath(f"{name_or_file}.toml").read_text(encoding="utf-8")
+        text = preset_text(name_or_file)
     else:
         path = Path(name_or_file)
         if not os.path.lexists(path):
