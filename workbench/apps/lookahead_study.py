@@ -3,7 +3,13 @@ Fréchet distance against the initial cross-track error (Figure 5b).
 
 A vehicle is placed at arc length s on a path, offset laterally by a CTE (left positive) and turned by a heading
 error, with the path's curvature there as its own; every candidate lookahead is scored exactly as the clothoid
-controller scores it (`controllers.clothoid.lookahead`).
+controller scores it (`controllers.clothoid.lookahead`), over the controller's own candidates, kappa' saturation and
+threshold (the `ClothoidConfig` defaults).
+
+Where the path's curvature stays what the vehicle's is (a straight, the middle of an arc), the fitted clothoid is the
+path itself and the Fréchet distance is zero at every lookahead; it grows with the lookahead where the curvature
+ahead changes (a bend's entry or exit). `growing_stretch` finds the place on a path where it grows most across the
+candidates while crossing the threshold among them: the stretch on which Figure 4b shows what the threshold does.
 """
 
 from __future__ import annotations
@@ -15,16 +21,29 @@ from typing import TYPE_CHECKING
 import numpy as np
 import pandas as pd
 
+from controllers.clothoid.controller import ClothoidConfig
 from controllers.clothoid.lookahead import LookaheadEvaluator
-from workbench.base.errors import require_finite, require_in_range
+from workbench.base.errors import WorkbenchInputError, require_finite, require_in_range, require_positive
 from workbench.base.path import ReferencePath
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
 
-#: The paper's candidate range (section 3) and the clothoid controller's default kappa' saturation.
-DEFAULT_LOOKAHEADS_M = np.arange(5.0, 20.0 + 1e-9, 0.5)
-DEFAULT_MAX_CURVATURE_RATE_1PM2 = 0.05
+#: The clothoid controller's defaults, which the analyses use unless told otherwise.
+CONTROLLER_DEFAULTS = ClothoidConfig()
+#: The controller's candidate lookaheads (m): its default range (the paper's 5-20 m, section 3) on its search grid.
+DEFAULT_LOOKAHEADS_M = np.arange(
+    CONTROLLER_DEFAULTS.min_lookahead_m,
+    CONTROLLER_DEFAULTS.max_lookahead_m + 1e-9 * CONTROLLER_DEFAULTS.lookahead_step_m,
+    CONTROLLER_DEFAULTS.lookahead_step_m,
+)
+#: The controller's default saturation of the clothoid's kappa' (1/m^2).
+DEFAULT_MAX_CURVATURE_RATE_1PM2 = CONTROLLER_DEFAULTS.max_curvature_rate_1pm2
+#: The controller's default Fréchet threshold (m; the paper's is 0.5 m): the largest lookahead whose Fréchet distance
+#: stays within it is the one the adaptive search picks.
+DEFAULT_FRECHET_THRESHOLD_M = CONTROLLER_DEFAULTS.frechet_threshold_m
+#: Spacing (m) of the places `growing_stretch` tries along a path.
+STRETCH_STEP_M = 1.0
 
 
 def _pose(path: ReferencePath, s_m: float, cte_m: float, heading_error_rad: float) -> tuple[float, float, float]:
@@ -43,18 +62,40 @@ class FrechetVsLookahead:
     lookahead_m: np.ndarray
     frechet_m: np.ndarray
     label: str
+    #: Where on the path (arc length, m).
+    s_m: float = math.nan
 
     def to_pandas(self) -> pd.DataFrame:
         return pd.DataFrame({"lookahead_m": self.lookahead_m, "frechet_m": self.frechet_m})
 
-    def plot(self, ax: Axes | None = None, threshold_m: float | None = 0.5) -> Axes:
+    def chosen_lookahead_m(self, threshold_m: float = DEFAULT_FRECHET_THRESHOLD_M) -> float:
+        """The largest lookahead (m) whose Fréchet distance stays within threshold_m, as the adaptive search picks
+        it (before the end-point tolerances, the floor and the filter); NaN when none does."""
+        within = np.flatnonzero(self.frechet_m <= threshold_m)
+        return float(self.lookahead_m[within[-1]]) if within.size else math.nan
+
+    def crosses(self, threshold_m: float = DEFAULT_FRECHET_THRESHOLD_M) -> bool:
+        """Whether the Fréchet distance starts within threshold_m and ends above it (the threshold then picks a
+        lookahead inside the range)."""
+        return bool(self.frechet_m[0] <= threshold_m < self.frechet_m[-1])
+
+    def plot(self, ax: Axes | None = None, threshold_m: float | None = DEFAULT_FRECHET_THRESHOLD_M) -> Axes:
+        """The Fréchet distance against the lookahead; with threshold_m (the controller's default unless given; None:
+        none), the threshold and the lookahead it picks. The axis runs from 0 to above the larger of the curve and
+        the threshold, so both show."""
         import matplotlib.pyplot as plt
 
         if ax is None:
             _, ax = plt.subplots(figsize=(6, 4), layout="constrained")
         ax.plot(self.lookahead_m, self.frechet_m, "o-", ms=3, label=self.label)
+        top = float(np.max(self.frechet_m))
         if threshold_m is not None:
             ax.axhline(threshold_m, color="k", ls="--", lw=0.8, label=f"threshold {threshold_m:g} m")
+            chosen = self.chosen_lookahead_m(threshold_m)
+            if math.isfinite(chosen) and chosen < self.lookahead_m[-1]:
+                ax.axvline(chosen, color="tab:red", ls=":", lw=1.0, label=f"lookahead picked: {chosen:g} m")
+            top = max(top, threshold_m)
+        ax.set_ylim(0.0, 1.1 * top if top > 0.0 else 1.0)
         ax.set(xlabel="lookahead distance (m)", ylabel="Fréchet distance (m)", title="Fréchet distance vs lookahead")
         ax.legend(fontsize="small")
         return ax
@@ -78,8 +119,35 @@ def frechet_vs_lookahead(
             for la in lookaheads_m
         ]
     )
-    label = f"s = {s_m:g} m, CTE {cte_m:g} m, curvature {kappa:.3g} 1/m"
-    return FrechetVsLookahead(np.asarray(lookaheads_m, dtype=float), fd, label)
+    label = f"s = {s_m:.4g} m, CTE {cte_m:g} m, curvature {kappa:.3g} 1/m"
+    return FrechetVsLookahead(np.asarray(lookaheads_m, dtype=float), fd, label, s_m)
+
+
+def growing_stretch(
+    path: ReferencePath,
+    threshold_m: float = DEFAULT_FRECHET_THRESHOLD_M,
+    lookaheads_m: np.ndarray = DEFAULT_LOOKAHEADS_M,
+    max_curvature_rate_1pm2: float = DEFAULT_MAX_CURVATURE_RATE_1PM2,
+    step_m: float = STRETCH_STEP_M,
+) -> FrechetVsLookahead:
+    """Figure 4b's stretch: of the places on the path every step_m (a vehicle on the path, at its curvature), the one
+    whose Fréchet distance crosses threshold_m among the lookaheads and grows most across them (where the curvature
+    ahead changes most within the lookahead range). Refused for a path without such a place (a straight, a circle)."""
+    require_positive("threshold_m", threshold_m)
+    require_positive("step_m", step_m)
+    best: FrechetVsLookahead | None = None
+    for s_m in np.arange(0.0, path.length_m, step_m):
+        sweep = frechet_vs_lookahead(path, float(s_m), 0.0, 0.0, lookaheads_m, max_curvature_rate_1pm2)
+        growth = sweep.frechet_m[-1] - sweep.frechet_m[0]
+        if sweep.crosses(threshold_m) and (best is None or growth > best.frechet_m[-1] - best.frechet_m[0]):
+            best = sweep
+    if best is None:
+        raise WorkbenchInputError(
+            f"no place on path {path.name!r} where the Fréchet distance crosses the threshold {threshold_m:g} m "
+            f"between lookaheads of {lookaheads_m[0]:g} and {lookaheads_m[-1]:g} m (its curvature ahead never changes "
+            "enough)"
+        )
+    return best
 
 
 @dataclass(frozen=True, eq=False)

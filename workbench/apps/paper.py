@@ -36,8 +36,15 @@ import numpy as np
 import pandas as pd
 from tqdm import tqdm
 
-from workbench.apps.lookahead_study import frechet_vs_lookahead, min_frechet_vs_cte
+from workbench.apps.lookahead_study import (
+    DEFAULT_FRECHET_THRESHOLD_M,
+    FrechetVsLookahead,
+    frechet_vs_lookahead,
+    growing_stretch,
+    min_frechet_vs_cte,
+)
 from workbench.base.errors import WorkbenchInputError
+from workbench.base.path import ReferencePath
 from workbench.simulation import plots
 from workbench.simulation.result import SimulationResult
 from workbench.simulation.scenarios import (
@@ -58,8 +65,9 @@ FIG7_SPEEDS_KMH = (30.0, 60.0, 90.0)
 FIG6_SPEEDS_KMH = (10.0, 20.0, 30.0, 40.0, 50.0, 60.0, 70.0, 80.0, 90.0, 100.0)
 #: Figure 5b's initial CTEs (m).
 FIG5_CTES_M = np.linspace(0.0, 2.0, 11)
-#: The paper's Fréchet-distance threshold (m, section 3), drawn on Figure 4b.
-FRECHET_THRESHOLD_M = 0.5
+#: The paper's Fréchet-distance threshold (m, section 3); Figure 4b draws the controller's own
+#: (`lookahead_study.DEFAULT_FRECHET_THRESHOLD_M`, the ClothoidConfig default).
+PAPER_FRECHET_THRESHOLD_M = 0.5
 MPH_PER_MPS = 3600.0 / 1609.344
 
 #: The paper's reported figures (section 6): quantity -> (what it reports, with its figure, and our value's unit).
@@ -78,7 +86,8 @@ PAPER_FIGURES: dict[int, tuple[str, str]] = {
         "Variation of Fréchet distance with respect to the distance between the current vehicle coordinates and the "
         "target point.",
         "The Fréchet distance grows notably with the lookahead where the path curves; a threshold on it (0.5 m) "
-        "sets the lookahead. We draw (b).",
+        "sets the lookahead. We draw (b) where it grows most on the figure-8 (a bend's entry), with our controller's "
+        "threshold and the lookahead it picks, and on the arc of constant curvature beside it.",
     ),
     5: (
         "(a) Pictorial representation of deviation between the locally fitted clothoid and the reference path. (b) "
@@ -158,21 +167,43 @@ def _save(ax_or_fig: plt.Axes | plt.Figure, path: Path) -> Path:
     return path
 
 
+def tightest_curve_m(path: ReferencePath) -> float:
+    """Arc length (m) of the path's largest |curvature| (its first sample)."""
+    return float(np.argmax(np.abs(path.curvature_1pm)) * path.spacing_m)
+
+
+def figure_4b(path: ReferencePath) -> tuple[plt.Axes, FrechetVsLookahead, FrechetVsLookahead]:
+    """Figure 4b: the Fréchet distance against the lookahead where it grows most on the path (`growing_stretch`: a
+    bend's entry, where the curvature ahead changes), with the controller's threshold and the lookahead it picks;
+    beside it, on the tightest curve's constant curvature, where the fitted clothoid is the arc itself (zero at every
+    lookahead). Returns the axes and the two sweeps (growing, on the arc)."""
+    growing = growing_stretch(path, DEFAULT_FRECHET_THRESHOLD_M)
+    on_arc = frechet_vs_lookahead(path, tightest_curve_m(path))
+    ax = growing.plot(threshold_m=DEFAULT_FRECHET_THRESHOLD_M)
+    ax.lines[0].set_label(f"a bend's entry: {growing.label}")
+    ax.plot(on_arc.lookahead_m, on_arc.frechet_m, "s", ms=2.5, color="tab:gray", label=f"on the arc: {on_arc.label}")
+    ax.set_title(f"{path.name}: Fréchet distance vs lookahead (controller's threshold)")
+    ax.legend(fontsize="small", loc="upper left")
+    return ax, growing, on_arc
+
+
 def _lookahead_figures(out: Path) -> StepOutput:
     path = make_scenario("figure8").path
-    s_on_curve = float(np.argmax(np.abs(path.curvature_1pm)) * path.spacing_m)
-    fig4 = frechet_vs_lookahead(path, s_on_curve)
-    fig5 = min_frechet_vs_cte(path, s_on_curve, FIG5_CTES_M)
-    crossing = np.flatnonzero(fig4.frechet_m > FRECHET_THRESHOLD_M)
-    beyond = f"above {FRECHET_THRESHOLD_M:g} m from {fig4.lookahead_m[crossing[0]]:g} m" if crossing.size else ""
+    ax, fig4, on_arc = figure_4b(path)
+    fig5 = min_frechet_vs_cte(path, tightest_curve_m(path), FIG5_CTES_M)
+    crossing = fig4.lookahead_m[np.flatnonzero(fig4.frechet_m > DEFAULT_FRECHET_THRESHOLD_M)[0]]
     notes = {
-        4: f"On the figure-8's tightest curve: {fig4.frechet_m[0]:.3g} m at {fig4.lookahead_m[0]:g} m lookahead, "
-        f"{fig4.frechet_m[-1]:.3g} m at {fig4.lookahead_m[-1]:g} m" + (f"; {beyond}" if beyond else ""),
+        4: f"On the figure-8 at s = {fig4.s_m:g} m (a bend's entry, curvature {path.curvature(fig4.s_m):.3g} 1/m "
+        f"rising): {fig4.frechet_m[0]:.3g} m at {fig4.lookahead_m[0]:g} m lookahead, {fig4.frechet_m[-1]:.3g} m at "
+        f"{fig4.lookahead_m[-1]:g} m, above the controller's threshold ({DEFAULT_FRECHET_THRESHOLD_M:g} m; the "
+        f"paper's: {PAPER_FRECHET_THRESHOLD_M:g} m) from {crossing:g} m, so the search picks "
+        f"{fig4.chosen_lookahead_m():g} m. On the arc (s = {on_arc.s_m:.4g} m) at most "
+        f"{np.max(on_arc.frechet_m):.2g} m at any lookahead: the fitted clothoid is the arc itself",
         5: f"{fig5.min_frechet_m[0]:.3g} m at {fig5.cte_m[0]:g} m initial CTE, {fig5.min_frechet_m[-1]:.3g} m at "
         f"{fig5.cte_m[-1]:g} m",
     }
     files = [
-        _save(fig4.plot(threshold_m=FRECHET_THRESHOLD_M), out / "fig04b_frechet_vs_lookahead.png"),
+        _save(ax, out / "fig04b_frechet_vs_lookahead.png"),
         _save(fig5.plot(), out / "fig05b_min_frechet_vs_cte.png"),
     ]
     return files, notes
