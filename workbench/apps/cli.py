@@ -39,11 +39,14 @@ from workbench.base.version import VersionAction
 
 if TYPE_CHECKING:
     from workbench.apps.comparison import Comparison
+    from workbench.apps.stage_progress import StageProgress
     from workbench.apps.studies import StudySpec
     from workbench.apps.studies.backends import Backend
     from workbench.base.output_dir import OutputDir
     from workbench.simulation.plot_worker import PlotWorker
+    from workbench.simulation.result import SimulationResult
     from workbench.simulation.run_config import SimulationConfig
+    from workbench.simulation.simulator import Simulation
 
 # Heavy modules (the simulator, the scenarios' paths, plotting, the controllers' solvers, the studies' backends)
 # are imported inside the command that needs them, so that `workbench --help` and `workbench scenarios` start
@@ -56,6 +59,8 @@ EXIT_INTERRUPTED = 130
 DEFAULT_CONTROLLER = "clothoid"
 #: The vehicle `workbench run` steers without --vehicle or --vehicle-file.
 DEFAULT_VEHICLE = "kinematic-bicycle"
+#: What shortens a run refused as too long (`run_size.check_run_size`), for `run` and `compare`.
+_SHORTEN_RUN = "a higher --speed (now {speed:g} km/h), fewer --laps or a --max-time-s shortens it"
 #: compare's `--controller-config NAME=FILE.toml` and `--set NAME:KEY=VALUE`: a controller name's shape.
 _CONTROLLER_NAME = re.compile(r"[A-Za-z][A-Za-z0-9_-]*")
 
@@ -277,6 +282,12 @@ def _run_options(parser: argparse.ArgumentParser, several: bool) -> None:
         help="stop a run after this much simulated time, status timeout (default: three times the planned time "
         "plus 30 s)",
     )
+    parser.add_argument(
+        "--allow-long-run",
+        action="store_true",
+        help="run even when the time-out allows more than 2,000,000 controller steps or a trace over 1 GB (refused "
+        "without it)",
+    )
     _conditions_options(parser)
     what = "trace and metrics" if not several else "traces, metrics and summary.csv, without figures or report.html"
     parser.add_argument("--no-plots", action="store_true", help=f"write the {what} only")
@@ -304,6 +315,8 @@ def _simulation_config(args: argparse.Namespace, **fields: object) -> Simulation
 
 def _run_config(args: argparse.Namespace) -> SimulationConfig:
     """The SimulationConfig of `run`'s and `compare`'s options (`_run_options`)."""
+    if args.laps < 1:
+        raise WorkbenchInputError(f"--laps must be a whole number >= 1; got {args.laps}")
     return _simulation_config(
         args,
         speed_kmh=args.speed,
@@ -486,6 +499,7 @@ def _compare(args: argparse.Namespace) -> int:
         ScenarioOptions(track_file=args.track),
         warn=warn_on_stderr,
         progress=sys.stderr.isatty(),
+        allow_long_run=args.allow_long_run,
     )
     with _writing(out):
         comparison.save(args.out, with_plots=not args.no_plots)
@@ -686,45 +700,27 @@ def _run(args: argparse.Namespace) -> int:
 
 
 def _run_with(args: argparse.Namespace, plot_worker: PlotWorker | None) -> int:
-    from controllers import make_controller
-    from tuning.own_tuning import tuned_controller
-    from workbench.apps.controller_config import read_controller_config
+    from workbench.apps.stage_progress import StageProgress
     from workbench.base.output_dir import OutputDir
     from workbench.simulation.limit_cycle import detect_limit_cycle
-    from workbench.simulation.scenarios import ScenarioOptions, make_scenario
-    from workbench.simulation.simulator import Simulation
-    from workbench.vehicles import make_vehicle
 
     out = OutputDir(args.out, "run", args.overwrite)
     _check_inputs(args)
-    name = args.vehicle if args.vehicle or args.vehicle_file else DEFAULT_VEHICLE
-    vehicle = make_vehicle(name, payload_kg=args.payload_kg, vehicle_file=args.vehicle_file)
-    if args.controller not in CONTROLLERS:
-        make_controller(args.controller, vehicle.geometry)  # raises the unknown-name error
-    options = read_controller_config(
-        args.controller_config,
-        args.controller,
-        CONTROLLERS[args.controller].config_type,
-        args.set,
-        vehicle.geometry,
-        warn=warn_on_stderr,
-    )
-    controller = tuned_controller(args.controller, vehicle, options)
-    scenario = make_scenario(
-        args.scenario, ScenarioOptions(vehicle_width_m=vehicle.geometry.width_m, track_file=args.track)
-    )
-    simulation = Simulation(scenario, vehicle, controller, _run_config(args))
-    for warning in simulation.warnings(f"{scenario.name}: {controller.name} on {vehicle.name}"):
-        warn_on_stderr(warning)
-    result = simulation.run(progress=sys.stderr.isatty())
-    with _writing(out):
-        written = result.save(args.out, with_plots=not args.no_plots, plot_worker=plot_worker)
+    with StageProgress("run", 3) as progress:
+        simulation, result, written = _run_stages(args, plot_worker, out, progress)
+    scenario, controller, vehicle = simulation.scenario, simulation.controller, simulation.vehicle
+    top = None if simulation.top_speed.reached else simulation.top_speed  # the planned speed falls short
+    speed = f"at {args.speed:g} km/h"
+    if top is not None:
+        speed = f"target {args.speed:g} km/h, planned top {top.top_mps * 3.6:.3g} km/h"
     m = result.metrics
 
     def fmt(value: float | None, unit: str) -> str:
         return "n/a" if value is None or (isinstance(value, float) and math.isnan(value)) else f"{value:.3f} {unit}"
 
-    print(f"{scenario.name}: {controller.name} on {vehicle.name} at {args.speed:g} km/h -> {result.status.value}")
+    print(f"{scenario.name}: {controller.name} on {vehicle.name} {speed} -> {result.status.value}")
+    if top is not None:
+        print(f"  the planned top speed is limited by {top.reason()}")
     print(f"  distance {fmt(m.distance_m, 'm')} of {fmt(m.path_length_m, 'm')}")
     print(f"  max |CTE| {fmt(m.max_abs_cte_m, 'm')}, RMS CTE {fmt(m.rms_cte_m, 'm')}")
     print(
@@ -746,6 +742,54 @@ def _run_with(args: argparse.Namespace, plot_worker: PlotWorker | None) -> int:
         print(f"workbench: run did not complete: {result.message} (partial trace kept in {args.out})", file=sys.stderr)
         return EXIT_RUN_FAILED
     return 0
+
+
+def _run_stages(
+    args: argparse.Namespace, plot_worker: PlotWorker | None, out: OutputDir, progress: StageProgress
+) -> tuple[Simulation, SimulationResult, list[Path]]:
+    """`workbench run`'s work, each stage named on `progress`: build the run (refused here when it may simulate
+    more than the bounds of `run_size` without --allow-long-run), simulate, write."""
+    from controllers import make_controller
+    from tuning.own_tuning import tuned_controller
+    from workbench.apps.controller_config import read_controller_config
+    from workbench.simulation.run_size import check_run_size, duration_text
+    from workbench.simulation.scenarios import ScenarioOptions, make_scenario
+    from workbench.simulation.simulator import Simulation
+    from workbench.vehicles import make_vehicle
+
+    config = _run_config(args)
+    progress.stage("building the vehicle, the controller and the scenario")
+    name = args.vehicle if args.vehicle or args.vehicle_file else DEFAULT_VEHICLE
+    vehicle = make_vehicle(name, payload_kg=args.payload_kg, vehicle_file=args.vehicle_file)
+    if args.controller not in CONTROLLERS:
+        make_controller(args.controller, vehicle.geometry)  # raises the unknown-name error
+    options = read_controller_config(
+        args.controller_config,
+        args.controller,
+        CONTROLLERS[args.controller].config_type,
+        args.set,
+        vehicle.geometry,
+        warn=progress.warn,
+    )
+    controller = tuned_controller(args.controller, vehicle, options)
+    scenario = make_scenario(
+        args.scenario, ScenarioOptions(vehicle_width_m=vehicle.geometry.width_m, track_file=args.track)
+    )
+    simulation = Simulation(scenario, vehicle, controller, config)
+    label = f"{scenario.name}: {controller.name} on {vehicle.name}"
+    if not args.allow_long_run:
+        check_run_size(simulation.size, label, _SHORTEN_RUN.format(speed=args.speed), "--allow-long-run")
+    for warning in simulation.warnings(label):
+        progress.warn(warning)
+    progress.stage(
+        f"simulating {simulation.total_length_m:,.0f} m of {scenario.name} (time-out after "
+        f"{duration_text(simulation.max_time_s)} simulated)"
+    )
+    result = simulation.run(progress=progress.terminal)
+    progress.stage(f"writing to {args.out}")
+    with _writing(out):
+        written = result.save(args.out, with_plots=not args.no_plots, plot_worker=plot_worker)
+    return simulation, result, written
 
 
 def _scenarios(args: argparse.Namespace) -> None:

@@ -10,8 +10,9 @@ keeps its row with its status and message: nothing is dropped. `workbench compar
 the result with `save` (traces, metrics, summary.csv, figures) and `workbench.apps.report.write_report` (report.html).
 
 Every run is built (vehicle, scenario, controller options and files) before the first one is simulated, so a bad
-input is refused before any work, and what each run's `Simulation.warnings` says (stretches of the path the
-vehicle cannot turn, a run that may be very long) is announced first. With `progress` one bar counts the runs
+input is refused before any work, a run that may simulate more than the bounds of `run_size` is refused without
+`allow_long_run`, and what each run's `Simulation.warnings` says (stretches of the path the vehicle cannot turn, a
+planned top speed short of the speed asked for) is announced first. With `progress` one bar counts the runs
 (the current run named on it), and each run shows its metres as `workbench run` does.
 """
 
@@ -36,6 +37,7 @@ from workbench.base.errors import WorkbenchInputError
 from workbench.simulation.limit_cycle import LimitCycle, detect_limit_cycle
 from workbench.simulation.metrics import METRIC_KEYS
 from workbench.simulation.result import SimulationResult
+from workbench.simulation.run_size import check_run_size
 from workbench.simulation.scenarios import Scenario, ScenarioOptions, make_scenario
 from workbench.simulation.simulator import Simulation, SimulationConfig
 from workbench.vehicles import VEHICLES, load_vehicle
@@ -47,6 +49,8 @@ if TYPE_CHECKING:
 
 #: |CTE| (m) within which a run counts as converged onto the path (the fig17 scenario starts 1 m off it).
 CONVERGED_CTE_M = 0.1
+#: What shortens a comparison's run refused as too long (`run_size.check_run_size`).
+LONG_RUN_SHORTENED = "a higher speed, fewer laps or a max_time_s (--speed, --laps, --max-time-s) shortens it"
 #: The comparison figures: file name, Comparison method (Figures 17a, 17b, 18a, 18b).
 FIGURES: tuple[tuple[str, str], ...] = (
     ("trajectories.png", "plot_trajectories"),
@@ -256,12 +260,14 @@ def compare(
     reference_controller: str | None = "clothoid",
     warn: Callable[[str], None] | None = warn_on_stderr,
     progress: bool = False,
+    allow_long_run: bool = False,
 ) -> Comparison:
     """Simulate each run on `scenario` (a name, a waypoint file or a Scenario) with the same config. Every run is
-    built first (a bad input is refused before any simulation); what a vehicle cannot follow
-    and each run that may be long (`Simulation.warnings`) are announced through `warn`
-    before the first run (None: silent). progress: a bar on stderr counting the runs (naming the one being
-    prepared or run), left on screen when done."""
+    built first (a bad input is refused before any simulation); what a vehicle cannot follow and a planned top
+    speed short of the config's (`Simulation.warnings`) are announced through `warn` before the first run (None:
+    silent). progress: a bar on stderr counting the runs (naming the one being
+    prepared or run), left on screen when done. A run that may simulate more than the bounds of `run_size` is
+    refused before any run starts, unless allow_long_run."""
     if not runs:
         raise WorkbenchInputError("a comparison needs at least one (controller, vehicle) run; got none")
     if len(set(runs)) != len(runs):
@@ -280,6 +286,8 @@ def compare(
         for spec in runs:
             bar.set_postfix_str(f"preparing {spec.label}")
             simulations.append(_simulation(spec, scenario, scenario_options, config))
+            if not allow_long_run:
+                check_run_size(simulations[-1].size, spec.label, LONG_RUN_SHORTENED, "--allow-long-run")
         messages = [m for spec, sim in zip(runs, simulations, strict=True) for m in sim.warnings(spec.label)]
         if warn is not None:
             with tqdm.external_write_mode(file=sys.stderr):  # above the bar, not through it

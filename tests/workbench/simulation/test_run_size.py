@@ -94,11 +94,9 @@ def test_a_very_slow_run_is_sized_in_days_and_gigabytes() -> None:
 
 @pytest.mark.parametrize("laps", [2, 1_000_000_000])
 def test_laps_on_an_open_path_are_refused(laps: int) -> None:
-    vehicle = KinematicBicycle()
+    vehicle, config = KinematicBicycle(), SimulationConfig(laps=laps)
     with pytest.raises(WorkbenchInputError, match=rf"^laps = {laps}: straight is an open path .*closed paths only"):
-        Simulation(
-            Scenario("straight", _straight(), "test"), vehicle, PurePursuit(vehicle.geometry), SimulationConfig(laps=laps)
-        )
+        Simulation(Scenario("straight", _straight(), "test"), vehicle, PurePursuit(vehicle.geometry), config)
 
 
 def test_laps_on_a_closed_path_are_accepted() -> None:

@@ -75,6 +75,7 @@ def test_speeds_the_path_carries_that_lower_the_top_are_named() -> None:
     path = ReferencePath.from_xy(x, y, speed_mps=np.full_like(x, 5.0), name="slow")
     planned, top = plan_path_speed_and_top(path, SimulationConfig(speed_kmh=50.0))
     assert top.limit is TopSpeedLimit.PATH_SPEED and top.top_mps == pytest.approx(5.0)
+    assert float(planned.speed_mps.max()) == pytest.approx(5.0)
     assert top.reason() == "the speeds the path's waypoints carry"
 
 
