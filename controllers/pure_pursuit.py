@@ -16,7 +16,7 @@ import numpy as np
 from numba import njit
 
 from controllers.base import Controller, Measurement
-from controllers.config_checks import check_number
+from controllers.config_checks import Number, check_options, option
 from workbench.base.errors import WorkbenchInputError, value_text
 from workbench.base.path import PathTracker, ReferencePath
 from workbench.base.path_search import first_beyond, track, value_at
@@ -27,16 +27,26 @@ MAX_LOOKAHEAD_M = 1000.0
 
 @dataclass(frozen=True)
 class PurePursuitConfig:
-    """lookahead_gain_s: l_d per unit speed (s); min_lookahead_m, max_lookahead_m: bounds on l_d (m)."""
+    """Options of pure pursuit (module docstring); each field's unit, range and meaning are in its metadata
+    (`config_checks.option`), which `workbench controllers --show pure-pursuit` prints."""
 
-    lookahead_gain_s: float = 0.8
-    min_lookahead_m: float = 4.0
-    max_lookahead_m: float = 30.0
+    lookahead_gain_s: float = option(
+        0.8,
+        "k, the lookahead per unit speed: l_d = clip(k v, min_lookahead_m, max_lookahead_m); longer is calmer, "
+        "shorter cuts corners less",
+        Number(0.0, 100.0, "s", low_open=True),
+    )
+    min_lookahead_m: float = option(
+        4.0, "the shortest lookahead l_d, at low speed", Number(0.0, MAX_LOOKAHEAD_M, "m", low_open=True)
+    )
+    max_lookahead_m: float = option(
+        30.0,
+        "the longest lookahead l_d, at high speed (at least min_lookahead_m)",
+        Number(0.0, MAX_LOOKAHEAD_M, "m", low_open=True),
+    )
 
     def __post_init__(self) -> None:
-        check_number("lookahead_gain_s", self.lookahead_gain_s, 0.0, 100.0, "s", low_open=True)
-        check_number("min_lookahead_m", self.min_lookahead_m, 0.0, MAX_LOOKAHEAD_M, "m", low_open=True)
-        check_number("max_lookahead_m", self.max_lookahead_m, 0.0, MAX_LOOKAHEAD_M, "m", low_open=True)
+        check_options(self)
         if self.max_lookahead_m < self.min_lookahead_m:
             raise WorkbenchInputError(
                 f"max_lookahead_m must be >= min_lookahead_m = {value_text(self.min_lookahead_m)} m; "

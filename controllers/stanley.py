@@ -13,23 +13,34 @@ from dataclasses import dataclass
 from typing import ClassVar
 
 from controllers.base import Controller, Measurement
-from controllers.config_checks import check_bool, check_number
+from controllers.config_checks import Flag, Number, check_options, option
 from workbench.base.path import PathTracker, ReferencePath, wrap_angle
 
 
 @dataclass(frozen=True)
 class StanleyConfig:
-    """gain_per_s: k, cross-track gain (1/s); softening_mps: k_soft, keeps the law finite at low speed (m/s);
-    curvature_feedforward: add atan(L kappa_path) at the front axle's foot point."""
+    """Options of the Stanley law (module docstring); each field's unit, range and meaning are in its metadata
+    (`config_checks.option`), which `workbench controllers --show stanley` prints."""
 
-    gain_per_s: float = 1.5
-    softening_mps: float = 1.0
-    curvature_feedforward: bool = False
+    gain_per_s: float = option(
+        1.5,
+        "k, the cross-track gain: how hard the front axle's offset is steered out (atan(k e / (k_soft + v)))",
+        Number(0.0, 100.0, "1/s", low_open=True),
+    )
+    softening_mps: float = option(
+        1.0,
+        "k_soft, added to the speed in the cross-track term: keeps the law finite and calm at low speed",
+        Number(0.0, 100.0, "m/s", low_open=True),
+    )
+    curvature_feedforward: bool = option(
+        False,
+        "add the feed-forward that holds the path's curvature in a steady turn (module docstring; off in the original "
+        "law)",
+        Flag(),
+    )
 
     def __post_init__(self) -> None:
-        check_number("gain_per_s", self.gain_per_s, 0.0, 100.0, "1/s", low_open=True)
-        check_number("softening_mps", self.softening_mps, 0.0, 100.0, "m/s", low_open=True)
-        check_bool("curvature_feedforward", self.curvature_feedforward)
+        check_options(self)
 
 
 class Stanley(Controller):

@@ -47,16 +47,10 @@ from controllers.clothoid.delay_predictor import history_length
 from controllers.clothoid.filter_schedule import FilterSchedule
 from controllers.clothoid.lead_filter import DiscreteLeadFilter
 from controllers.clothoid.lookahead import MAX_CURVE_POINTS, candidate_count
-from controllers.clothoid.lookahead_filter import require_rate
+from controllers.clothoid.lookahead_filter import RATE_LIMIT
 from controllers.clothoid.path_feedforward import FeedforwardTiming
 from controllers.clothoid.vehicle_tuning import VehicleTuning
-from controllers.config_checks import (
-    check_bool,
-    check_choice,
-    check_number,
-    check_optional_instance,
-    check_optional_number,
-)
+from controllers.config_checks import Choice, Flag, Instance, Number, check_options, option
 from workbench.base.errors import WorkbenchInputError, value_text
 from workbench.base.path import PathTracker, ReferencePath
 from workbench.vehicles.base import VehicleGeometry
@@ -108,88 +102,206 @@ DIAGNOSTIC_KEYS = (
 
 @dataclass(frozen=True)
 class ClothoidConfig:
-    """Options of the clothoid controller (the paper's values where it gives them).
+    """Options of the clothoid controller (the paper's values where it gives them; module docstring). Each field's
+    unit, allowed range and meaning are in its metadata (`config_checks.option`): `check_options` checks them and
+    `workbench controllers --show clothoid` prints them. The objects a file is read into (`tuning`, `lead_filter`,
+    `curvature_limits`) are given in a config file or `--set` by their file options (`tuning_dir`, `filter_file`,
+    `limits_file`), read when the config is loaded."""
 
-    lookahead_mode: "adaptive" (Fréchet, section 3), "fixed" (fixed_lookahead_m) or "speed" (lookahead_gain_s x
-    speed, clipped to the range); min/max_lookahead_m: the range (m; the paper: 5-20 m; the analysis floor raises
-    the lower end, and the upper one with it where needed); lookahead_step_m: the grid of the adaptive search (m);
-    search_start: where the adaptive search starts, "last" (the last step's choice; few fits a step) or "ends"
-    (bisection from the range's ends every step, as before issue 19); the two choose alike wherever admissibility
-    falls with the lookahead (`lookahead.adaptive_search`);
-    min_preview_time_s: raises the lower end of the range to this time x speed (s; 0: off); lookahead_hysteresis_m,
-    max_lookahead_growth_m_per_m, max_lookahead_shrink_m_per_m: how the search's choice is followed
-    (`lookahead_filter.py`; None: at once); min_phase_margin_deg, min_gain_margin_db: the margins the lookahead floor
-    keeps (`loop_analysis.py`; 0 and 0: no floor; with a known delay compensated by the lags' model, the nominal,
-    delay-free loop's); min_delayed_phase_margin_deg, min_delayed_gain_margin_db, known_delay_uncertainty_s: with that
-    compensation, the margins the loop with its delay and the predictor keeps besides, at the steering sent, the
-    vehicle's dead time within +- known_delay_uncertainty_s (s) of the known one (`loop_analysis.DelayRobustness`);
-    max_target_turn_deg: the lookahead's geometric ceiling, no target farther round a bend than the path turning this
-    much from the foot point (deg; 0: none; never below the floor): an offset of the vehicle shows at a target theta
-    round the bend as offset x cos(theta), and Eq. 3's gain on it falls alike (0.46 of a straight's at 60 deg, none at
-    90 deg), which the margins do not see;
-    frechet_threshold_m: the adaptive threshold (m; the paper: 0.5 m) and threshold_mode how it applies ("excess" of
-    |CTE| or "absolute"; module docstring); frechet_point_spacing_m: sampling of the curves compared (m); tolerance_x_m,
-    tolerance_y_m: delta_x, delta_y of Eq. 3 (m); max_curvature_rate_1pm2: saturation of the clothoid's kappa' (1/m^2);
-    initial_curvature: kappa(0) of Eq. 3, "yaw-rate", "command" or "steering" (the lookahead floor is the measured
-    kappa(0)'s, "yaw-rate", whichever is chosen: `loop_analysis` models "command" too, whose loop has 25-36 deg of phase
-    margin on the truck and the car at 30 km/h, below 45 deg at any lookahead, and not "steering"); heading: "course" or
-    "yaw"; prediction_time_s: pose prediction (s; 0: off); known_delay_s: the loop's dead time the controller knows,
-    measurement latency (the pose measured is that long old) plus actuation dead time (a command reaches the steering
-    that much later) (s; 0: none): the pose is predicted over it as well, the reference pose and the feed-forward point
-    move ahead with it, and the lookahead floor's loop analysis has it (`loop_analysis.LoopSettings`);
-    delay_compensation: how the pose is predicted over the known delay, "model" (the identified lags driven by the
-    commands already sent, a Smith predictor, `delay_predictor.py`: the loop's nominal dynamics are the delay-free ones,
-    and the lookahead floor keeps the margins on them and the min_delayed_* ones; needs the tuning and initial_curvature
-    "yaw-rate") or "arc" (on kappa(0) over prediction_time_s + known_delay_s; the delay stays in the loop, and the floor
-    is the delayed loop's);
-    path_feedforward: the two-degree-of-freedom form (`path_feedforward.py`; False: Eq. 3 alone);
-    feedforward_window_m: the window the path's curvature rate is averaged over (m); feedforward_time_s,
-    reference_lead_s: its timings (s; None: from the vehicle's identified lags); tuning: the steered vehicle's own
-    tuning (lead filter, curvature limits, identified lags; `tuning.own_tuning.tuning_for` finds it, and
-    `tuned_controller` fills it in; None: untuned, no lead filter and no lookahead floor unless given below; in a
-    config file, `tuning_dir` names a tuning directory); lead_filter: the lead filter's schedule (None: the
-    tuning's; in a config file or `--set`, `filter_file` names a file of the `tuning design-lead` or `tuning
-    schedule` format, read when the config is loaded); use_lead_filter: False switches the filter off;
-    curvature_limits: the curvature limits (None: the tuning's, else limits from the geometry,
-    `CurvatureLimits.default_for`; in a file, `limits_file` names a CSV of the `tuning rollover-limits` format).
-    """
-
-    lookahead_mode: str = "adaptive"
-    min_lookahead_m: float = 5.0
-    max_lookahead_m: float = 20.0
-    lookahead_step_m: float = 0.5
-    search_start: str = "last"
-    min_preview_time_s: float = 0.0
-    lookahead_hysteresis_m: float = 0.5
-    max_lookahead_growth_m_per_m: float | None = 0.3
-    max_lookahead_shrink_m_per_m: float | None = 0.5
-    min_phase_margin_deg: float = 45.0
-    min_gain_margin_db: float = 6.0
-    min_delayed_phase_margin_deg: float = 30.0
-    min_delayed_gain_margin_db: float = 3.0
-    known_delay_uncertainty_s: float = 0.05
-    max_target_turn_deg: float = 60.0
-    fixed_lookahead_m: float = 10.0
-    lookahead_gain_s: float = 1.0
-    frechet_threshold_m: float = 0.02
-    threshold_mode: str = "absolute"
-    frechet_point_spacing_m: float = 0.5
-    tolerance_x_m: float = 0.5
-    tolerance_y_m: float = 0.5
-    max_curvature_rate_1pm2: float = 0.05
-    initial_curvature: str = "yaw-rate"
-    heading: str = "course"
-    prediction_time_s: float = 0.2
-    known_delay_s: float = 0.0
-    delay_compensation: str = "model"
-    path_feedforward: bool = True
-    feedforward_window_m: float = 6.0
-    feedforward_time_s: float | None = None
-    reference_lead_s: float | None = None
-    tuning: VehicleTuning | None = None
-    lead_filter: FilterSchedule | None = None
-    use_lead_filter: bool = True
-    curvature_limits: CurvatureLimits | None = None
+    lookahead_mode: str = option(
+        "adaptive",
+        'how the lookahead is chosen: "adaptive" (the Fréchet search, section 3), "fixed" (fixed_lookahead_m) or '
+        '"speed" (lookahead_gain_s x speed, clipped to the range)',
+        Choice(LOOKAHEAD_MODES),
+    )
+    min_lookahead_m: float = option(
+        5.0,
+        "the lower end of the lookahead range (the paper: 5-20 m); the lookahead floor raises it where the loop's "
+        "margins need a longer one",
+        Number(0.5, MAX_LOOKAHEAD_M, "m"),
+    )
+    max_lookahead_m: float = option(
+        20.0,
+        "the upper end of the lookahead range (at least min_lookahead_m); raised with the floor where needed",
+        Number(0.5, MAX_LOOKAHEAD_M, "m"),
+    )
+    lookahead_step_m: float = option(
+        0.5,
+        "the spacing of the adaptive search's candidate lookaheads (at most 1000 candidates over the range)",
+        Number(0.05, 50.0, "m"),
+    )
+    search_start: str = option(
+        "last",
+        'where the adaptive search starts: "last" (the last step\'s choice; few fits a step) or "ends" (bisection '
+        "from the range's ends every step); the two choose alike wherever admissibility falls with the lookahead",
+        Choice(SEARCH_STARTS),
+    )
+    min_preview_time_s: float = option(
+        0.0,
+        "raises the lower end of the lookahead range to this time x speed (0: off)",
+        Number(0.0, 10.0, "s"),
+    )
+    lookahead_hysteresis_m: float = option(
+        0.5,
+        "changes of the search's choice smaller than this are not followed (`lookahead_filter.py`)",
+        Number(0.0, 50.0, "m"),
+    )
+    max_lookahead_growth_m_per_m: float | None = option(
+        0.3,
+        "the most the followed lookahead lengthens per metre travelled (`lookahead_filter.py`)",
+        RATE_LIMIT,
+    )
+    max_lookahead_shrink_m_per_m: float | None = option(
+        0.5,
+        "the most the followed lookahead shortens per metre travelled (`lookahead_filter.py`)",
+        RATE_LIMIT,
+    )
+    min_phase_margin_deg: float = option(
+        45.0,
+        "the phase margin the lookahead floor keeps (`loop_analysis.py`; 0 here and in min_gain_margin_db: no floor; "
+        "with a known delay compensated by the lags' model, the delay-free loop's)",
+        Number(0.0, 89.0, "deg"),
+    )
+    min_gain_margin_db: float = option(
+        6.0,
+        "the gain margin the lookahead floor keeps (as min_phase_margin_deg)",
+        Number(0.0, 40.0, "dB"),
+    )
+    min_delayed_phase_margin_deg: float = option(
+        30.0,
+        'with delay_compensation "model" and a known delay, the phase margin the loop with its delay and the '
+        "predictor keeps besides, for dead times within known_delay_uncertainty_s of the known one "
+        "(`loop_analysis.DelayRobustness`)",
+        Number(0.0, 89.0, "deg"),
+    )
+    min_delayed_gain_margin_db: float = option(
+        3.0,
+        "the gain margin kept as min_delayed_phase_margin_deg is",
+        Number(0.0, 40.0, "dB"),
+    )
+    known_delay_uncertainty_s: float = option(
+        0.05,
+        "how far the vehicle's dead time may be from known_delay_s (either way) with the min_delayed_* margins kept",
+        Number(0.0, 1.0, "s"),
+    )
+    max_target_turn_deg: float = option(
+        60.0,
+        "the lookahead's geometric ceiling: no target farther round a bend than the path turning this much from the "
+        "foot point (never below the floor); an offset shows at a target theta round the bend as offset x "
+        "cos(theta), which the margins do not see",
+        Number(0.0, 180.0, "deg", note="0: no ceiling"),
+    )
+    fixed_lookahead_m: float = option(
+        10.0,
+        'the lookahead of lookahead_mode "fixed"',
+        Number(0.5, MAX_LOOKAHEAD_M, "m"),
+    )
+    lookahead_gain_s: float = option(
+        1.0,
+        'the lookahead per unit speed of lookahead_mode "speed" (clipped to the range)',
+        Number(0.0, 100.0, "s", low_open=True),
+    )
+    frechet_threshold_m: float = option(
+        0.02,
+        "the adaptive search's threshold on the Fréchet distance between the clothoid and the path (the paper: "
+        "0.5 m); threshold_mode says how it applies",
+        Number(0.0, 100.0, "m", low_open=True),
+    )
+    threshold_mode: str = option(
+        "absolute",
+        'how frechet_threshold_m applies: "absolute" (the paper\'s) or "excess" (over the current |CTE|)',
+        Choice(THRESHOLD_MODES),
+    )
+    frechet_point_spacing_m: float = option(
+        0.5,
+        f"the sampling of the curves the Fréchet distance compares (above max_lookahead_m / {MAX_CURVE_POINTS})",
+        Number(0.0, 50.0, "m", low_open=True),
+    )
+    tolerance_x_m: float = option(
+        0.5,
+        "delta_x of Eq. 3: how far along x the clothoid's end may miss the target for a lookahead to be admissible",
+        Number(0.0, 100.0, "m", low_open=True),
+    )
+    tolerance_y_m: float = option(
+        0.5,
+        "delta_y of Eq. 3: how far along y the clothoid's end may miss the target for a lookahead to be admissible",
+        Number(0.0, 100.0, "m", low_open=True),
+    )
+    max_curvature_rate_1pm2: float = option(
+        0.05,
+        "the saturation of the clothoid's curvature rate kappa' (per metre of arc)",
+        Number(0.0, 10.0, "1/m^2", low_open=True),
+    )
+    initial_curvature: str = option(
+        "yaw-rate",
+        'kappa(0) of Eq. 3: "yaw-rate" (measured: yaw rate / speed), "command" or "steering"; the lookahead floor is '
+        "the measured kappa(0)'s whichever is chosen (\"command\"'s loop has 25-36 deg of phase margin on the truck "
+        'and the car at 30 km/h; "steering" is not modelled)',
+        Choice(INITIAL_CURVATURE),
+    )
+    heading: str = option(
+        "course",
+        'the clothoid\'s start direction: "course" (yaw plus sideslip, the direction the vehicle moves in) or "yaw"',
+        Choice(HEADINGS),
+    )
+    prediction_time_s: float = option(
+        0.2,
+        "the start pose is predicted this far ahead (Figure 2's step 5; 0: off)",
+        Number(0.0, 2.0, "s"),
+    )
+    known_delay_s: float = option(
+        0.0,
+        "the loop's dead time the controller knows, measurement latency plus actuation dead time: the pose is "
+        "predicted over it, the reference pose and feed-forward point move ahead with it, and the lookahead floor's "
+        "loop analysis has it",
+        Number(0.0, 1.0, "s", note="0: none"),
+    )
+    delay_compensation: str = option(
+        "model",
+        'how the pose is predicted over known_delay_s: "model" (the identified lags driven by the commands already '
+        'sent, a Smith predictor, `delay_predictor.py`; needs the tuning and initial_curvature "yaw-rate") or "arc" '
+        "(on kappa(0); the delay stays in the loop, and the floor is the delayed loop's)",
+        Choice(DELAY_COMPENSATIONS),
+    )
+    path_feedforward: bool = option(
+        True,
+        "the two-degree-of-freedom form: the path's own clothoid taken out of the feedback and its curvature rate fed "
+        "forward (`path_feedforward.py`; false: Eq. 3 alone)",
+        Flag(),
+    )
+    feedforward_window_m: float = option(
+        6.0,
+        "the window the path's curvature rate is averaged over for the feed-forward",
+        Number(0.1, 100.0, "m"),
+    )
+    feedforward_time_s: float | None = option(
+        None,
+        "where along the path the feed-forward reads the curvature rate: speed x this time ahead of the foot point",
+        Number(0.0, 5.0, "s", none_means="from the vehicle's lags"),
+    )
+    reference_lead_s: float | None = option(
+        None,
+        "how far ahead of the foot point the feedback's reference pose starts (at most the prediction time)",
+        Number(0.0, 5.0, "s", none_means="from the vehicle's lags"),
+    )
+    tuning: VehicleTuning | None = option(  # noqa: RUF009  (option is a dataclasses.field)
+        None,
+        "the steered vehicle's own tuning: lead filter, curvature limits, identified lags "
+        "(`tuning.own_tuning.tuned_controller` fills it in; in a file, tuning_dir names a tuning directory)",
+        Instance(VehicleTuning, "untuned: no lead filter and no lookahead floor unless given"),
+    )
+    lead_filter: FilterSchedule | None = option(  # noqa: RUF009  (option is a dataclasses.field)
+        None,
+        "the lead filter's schedule (in a file, filter_file names a `tuning design-lead` or `tuning schedule` file)",
+        Instance(FilterSchedule, "the tuning's"),
+    )
+    use_lead_filter: bool = option(True, "false switches the lead filter off", Flag())
+    curvature_limits: CurvatureLimits | None = option(  # noqa: RUF009  (option is a dataclasses.field)
+        None,
+        "the speed-dependent curvature and curvature-rate limits (in a file, limits_file names a CSV of the `tuning "
+        "rollover-limits` format)",
+        Instance(CurvatureLimits, "the tuning's, else limits from the geometry (`CurvatureLimits.default_for`)"),
+    )
 
     @property
     def predicts_with_model(self) -> bool:
@@ -197,43 +309,8 @@ class ClothoidConfig:
         return self.delay_compensation == "model" and self.known_delay_s > 0.0
 
     def __post_init__(self) -> None:
-        # Every field on its own first (`config_checks.py`), then what relates them.
-        check_choice("lookahead_mode", self.lookahead_mode, LOOKAHEAD_MODES)
-        check_choice("initial_curvature", self.initial_curvature, INITIAL_CURVATURE)
-        check_choice("heading", self.heading, HEADINGS)
-        check_choice("threshold_mode", self.threshold_mode, THRESHOLD_MODES)
-        check_choice("search_start", self.search_start, SEARCH_STARTS)
-        check_choice("delay_compensation", self.delay_compensation, DELAY_COMPENSATIONS)
-        check_number("prediction_time_s", self.prediction_time_s, 0.0, 2.0, "s")
-        check_number("known_delay_s", self.known_delay_s, 0.0, 1.0, "s", note="0: none")
-        check_number("min_preview_time_s", self.min_preview_time_s, 0.0, 10.0, "s")
-        check_number("lookahead_hysteresis_m", self.lookahead_hysteresis_m, 0.0, 50.0, "m")
-        require_rate("max_lookahead_growth_m_per_m", self.max_lookahead_growth_m_per_m)
-        require_rate("max_lookahead_shrink_m_per_m", self.max_lookahead_shrink_m_per_m)
-        check_number("min_phase_margin_deg", self.min_phase_margin_deg, 0.0, 89.0, "deg")
-        check_number("min_gain_margin_db", self.min_gain_margin_db, 0.0, 40.0, "dB")
-        check_number("min_delayed_phase_margin_deg", self.min_delayed_phase_margin_deg, 0.0, 89.0, "deg")
-        check_number("min_delayed_gain_margin_db", self.min_delayed_gain_margin_db, 0.0, 40.0, "dB")
-        check_number("known_delay_uncertainty_s", self.known_delay_uncertainty_s, 0.0, 1.0, "s")
-        check_number("max_target_turn_deg", self.max_target_turn_deg, 0.0, 180.0, "deg", note="0: no ceiling")
-        check_number("min_lookahead_m", self.min_lookahead_m, 0.5, MAX_LOOKAHEAD_M, "m")
-        check_number("max_lookahead_m", self.max_lookahead_m, 0.5, MAX_LOOKAHEAD_M, "m")
-        check_number("fixed_lookahead_m", self.fixed_lookahead_m, 0.5, MAX_LOOKAHEAD_M, "m")
-        check_number("lookahead_gain_s", self.lookahead_gain_s, 0.0, 100.0, "s", low_open=True)
-        check_number("frechet_threshold_m", self.frechet_threshold_m, 0.0, 100.0, "m", low_open=True)
-        check_number("frechet_point_spacing_m", self.frechet_point_spacing_m, 0.0, 50.0, "m", low_open=True)
-        check_number("tolerance_x_m", self.tolerance_x_m, 0.0, 100.0, "m", low_open=True)
-        check_number("tolerance_y_m", self.tolerance_y_m, 0.0, 100.0, "m", low_open=True)
-        check_number("max_curvature_rate_1pm2", self.max_curvature_rate_1pm2, 0.0, 10.0, "1/m^2", low_open=True)
-        check_number("lookahead_step_m", self.lookahead_step_m, 0.05, 50.0, "m")
-        check_bool("path_feedforward", self.path_feedforward)
-        check_number("feedforward_window_m", self.feedforward_window_m, 0.1, 100.0, "m")
-        for name in ("feedforward_time_s", "reference_lead_s"):
-            check_optional_number(name, getattr(self, name), 0.0, 5.0, "s", none_means="from the vehicle's lags")
-        check_optional_instance("tuning", self.tuning, VehicleTuning)
-        check_optional_instance("lead_filter", self.lead_filter, FilterSchedule)
-        check_bool("use_lead_filter", self.use_lead_filter)
-        check_optional_instance("curvature_limits", self.curvature_limits, CurvatureLimits)
+        # Every field on its own first (its rule, `config_checks.check_options`), then what relates them.
+        check_options(self)
         if self.predicts_with_model and self.initial_curvature != "yaw-rate":
             raise WorkbenchInputError(
                 f"delay_compensation 'model' predicts the measured kappa(0), initial_curvature 'yaw-rate'; got "

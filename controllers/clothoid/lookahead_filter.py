@@ -22,12 +22,15 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from controllers.config_checks import check_number, check_optional_number
+from controllers.config_checks import Number, check_number
+
+#: A rate limit in metres of lookahead per metre travelled: None (unlimited) or a number in (0, 100].
+RATE_LIMIT = Number(0.0, 100.0, "m per m", low_open=True, none_means="unlimited")
 
 
 def require_rate(name: str, value: float | None) -> None:
-    """A rate limit in metres of lookahead per metre travelled: None (unlimited) or a number in (0, 100]."""
-    check_optional_number(name, value, 0.0, 100.0, "m per m", low_open=True, none_means="unlimited")
+    """Refuse a rate limit `RATE_LIMIT` does not allow."""
+    RATE_LIMIT.check(name, value)
 
 
 @dataclass(frozen=True)

@@ -41,14 +41,7 @@ import numpy as np
 from numba import njit
 
 from controllers.base import Controller, Measurement
-from controllers.config_checks import (
-    check_bool,
-    check_choice,
-    check_number,
-    check_optional_instance,
-    check_optional_number,
-    check_whole,
-)
+from controllers.config_checks import Choice, Flag, Instance, Number, Whole, check_options, option
 from controllers.mpc.codegen import FastFunction, compile_function
 from controllers.mpc.ocp import TrackingOCP, TrackingWeights
 from controllers.mpc.plan import Plan, shift_rows
@@ -152,79 +145,113 @@ class PoseFilter:
         return Measurement(m.t_s, self._x, self._y, m.vx_mps, m.vy_mps, yaw, m.yaw_rate_rad_s, m.steer_wheel_rad)
 
 
+def _vehicle_choices() -> tuple[str, ...]:
+    """What MPCConfig.vehicle may name: "auto", "geometry" or a shipped preset (`workbench vehicles`)."""
+    from workbench.vehicles import VEHICLES
+
+    return ("auto", "geometry", *VEHICLES)
+
+
 @dataclass(frozen=True)
 class MPCConfig:
-    """Options common to both MPCs (SI units in the names).
+    """Options common to both MPCs (module docstring). Each field's unit, allowed range and meaning are in its
+    metadata (`config_checks.option`): `check_options` checks them and `workbench controllers --show nmpc` prints
+    them. The objects a file is read into (`prediction_vehicle`, `lag`) are given in a config file or `--set` by
+    their file options (`vehicle_file`, `lag_file`), read when the config is loaded."""
 
-    vehicle: where the prediction model's parameters come from: "auto" (the steered vehicle's own parameters when
-    the caller passes its model, else the shipped preset whose geometry equals the steered vehicle's, else the
-    geometry alone), "geometry" (kinematic single track from the geometry), or a preset name
-    (`workbench vehicles`); prediction_vehicle: a vehicle's single-track equivalent instead (overrides `vehicle`;
-    in a config file or `--set`, `vehicle_file` names a vehicle TOML file, read when the config is loaded);
-    lag: an identified steering lag that the prediction then uses, as the clothoid controller's lead filter does
-    (`lag_file` names a "steering-lag/1" JSON from `tuning fit-lag`); model: "auto" (kinematic-lag with a lag,
-    else dynamic when mass and tyres are known, else kinematic), "dynamic", "kinematic" or "kinematic-lag"
-    (`prediction_model.py`); horizon_steps: N; step_s: prediction step h (s); weight_cte (1/m^2),
-    weight_heading (1/rad^2), weight_steer_rate (s^2/rad^2, on the road-wheel rate): stage weights;
-    terminal_weight_cte (1/m^2), terminal_weight_heading (1/rad^2): terminal weights; max_lat_accel_mps2: soft
-    limit on the predicted lateral acceleration (m/s^2; 0: none) with weight_lat_accel_slack (s^4/m^2);
-    min_model_speed_mps: the prediction never runs slower than this (m/s); max_solve_time_s: the solver's wall-time
-    budget (s), a solve cut short by it is late and not used (0: the controller's sample time); codegen: compile
-    the model's derivatives with the system C compiler where that pays (cached; ignored without a compiler);
-    input_delay_s: the known actuation dead time D (s; a command sent at t reaches the steering at t + D) and
-    measurement_latency_s: the known measurement latency L (s; the measurement stamped t describes t - L), which the
-    controller compensates by predicting the measured state to t + D with the commands already sent and planning
-    from there (module docstring; 0 and 0: no compensation, the plan starts at the measurement);
-    pose_filter_cutoff_hz: the crossover frequency (Hz) of the complementary filter on the measured pose
-    (`PoseFilter`; 0: off, the measured pose is used as it is); yaw_rate_latency_s: the known latency (s) of the
-    measured yaw rate when it differs from measurement_latency_s, by which the pose filter aligns the yaw rate with
-    the pose (None: measurement_latency_s; only with the pose filter).
-    """
-
-    vehicle: str = "auto"
-    prediction_vehicle: PredictionParams | None = None
-    lag: SteeringLag | None = None
-    model: str = "auto"
-    horizon_steps: int = 30
-    step_s: float = 0.05
-    weight_cte: float = 200.0
-    weight_heading: float = 10.0
-    weight_steer_rate: float = 5.0
-    terminal_weight_cte: float = 2000.0
-    terminal_weight_heading: float = 100.0
-    max_lat_accel_mps2: float = 0.0
-    weight_lat_accel_slack: float = 100.0
-    min_model_speed_mps: float = 3.0
-    max_solve_time_s: float = 0.0
-    codegen: bool = True
-    input_delay_s: float = 0.0
-    measurement_latency_s: float = 0.0
-    pose_filter_cutoff_hz: float = 0.0
-    yaw_rate_latency_s: float | None = None
+    vehicle: str = option(
+        "auto",
+        'where the prediction model\'s parameters come from: "auto" (the steered vehicle\'s own when the caller passes '
+        "its model, else the shipped preset of the same geometry, else the geometry alone), \"geometry\" (kinematic "
+        "single track from the geometry), or a preset name",
+        Choice(_vehicle_choices),
+    )
+    prediction_vehicle: PredictionParams | None = option(  # noqa: RUF009  (option is a dataclasses.field)
+        None,
+        "a vehicle's single-track equivalent to predict with instead of `vehicle` (in a file, vehicle_file names a "
+        "vehicle TOML file)",
+        Instance(PredictionParams, "as `vehicle` says"),
+    )
+    lag: SteeringLag | None = option(  # noqa: RUF009  (option is a dataclasses.field)
+        None,
+        'an identified steering lag the prediction uses (in a file, lag_file names a "steering-lag/1" JSON from '
+        "`tuning fit-lag`)",
+        Instance(SteeringLag, "no identified lag"),
+    )
+    model: str = option(
+        "auto",
+        'the prediction model (`prediction_model.py`): "auto" (kinematic-lag with a lag, else dynamic when mass and '
+        'tyres are known, else kinematic), "dynamic", "kinematic" or "kinematic-lag"',
+        Choice(("auto", *MODEL_KINDS)),
+    )
+    horizon_steps: int = option(30, "N, the prediction horizon in steps of step_s", Whole(2, 500, "steps"))
+    step_s: float = option(0.05, "h, the prediction step", Number(1e-3, 1.0, "s"))
+    weight_cte: float = option(200.0, "the stage weight on the cross-track error", Number(0.0, MAX_WEIGHT, "1/m^2"))
+    weight_heading: float = option(
+        10.0, "the stage weight on the heading error", Number(0.0, MAX_WEIGHT, "1/rad^2")
+    )
+    weight_steer_rate: float = option(
+        5.0,
+        "the stage weight on the road-wheel angle's rate (the input): larger is smoother and slower",
+        Number(0.0, MAX_WEIGHT, "s^2/rad^2", low_open=True),
+    )
+    terminal_weight_cte: float = option(
+        2000.0, "the terminal weight on the cross-track error", Number(0.0, MAX_WEIGHT, "1/m^2")
+    )
+    terminal_weight_heading: float = option(
+        100.0, "the terminal weight on the heading error", Number(0.0, MAX_WEIGHT, "1/rad^2")
+    )
+    max_lat_accel_mps2: float = option(
+        0.0,
+        "a soft limit on the predicted lateral acceleration (its slack weighted by weight_lat_accel_slack)",
+        Number(0.0, 50.0, "m/s^2", note="0: no limit"),
+    )
+    weight_lat_accel_slack: float = option(
+        100.0,
+        "the weight on the lateral-acceleration limit's slack",
+        Number(0.0, MAX_WEIGHT, "s^4/m^2"),
+    )
+    min_model_speed_mps: float = option(
+        3.0, "the prediction never runs slower than this", Number(0.5, 50.0, "m/s")
+    )
+    max_solve_time_s: float = option(
+        0.0,
+        "the solver's wall-time budget; a solve cut short by it is late and not used (a machine-dependent result: "
+        "raise it for reproducible runs)",
+        Number(0.0, 10.0, "s", note="0: the sample time"),
+    )
+    codegen: bool = option(
+        True,
+        "compile the model's derivatives with the system C compiler where that pays (cached; ignored without a "
+        "compiler)",
+        Flag(),
+    )
+    input_delay_s: float = option(
+        0.0,
+        "D, the known actuation dead time (a command sent at t reaches the steering at t + D), compensated by "
+        "predicting the measured state to t + D with the commands already sent",
+        Number(0.0, 1.0, "s", note="0: none"),
+    )
+    measurement_latency_s: float = option(
+        0.0,
+        "L, the known measurement latency (the measurement stamped t describes t - L), compensated as input_delay_s",
+        Number(0.0, 1.0, "s", note="0: none"),
+    )
+    pose_filter_cutoff_hz: float = option(
+        0.0,
+        "the crossover frequency of the complementary filter on the measured pose (`PoseFilter`): pose noise in the "
+        "loop's correction band then no longer drives the steering",
+        Number(0.0, MAX_POSE_FILTER_HZ, "Hz", note="0: off"),
+    )
+    yaw_rate_latency_s: float | None = option(
+        None,
+        "the known latency of the measured yaw rate when it differs from measurement_latency_s, by which the pose "
+        "filter aligns the yaw rate with the pose (only with the pose filter)",
+        Number(0.0, 1.0, "s", none_means="measurement_latency_s"),
+    )
 
     def __post_init__(self) -> None:
-        from workbench.vehicles import VEHICLES
-
-        check_choice("vehicle", self.vehicle, ("auto", "geometry", *VEHICLES))
-        check_optional_instance("prediction_vehicle", self.prediction_vehicle, PredictionParams)
-        check_optional_instance("lag", self.lag, SteeringLag)
-        check_choice("model", self.model, ("auto", *MODEL_KINDS))
-        check_whole("horizon_steps", self.horizon_steps, 2, 500)
-        check_number("step_s", self.step_s, 1e-3, 1.0, "s")
-        for name in ("weight_cte", "weight_heading", "terminal_weight_cte", "terminal_weight_heading"):
-            check_number(name, getattr(self, name), 0.0, MAX_WEIGHT)
-        check_number("weight_steer_rate", self.weight_steer_rate, 0.0, MAX_WEIGHT, low_open=True)
-        check_number("max_lat_accel_mps2", self.max_lat_accel_mps2, 0.0, 50.0, "m/s^2", note="0: no limit")
-        check_number("weight_lat_accel_slack", self.weight_lat_accel_slack, 0.0, MAX_WEIGHT)
-        check_number("min_model_speed_mps", self.min_model_speed_mps, 0.5, 50.0, "m/s")
-        check_number("max_solve_time_s", self.max_solve_time_s, 0.0, 10.0, "s", note="0: the sample time")
-        check_bool("codegen", self.codegen)
-        check_number("input_delay_s", self.input_delay_s, 0.0, 1.0, "s", note="0: none")
-        check_number("measurement_latency_s", self.measurement_latency_s, 0.0, 1.0, "s", note="0: none")
-        check_number("pose_filter_cutoff_hz", self.pose_filter_cutoff_hz, 0.0, MAX_POSE_FILTER_HZ, "Hz", note="0: off")
-        check_optional_number(
-            "yaw_rate_latency_s", self.yaw_rate_latency_s, 0.0, 1.0, "s", none_means="measurement_latency_s"
-        )
+        check_options(self)
         if self.yaw_rate_latency_s is not None and self.pose_filter_cutoff_hz == 0.0:
             raise WorkbenchInputError(
                 "yaw_rate_latency_s is used by the pose filter only: set pose_filter_cutoff_hz > 0 or leave "

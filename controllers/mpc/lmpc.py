@@ -26,13 +26,12 @@ from typing import Any, ClassVar
 import casadi as ca
 import numpy as np
 
-from controllers.config_checks import check_number, check_whole
+from controllers.config_checks import Number, Whole, option
 from controllers.mpc.codegen import FastFunction, compile_function
 from controllers.mpc.common import MPCConfig, MPCController
 from controllers.mpc.ocp import TrackingOCP
 from controllers.mpc.sparse_qp import OsqpSettings
 from controllers.mpc.status import SolveResult
-from workbench.base.errors import WorkbenchInputError, value_text
 from workbench.vehicles.geometry import VehicleGeometry
 
 
@@ -107,22 +106,20 @@ class LtvSolver:
 
 @dataclass(frozen=True)
 class LMPCConfig(MPCConfig):
-    """The common MPC options (`MPCConfig`, model "auto" as the NMPC's) and:
-    qp_tolerance: OSQP's absolute and relative tolerance; qp_max_iterations: OSQP's iteration limit. The
-    lateral-acceleration limit (max_lat_accel_mps2) is the NMPC's only: the LTV-MPC refuses it."""
+    """The common MPC options (`MPCConfig`, model "auto" as the NMPC's) and OSQP's; each field's unit, range and
+    meaning are in its metadata (`config_checks.option`). The lateral-acceleration limit (max_lat_accel_mps2) is the
+    NMPC's only: the LTV-MPC allows 0 alone."""
 
-    qp_tolerance: float = 1e-3
-    qp_max_iterations: int = 4000
+    max_lat_accel_mps2: float = option(
+        0.0,
+        "the NMPC's soft lateral-acceleration limit, which the LTV-MPC does not have",
+        Number(0.0, 0.0, "m/s^2", note="the LTV-MPC has no lateral-acceleration limit; the NMPC has"),
+    )
+    qp_tolerance: float = option(1e-3, "OSQP's absolute and relative tolerance", Number(1e-10, 1e-1))
+    qp_max_iterations: int = option(4000, "OSQP's iteration limit", Whole(1, 10**6, "iterations"))
 
     def __post_init__(self) -> None:
-        super().__post_init__()
-        if self.max_lat_accel_mps2 != 0.0:
-            raise WorkbenchInputError(
-                f"max_lat_accel_mps2 must be 0 for the LTV-MPC (it has no lateral-acceleration limit; the NMPC has); "
-                f"got {value_text(self.max_lat_accel_mps2)}"
-            )
-        check_number("qp_tolerance", self.qp_tolerance, 1e-10, 1e-1)
-        check_whole("qp_max_iterations", self.qp_max_iterations, 1, 10**6)
+        super().__post_init__()  # every field's rule, this class's included (`check_options`)
 
 
 class LMPCController(MPCController):

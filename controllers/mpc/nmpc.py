@@ -21,7 +21,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
-from controllers.config_checks import check_bool, check_choice, check_number, check_whole
+from controllers.config_checks import Choice, Flag, Number, Whole, option
 from controllers.mpc.common import MPCConfig, MPCController
 from controllers.mpc.nlp_solver import IpoptSolver
 from controllers.mpc.rti import RtiSolver
@@ -33,29 +33,29 @@ SOLVERS = ("rti", "ipopt")
 
 @dataclass(frozen=True)
 class NMPCConfig(MPCConfig):
-    """The common MPC options (`MPCConfig`) and: solver: "rti" or "ipopt"; first_iterations: SQP iterations of
-    the RTI on its first step after a reset (no previous solution to linearise along); max_iterations: IPOPT's
-    iteration limit; tolerance: IPOPT's tolerance; exact_hessian: IPOPT with the exact Hessian of the Lagrangian
-    instead of the Gauss-Newton one; qp_tolerance: OSQP's absolute and relative tolerance (RTI);
-    qp_max_iterations: OSQP's iteration limit (RTI)."""
+    """The common MPC options (`MPCConfig`) and the NMPC's solver options; each field's unit, range and meaning are
+    in its metadata (`config_checks.option`)."""
 
-    solver: str = "rti"
-    first_iterations: int = 10
-    max_iterations: int = 100
-    tolerance: float = 1e-6
-    exact_hessian: bool = False
-    qp_tolerance: float = 1e-3
-    qp_max_iterations: int = 4000
+    solver: str = option(
+        "rti",
+        '"rti" (one SQP iteration per step on OSQP, real-time iteration) or "ipopt" (solved to convergence)',
+        Choice(SOLVERS),
+    )
+    first_iterations: int = option(
+        10,
+        "SQP iterations of the RTI on its first step after a reset (no previous solution to linearise along)",
+        Whole(1, 100, "iterations"),
+    )
+    max_iterations: int = option(100, "IPOPT's iteration limit", Whole(1, 10000, "iterations"))
+    tolerance: float = option(1e-6, "IPOPT's convergence tolerance", Number(1e-12, 1e-1))
+    exact_hessian: bool = option(
+        False, "IPOPT with the exact Hessian of the Lagrangian instead of the Gauss-Newton one", Flag()
+    )
+    qp_tolerance: float = option(1e-3, "OSQP's absolute and relative tolerance (RTI)", Number(1e-10, 1e-1))
+    qp_max_iterations: int = option(4000, "OSQP's iteration limit (RTI)", Whole(1, 10**6, "iterations"))
 
     def __post_init__(self) -> None:
-        super().__post_init__()
-        check_choice("solver", self.solver, SOLVERS)
-        check_whole("first_iterations", self.first_iterations, 1, 100)
-        check_whole("max_iterations", self.max_iterations, 1, 10000)
-        check_number("tolerance", self.tolerance, 1e-12, 1e-1)
-        check_bool("exact_hessian", self.exact_hessian)
-        check_number("qp_tolerance", self.qp_tolerance, 1e-10, 1e-1)
-        check_whole("qp_max_iterations", self.qp_max_iterations, 1, 10**6)
+        super().__post_init__()  # every field's rule, this class's included (`check_options`)
 
 
 class NMPCController(MPCController):

@@ -129,6 +129,11 @@ def _parser(command: str | None = None) -> argparse.ArgumentParser:
     )
     fig.add_argument("--out", type=Path, required=True, metavar="DIR", help="output directory (report.html in it)")
     fig.add_argument("--speed", type=float, default=30.0, metavar="KMH", help="target speed, km/h (default 30)")
+    fig.add_argument(
+        "--allow-long-run",
+        action="store_true",
+        help="run even when a run's time-out allows more than 2,000,000 controller steps or a trace over 1 GB",
+    )
     _conditions_options(fig)
     _overwrite_option(fig)
 
@@ -543,7 +548,7 @@ def _fig17(args: argparse.Namespace) -> int:
     from workbench.base.output_dir import OutputDir
 
     out = OutputDir(args.out, "fig17", args.overwrite)
-    result = run_fig17(_simulation_config(args, speed_kmh=args.speed))
+    result = run_fig17(_simulation_config(args, speed_kmh=args.speed), allow_long_run=args.allow_long_run)
     with _writing(out):
         written = result.save(args.out)
     print("Figure 17, fair set (each controller on each plant):")

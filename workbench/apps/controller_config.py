@@ -25,6 +25,8 @@ from __future__ import annotations
 
 import dataclasses
 import difflib
+import json
+import textwrap
 from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -205,25 +207,66 @@ def read_controller_config(
         raise WorkbenchInputError(f"{where}{exc}") from None
 
 
+#: The width of the template's comment lines (characters).
+TEMPLATE_WIDTH = 116
+
+
 def config_template(controller_name: str, config_type: type) -> str:
     """A TOML table of the controller's options at their defaults, to copy and edit (`workbench controllers
-    --show NAME`). Options whose default is None are written commented out."""
+    --show NAME`). Above each option, as comments, what it does, its unit, its default and what it allows, from its
+    field's metadata (`controllers.config_checks.option`: the rule its config's validation checks); a field without
+    that metadata is listed undocumented. Options whose default is an object read from a file are written commented
+    out; the text reads back (`read_controller_config`) to the defaults."""
     defaults = config_type()
-    lines = [f"# {config_type.__name__}: options and defaults; see its docstring for units and meaning.", ""]
-    lines.append(f"[{controller_name}]")
     by_field = {option.field: name for name, option in FILE_OPTIONS.items()}
+    lines = [
+        f"# {controller_name}: {config_type.__name__}, every option at its default. Above each: what it does, its unit",
+        '# ("-": none), its default and the values allowed. Copy, edit and pass it with --controller-config.',
+        "",
+        f"[{controller_name}]",
+    ]
     for f in dataclasses.fields(config_type):
         if not f.init:
             continue
         value = getattr(defaults, f.name)
+        lines += ["", *_option_comment(f, value, by_field.get(f.name))]
         if f.name in by_field:
             lines.append(f'# {by_field[f.name]} = "..."')
-        elif value is None:
-            lines.append(f'# {f.name} = "..."')
-        elif isinstance(value, bool):
-            lines.append(f"{f.name} = {'true' if value else 'false'}")
-        elif isinstance(value, str | Path):
-            lines.append(f'{f.name} = "{value}"')
         else:
-            lines.append(f"{f.name} = {value_text(value)}")
+            lines.append(f"{f.name} = {_toml_text(value)}")
     return "\n".join(lines) + "\n"
+
+
+def _toml_text(value: Any) -> str:
+    """`value` as a TOML value (None as "none", which TOML has no other way to write)."""
+    if value is None:
+        return '"none"'
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, str | Path):
+        return json.dumps(str(value), ensure_ascii=False)
+    return value_text(value)
+
+
+def _option_comment(f: dataclasses.Field[Any], default: Any, file_option: str | None) -> list[str]:
+    """The comment lines above option `f` in a template: its meaning, then unit, default and allowed values."""
+    from controllers.config_checks import option_rule
+
+    rule, doc = option_rule(f), f.metadata.get("doc")
+    if rule is None or doc is None:
+        return [f"# {f.name}: undocumented (its config field has no `option` metadata)"]
+    if file_option is not None:  # the option names a file its config field's object is read from
+        none_means = getattr(rule, "none_means", None) or "none"
+        default_text = f'"none" ({none_means})' if default is None else "given"
+        allowed, name = 'a file path, or "none"', file_option
+    else:
+        default_text, allowed, name = _toml_text(default), rule.allowed(), f.name
+
+    def wrapped(text: str, first: str) -> list[str]:
+        return textwrap.wrap(
+            text, TEMPLATE_WIDTH, initial_indent=first, subsequent_indent="#   ", break_on_hyphens=False
+        )
+
+    return wrapped(f"{name}: {doc}.", "# ") + wrapped(
+        f"unit {rule.unit}; default {default_text}; allowed: {allowed}", "#   "
+    )

@@ -278,12 +278,16 @@ class Fig17Result:
         return written
 
 
-def run_fig17(config: SimulationConfig | None = None, progress: bool | None = None) -> Fig17Result:
+def run_fig17(
+    config: SimulationConfig | None = None, progress: bool | None = None, allow_long_run: bool = False
+) -> Fig17Result:
     """Simulate the fair set (it contains the published pairs) on the fig17 scenario; progress: a line on stderr
-    counting the runs (`compare`; None: when stderr is a terminal, as the CLI shows it)."""
+    counting the runs (`compare`; None: when stderr is a terminal, as the CLI shows it); allow_long_run: run even
+    when a run may simulate more than the bounds of `run_size` (`compare`)."""
     show = sys.stderr.isatty() if progress is None else progress
+    config = config or SimulationConfig(speed_kmh=SPEED_KMH)
     fair = compare(
-        SCENARIO, FAIR, config or SimulationConfig(speed_kmh=SPEED_KMH), reference_controller="clothoid", progress=show
+        SCENARIO, FAIR, config, reference_controller="clothoid", progress=show, allow_long_run=allow_long_run
     )
     return Fig17Result(published=fair.select(PUBLISHED), fair=fair)
 

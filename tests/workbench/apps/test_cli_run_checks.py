@@ -119,3 +119,10 @@ def test_run_names_each_stage_on_stderr_when_it_is_not_a_terminal(tmp_path: Path
     assert stages[0] == "workbench run: building the vehicle, the controller and the scenario"
     assert re.fullmatch(r"workbench run: simulating 191 m of dlc \(time-out after \d+ s simulated\)", stages[1])
     assert stages[2] == f"workbench run: writing to {tmp_path / 'o'}" and len(stages) == 3
+
+
+def test_fig17_refuses_a_crawl_naming_its_option(tmp_path: Path, capsys, runs) -> None:
+    assert main(["fig17", "--speed", "0.001", "--out", str(tmp_path / "o")]) == 2
+    error = capsys.readouterr().err.splitlines()[-1]
+    assert error.startswith("workbench: error: clothoid on ") and error.endswith("allow it with --allow-long-run")
+    assert runs == []

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import dataclasses
+import math
 import tomllib
 from pathlib import Path
 
@@ -10,8 +12,10 @@ import pytest
 from controllers import CONTROLLERS
 from controllers.clothoid import ClothoidConfig
 from controllers.clothoid.filter_schedule import DEFAULT_FILTER
+from controllers.config_checks import Choice, Flag, Number, Whole, option_rule
 from tuning.filter_file import read_filter_file, write_filter_file
 from workbench.apps.controller_config import (
+    FILE_OPTIONS,
     build_config,
     config_template,
     missing_table_warning,
@@ -191,3 +195,67 @@ def test_a_study_specs_controller_config_is_checked_alike(tmp_path: Path, capsys
     (tmp_path / "options.toml").write_text("[pure-pursuit]\n")
     load_spec(spec)
     assert "has no [stanley] table (only [pure-pursuit])" in capsys.readouterr().err
+
+
+# ------------------------------------------------------------------------------ the options' documentation
+def _documented_fields(name: str) -> list[tuple[type, dataclasses.Field]]:
+    config_type = CONTROLLERS[name].config_type
+    return [(config_type, f) for f in dataclasses.fields(config_type) if f.init]
+
+
+@pytest.mark.parametrize("name", sorted(CONTROLLERS))
+def test_every_option_has_a_unit_a_range_and_a_meaning_and_the_template_prints_them(name: str) -> None:
+    config_type = CONTROLLERS[name].config_type
+    template = config_template(name, config_type)
+    file_options = {option.field: key for key, option in FILE_OPTIONS.items()}
+    for _, f in _documented_fields(name):
+        rule = option_rule(f)
+        assert rule is not None, f"{config_type.__name__}.{f.name} has no rule (config_checks.option)"
+        doc = f.metadata.get("doc")
+        assert isinstance(doc, str) and len(doc) > 10 and "\n" not in doc, f"{f.name}: {doc!r}"
+        assert rule.unit and rule.allowed(), f.name
+        shown = file_options.get(f.name, f.name)
+        block = template.split(f"\n# {shown}: ", 1)[1].split("\n\n", 1)[0]  # its comment and its line
+        assert f"unit {rule.unit}; default " in " ".join(block.split("\n#   ")), shown
+        if f.name not in file_options:
+            assert rule.allowed() in " ".join(block.replace("\n#   ", " ").split()), shown
+            assert f"\n{f.name} = " in f"\n{block}", shown
+
+
+def _outside_and_inside(rule: object) -> tuple[list[object], list[object]]:
+    """Values just outside the range a rule prints, and its ends (or its choices) inside it."""
+    if isinstance(rule, Number):
+        below = rule.low if rule.low_open else math.nextafter(rule.low, -math.inf)
+        inside = [rule.high] + ([] if rule.low_open else [rule.low])
+        return [below, math.nextafter(rule.high, math.inf), math.nan], inside
+    if isinstance(rule, Whole):
+        return [rule.low - 1, rule.high + 1, float(rule.low)], [rule.low, rule.high]
+    if isinstance(rule, Choice):
+        return ["not-a-choice"], list(rule.choices())
+    if isinstance(rule, Flag):
+        return [1, "true"], [True, False]
+    return [3.0], [None]  # Instance: only its object or None
+
+
+@pytest.mark.parametrize("name", sorted(CONTROLLERS))
+def test_the_printed_range_is_the_one_the_config_checks(name: str) -> None:
+    """Just outside an option's printed range its config refuses the value, naming the option and that range;
+    at its ends the option's own check passes (a refusal there, if any, is of a relation to another option)."""
+    for config_type, f in _documented_fields(name):
+        rule = option_rule(f)
+        outside, inside = _outside_and_inside(rule)
+        said = {Number: "a finite number in", Whole: "a whole number in", Choice: "one of", Flag: "true or false"}
+        own = f"{f.name} must be {said.get(type(rule), 'a ')}"  # the rule's own message (config_checks)
+        for value in outside:
+            with pytest.raises(WorkbenchInputError) as info:
+                config_type(**{f.name: value})
+            message = str(info.value)
+            assert message.startswith(own), (f.name, value, message)
+            if isinstance(rule, Number):
+                interval = rule.allowed().split(" (")[0].split(", or")[0]
+                assert interval in message, (f.name, value, message)
+        for value in inside:
+            try:
+                config_type(**{f.name: value})
+            except WorkbenchInputError as exc:
+                assert not str(exc).startswith(own), (f.name, value, str(exc))
