@@ -626,7 +626,9 @@ def _robustness(args: argparse.Namespace) -> int:
                 progress=sys.stderr.isatty(),
             )
         written = result.save(args.out)
-        print(result.tolerance().to_string(index=False, float_format=lambda v: f"{v:.3g}"))
+        print(result.tolerance().to_string(index=False, float_format=lambda v: f"{v:.3g}", na_rep="-"))
+        for line in result.payload_summary():
+            print(line)
         print(f"wrote {', '.join(str(p) for p in written)} and {args.out / 'results.parquet'}")
         return 0
 

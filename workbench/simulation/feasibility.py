@@ -1,12 +1,20 @@
 """Whether a vehicle can follow a path at the path's planned speed, checked before a run: where the path curves
-tighter than the vehicle steers, or asks for more lateral acceleration than its rollover threshold or its tyres
-allow. A run through such a place ends with a large CTE (or a wheel lifted); the check says where and why first.
+tighter than the vehicle steers, changes its curvature faster than the vehicle's steering can follow, or asks for
+more lateral acceleration than its rollover threshold or its tyres allow. A run through such a place ends with a
+large CTE (or a wheel lifted); the check says where and why first (`workbench run` refuses such a path unless
+told to run it anyway).
 
 Steering lock: the steady-state road-wheel angle a path of curvature kappa needs at speed v is
 atan(L kappa) + K v^2 kappa (Ackermann at the rear axle, L the wheelbase, plus the understeer gradient K of the
 vehicle's single track, `SingleTrackParams.understeer_gradient_rad_per_mps2`; 0 for a model without tyres); the
 lock allows `max_road_wheel_angle_rad`. The loaded tractor-semitrailer turns a 9.19 m radius at lock at walking
-pace and 9.36 m at 0.3 g (understeer), the car 1.43 m.
+pace and 9.36 m at 0.3 g (understeer), the car 1.43 m: kappa_max = tan(delta_max) / L at walking pace. No model
+states an articulation limit (the tractor-semitrailer's hitch turns freely), so none is checked.
+Steering rate: the road-wheel angle the path asks for (as above, signed) as a function of time at the planned
+speed must not change by more than the steering's rate limit allows (`max_steer_wheel_rate_rad_s` over the
+steering ratio) within any STEERING_RATE_WINDOW_S. A curvature that changes too fast for the speed (a circle
+entered without a transition, two turns closer than the steering can reverse between) asks for that; a short
+burst above the rate costs a lag a controller recovers from, a sustained one leaves the path.
 Rollover: v^2 kappa against the vehicle's static rollover threshold, for a model that states one (the
 tractor-semitrailer's `Derived.rollover_threshold_g`, 0.45 g loaded; a dynamic manoeuvre lifts a wheel up to about
 25% earlier, SAE 2003-01-3385, which this static check does not claim to catch).
@@ -18,6 +26,7 @@ The vehicle's parameters only: the simulation layer does not read the controller
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import asdict, dataclass
 from typing import TYPE_CHECKING
@@ -33,9 +42,19 @@ if TYPE_CHECKING:
 
 #: Why a place is infeasible, in the order the findings list them at one place.
 STEERING_LOCK = "steering lock"
+STEERING_RATE = "steering rate"
 ROLLOVER = "rollover"
 TYRE_GRIP = "tyre grip"
-REASONS = (STEERING_LOCK, ROLLOVER, TYRE_GRIP)
+REASONS = (STEERING_LOCK, STEERING_RATE, ROLLOVER, TYRE_GRIP)
+#: The steering-rate check's window (s): within any this long at the planned speed, the road-wheel angle the path
+#: asks for may change by at most the rate limit times this. Measured with the planned speeds at 30 and 100 km/h
+#: (the most the path asks over what the window allows): figure8, dlc, fig17 and Zandvoort 0.09-0.32 on the cars and
+#: 0.11-0.38 on the loaded truck; a stadium whose 6.5 m hairpins start without a transition 0.72 (car, tracked within
+#: 0.29 m by pure pursuit) and 0.76 (truck); a 3 m semicircle between straights 1.37 (car, the clothoid controller
+#: 4.8 m off the path) and 1.19 (truck); two 90-degree turns 0.5 m apart 1.14 (car, 21 m off the path; the truck's
+#: lock rules them out). Over a 1 s window the hairpins the car tracks would be 1.08: a shorter window judges a lag
+#: the controllers recover from.
+STEERING_RATE_WINDOW_S = 1.5
 #: Two infeasible stretches of one reason closer than this along the path (m) are one span: a curvature that
 #: dips under the limit for a few samples inside a hairpin is one place, not several.
 MERGE_GAP_M = 2.0
@@ -51,7 +70,8 @@ class VehicleLimits:
     name: the vehicle's name, for messages; wheelbase_m, max_road_wheel_angle_rad: as `VehicleGeometry`;
     understeer_gradient_rad_per_mps2: K in delta = L kappa + K a_y (0 for a kinematic model);
     max_lateral_accel_g: the tyres' grip (peak axle forces over the mass), None when the model has no tyres;
-    rollover_threshold_g: the static rollover threshold, None when the model states none.
+    rollover_threshold_g: the static rollover threshold, None when the model states none;
+    max_road_wheel_rate_rad_s: how fast the steering turns the road wheels (rad/s), None: not checked.
     """
 
     name: str
@@ -60,20 +80,21 @@ class VehicleLimits:
     understeer_gradient_rad_per_mps2: float = 0.0
     max_lateral_accel_g: float | None = None
     rollover_threshold_g: float | None = None
+    max_road_wheel_rate_rad_s: float | None = None
 
     def __post_init__(self) -> None:
         require_in_range("wheelbase_m", self.wheelbase_m, 0.5, 15.0, "m")
         require_in_range("max_road_wheel_angle_rad", self.max_road_wheel_angle_rad, 0.01, 1.5, "rad")
         require_in_range("understeer_gradient_rad_per_mps2", self.understeer_gradient_rad_per_mps2, -1.0, 1.0)
-        for name in ("max_lateral_accel_g", "rollover_threshold_g"):
+        for name in ("max_lateral_accel_g", "rollover_threshold_g", "max_road_wheel_rate_rad_s"):
             value = getattr(self, name)
             if value is not None:
                 require_positive(name, value)
 
     @classmethod
     def of(cls, vehicle: VehicleModel) -> VehicleLimits:
-        """The limits of a vehicle model: its geometry, its single track's understeer and grip (when it has tyres)
-        and its static rollover threshold (the tractor-semitrailer's)."""
+        """The limits of a vehicle model: its geometry (steering lock and rate), its single track's understeer and
+        grip (when it has tyres) and its static rollover threshold (the tractor-semitrailer's)."""
         from workbench.vehicles.tractor_semitrailer import TractorSemitrailer  # loaded with any vehicle model
 
         geometry = vehicle.geometry
@@ -83,7 +104,10 @@ class VehicleLimits:
             understeer = track.understeer_gradient_rad_per_mps2()
             grip = (track.front_peak_force_n + track.rear_peak_force_n) / (track.mass_kg * G_MPS2)
         rollover = vehicle.derived.rollover_threshold_g if isinstance(vehicle, TractorSemitrailer) else None
-        return cls(vehicle.name, geometry.wheelbase_m, geometry.max_road_wheel_angle_rad, understeer, grip, rollover)
+        rate = geometry.max_steer_wheel_rate_rad_s / geometry.steering_ratio
+        return cls(
+            vehicle.name, geometry.wheelbase_m, geometry.max_road_wheel_angle_rad, understeer, grip, rollover, rate
+        )
 
     @property
     def lock_radius_m(self) -> float:
@@ -116,6 +140,31 @@ class VehicleLimits:
             speed_sq * curvature_1pm
         )
 
+    def road_wheel_angle_rad(self, curvature_1pm: np.ndarray, speed_mps: np.ndarray) -> np.ndarray:
+        """The steady-state road-wheel angle (rad, signed as the curvature) the path asks for at each sample."""
+        return np.sign(curvature_1pm) * self._lock_angle(np.abs(curvature_1pm), speed_mps * speed_mps)
+
+    def steering_rate_ratios(self, path: ReferencePath) -> tuple[np.ndarray, np.ndarray] | None:
+        """What the path, at its planned speed, asks of the steering's rate over what it allows, for the window of
+        STEERING_RATE_WINDOW_S starting at each sample: the most the asked road-wheel angle changes within the
+        window over the rate limit times the window (> 1: infeasible); and the index of each window's last sample
+        (on a closed loop counted on past the seam: index mod (n - 1)). None without a rate limit."""
+        if self.max_road_wheel_rate_rad_s is None:
+            return None
+        angle = self.road_wheel_angle_rad(path.curvature_1pm, path.speed_mps)
+        speed = np.asarray(path.speed_mps, dtype=float)
+        step_s = np.diff(path.s_m) / (0.5 * (speed[1:] + speed[:-1]))
+        n = angle.size
+        if path.closed:  # once more round the loop (its last sample repeats the first), for windows past the seam
+            angle = np.concatenate((angle, angle[1:]))
+            step_s = np.concatenate((step_s, step_s))
+        t_s = np.concatenate(([0.0], np.cumsum(step_s)))
+        last = np.searchsorted(t_s, t_s[:n] + STEERING_RATE_WINDOW_S, side="right") - 1
+        first = np.arange(n)
+        high, low = _range_extremes(angle, first, last)
+        change = np.maximum(high - angle[:n], angle[:n] - low)
+        return change / (self.max_road_wheel_rate_rad_s * STEERING_RATE_WINDOW_S), last
+
     def demand_ratios(self, curvature_1pm: np.ndarray, speed_mps: np.ndarray) -> dict[str, np.ndarray]:
         """For each reason the vehicle has a limit for, what the path asks of it over what it allows (> 1:
         infeasible) at each sample: road-wheel angle over the lock, lateral acceleration over the threshold."""
@@ -135,29 +184,36 @@ class InfeasibleSpan:
     """A stretch of the path the vehicle cannot follow at the planned speed, for one reason.
 
     start_s_m, end_s_m: where it starts and ends along the path (m; on a closed loop a span across the start has
-    end_s_m < start_s_m); s_m: its worst point, the one that asks most over the limit; radius_m: the path's radius
-    there; min_radius_m: the smallest radius the vehicle holds there, at speed_kmh, the planned speed; reason:
-    one of REASONS.
+    end_s_m < start_s_m); s_m: its worst point, the one that asks most over the limit (for the steering rate: the
+    start of its worst window); radius_m: the path's radius there (the tightest in that window); min_radius_m: the
+    smallest radius the vehicle holds there, at speed_kmh, the planned speed (None for the steering rate, which
+    limits how fast the curvature changes, not how tight it is); reason: one of REASONS; demand_ratio: what the
+    path asks there over what the vehicle allows (> 1), None when not known.
     """
 
     start_s_m: float
     end_s_m: float
     s_m: float
     radius_m: float
-    min_radius_m: float
+    min_radius_m: float | None
     speed_kmh: float
     reason: str
+    demand_ratio: float | None = None
 
     def __post_init__(self) -> None:
         if self.reason not in REASONS:
             raise WorkbenchInputError(f"reason must be one of {', '.join(REASONS)}; got {self.reason!r}")
-        for name in ("radius_m", "min_radius_m"):
-            require_positive(name, getattr(self, name))
+        for name in ("radius_m", "min_radius_m", "demand_ratio"):
+            if name == "radius_m" or getattr(self, name) is not None:
+                require_positive(name, getattr(self, name))
 
     def to_dict(self) -> dict[str, object]:
-        """The span as metrics.json writes it (numbers rounded to the centimetre and 0.1 km/h)."""
+        """The span as metrics.json writes it (numbers rounded to the centimetre, 0.01 of the ratio and 0.1 km/h)."""
         row = asdict(self)
-        return {k: round(v, 2 if k.endswith("_m") else 1) if isinstance(v, float) else v for k, v in row.items()}
+        return {
+            k: round(v, 2 if k.endswith("_m") or k == "demand_ratio" else 1) if isinstance(v, float) else v
+            for k, v in row.items()
+        }
 
 
 def infeasible_spans(path: ReferencePath, limits: VehicleLimits) -> tuple[InfeasibleSpan, ...]:
@@ -182,9 +238,64 @@ def infeasible_spans(path: ReferencePath, limits: VehicleLimits) -> tuple[Infeas
                     min_radius_m=limits.min_radius_m(reason, speed),
                     speed_kmh=speed / _MPS_PER_KMH,
                     reason=reason,
+                    demand_ratio=float(ratio[index]),
                 )
             )
+    spans += _steering_rate_spans(path, limits)
     return tuple(sorted(spans, key=lambda span: (span.start_s_m, REASONS.index(span.reason))))
+
+
+def _steering_rate_spans(path: ReferencePath, limits: VehicleLimits) -> list[InfeasibleSpan]:
+    """The spans where the path's curvature changes faster than the steering follows at the planned speed
+    (`VehicleLimits.steering_rate_ratios`): from the first window over the limit to the end of the last."""
+    rated = limits.steering_rate_ratios(path)
+    if rated is None:
+        return []
+    ratio, window_end = rated
+    wrap = ratio.size - 1 if path.closed else ratio.size  # a closed loop's last sample repeats the first
+    spans: list[InfeasibleSpan] = []
+    for first, last in _stretches(ratio > 1.0, path):
+        index = _worst(ratio, first, last)
+        window = np.arange(index, window_end[index] + 1) % wrap
+        speed = float(path.speed_mps[index])
+        span = InfeasibleSpan(
+            start_s_m=float(path.s_m[first]),
+            end_s_m=float(path.s_m[int(window_end[last]) % wrap]),
+            s_m=float(path.s_m[index]),
+            radius_m=1.0 / max(float(np.max(np.abs(path.curvature_1pm[window]))), 1e-12),
+            min_radius_m=None,
+            speed_kmh=speed / _MPS_PER_KMH,
+            reason=STEERING_RATE,
+            demand_ratio=float(ratio[index]),
+        )
+        previous = spans[-1] if spans else None
+        if previous is not None and previous.start_s_m <= span.start_s_m <= previous.end_s_m:  # windows overlap
+            worst = previous if (previous.demand_ratio or 0.0) >= (span.demand_ratio or 0.0) else span
+            span = dataclasses.replace(worst, start_s_m=previous.start_s_m, end_s_m=span.end_s_m)
+            spans.pop()
+        spans.append(span)
+    return spans
+
+
+def _range_extremes(values: np.ndarray, first: np.ndarray, last: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The largest and the smallest of values[first[i] : last[i] + 1] for each i (first <= last), by doubling:
+    at level k the extremes of every run of 2^k values, each query answered from the two runs that cover it, so
+    O(n log w) time for windows of up to w values and two levels' memory."""
+    length = last - first + 1
+    level_of = np.frexp(length.astype(float))[1] - 1  # floor(log2(length)), exact for whole numbers
+    high, low = np.empty(first.size), np.empty(first.size)
+    run_max, run_min, level, width = values, values, 0, 1
+    while True:
+        asked = np.flatnonzero(level_of == level)
+        if asked.size:
+            a, b = first[asked], last[asked] - width + 1
+            high[asked] = np.maximum(run_max[a], run_max[b])
+            low[asked] = np.minimum(run_min[a], run_min[b])
+        if 2 * width > length.max():
+            return high, low
+        run_max = np.maximum(run_max[:-width], run_max[width:])
+        run_min = np.minimum(run_min[:-width], run_min[width:])
+        level, width = level + 1, 2 * width
 
 
 def check_path(path: ReferencePath, vehicle: VehicleModel) -> tuple[InfeasibleSpan, ...]:
@@ -235,6 +346,14 @@ def feasibility_warnings(path_name: str, limits: VehicleLimits, spans: tuple[Inf
                 f"angle: a radius of {limits.lock_radius_m:.2f} m at walking pace{understeer}) {where}: expect it "
                 "to run wide there"
             )
+        elif reason == STEERING_RATE:
+            rate = math.degrees(limits.max_road_wheel_rate_rad_s or 0.0)
+            messages.append(
+                f"{path_name} changes its curvature faster than the {limits.name}'s steering follows at the planned "
+                f"speed (its road wheels turn at most {rate:.0f} deg/s: {rate * STEERING_RATE_WINDOW_S:.0f} deg in "
+                f"any {STEERING_RATE_WINDOW_S:g} s) {where}: expect it to fall behind the path there; transitions "
+                "into the curves, or turns further apart, keep it below"
+            )
         elif reason == ROLLOVER:
             messages.append(
                 f"{path_name} asks the {limits.name}, at the planned speed, for more lateral acceleration than its "
@@ -252,7 +371,14 @@ def feasibility_warnings(path_name: str, limits: VehicleLimits, spans: tuple[Inf
 
 def _place(span: InfeasibleSpan) -> str:
     """Where a span is, what the path asks at its worst point (curvature, or lateral acceleration) and the radius
-    the vehicle holds there."""
+    the vehicle holds there; for the steering rate, how many times the steering's turn in the window the path asks
+    for."""
+    if span.reason == STEERING_RATE:
+        return (
+            f"s = {span.start_s_m:.1f}-{span.end_s_m:.1f} m (the road-wheel angle asked for changes by "
+            f"{span.demand_ratio or math.nan:.2f} times that at {span.speed_kmh:.0f} km/h, through a radius of "
+            f"{span.radius_m:.2f} m)"
+        )
     if span.reason == STEERING_LOCK:
         peak = f"{1.0 / span.radius_m:.3g} 1/m"
     else:

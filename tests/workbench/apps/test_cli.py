@@ -333,6 +333,34 @@ def test_a_path_tighter_than_the_vehicle_turns_is_named_before_the_run(tmp_path:
     monkeypatch.setattr("workbench.apps.cli.Simulation.run", stop)
     angles = np.linspace(0.0, 2 * np.pi, 60)  # a 1 m circle: the car turns no tighter than a 1.42 m radius
     pd.DataFrame({"x": 1.0 * np.cos(angles), "y": 1.0 * np.sin(angles)}).to_csv(tmp_path / "tight.csv", index=False)
-    assert main([*QUICK_RUN[:1], str(tmp_path / "tight.csv"), *QUICK_RUN[2:], "--out", str(tmp_path / "o")]) == 2
+    args = [*QUICK_RUN[:1], str(tmp_path / "tight.csv"), *QUICK_RUN[2:], "--out", str(tmp_path / "o")]
+    assert main([*args, "--allow-infeasible"]) == 2
     warning = next(line for line in capsys.readouterr().err.splitlines() if not line.startswith("workbench run: "))
     assert warning.startswith("workbench: warning: ") and "tighter than the kinematic-bicycle can turn" in warning
+
+
+def test_run_refuses_a_path_the_vehicle_cannot_follow_unless_allowed(tmp_path: Path, capsys, monkeypatch) -> None:
+    """A 3 m semicircle between straights: within the car's lock, but its curvature changes faster than the car's
+    steering follows. Refused before the run (exit 2), naming where (s in m) and against what limit; with
+    --allow-infeasible it runs, warned."""
+    runs = []
+
+    def stop(*_args, **_kwargs):
+        runs.append(1)
+        raise WorkbenchInputError("stopped before simulating")
+
+    monkeypatch.setattr("workbench.apps.cli.Simulation.run", stop)
+    arc = [(3.0 * np.sin(a), 3.0 - 3.0 * np.cos(a)) for a in np.linspace(0.0, np.pi, 13)[1:-1]]
+    points = [(x, 0.0) for x in range(-20, 1)] + arc + [(x, 6.0) for x in range(0, -21, -1)]
+    pd.DataFrame(points, columns=["x", "y"]).to_csv(tmp_path / "r3.csv", index=False)
+    args = [*QUICK_RUN[:1], str(tmp_path / "r3.csv"), *QUICK_RUN[2:], "--out", str(tmp_path / "o")]
+    assert main(args) == 2 and runs == []
+    (error,) = [line for line in capsys.readouterr().err.splitlines() if not line.startswith("workbench run: ")]
+    assert error.startswith(
+        "workbench: error: r3 changes its curvature faster than the kinematic-bicycle's steering follows at the "
+        "planned speed (its road wheels turn at most 23 deg/s: 34 deg in any 1.5 s) at s = 1"
+    )
+    assert re.search(r"at s = \d+\.\d-\d+\.\d m \(the road-wheel angle asked for changes by 1\.\d\d times", error)
+    assert error.endswith("; --allow-infeasible runs it anyway")
+    assert main([*args, "--allow-infeasible"]) == 2 and runs == [1]  # run (stopped by the stand-in)
+    assert "workbench: warning: r3 changes its curvature faster" in capsys.readouterr().err

@@ -1,5 +1,6 @@
 """The check of a path against the vehicle before a run (issue 20, item 13): steering lock (with understeer at the
-planned speed), rollover and tyre grip, merged into spans along the path, and the warning that names them."""
+planned speed), steering rate, rollover and tyre grip, merged into spans along the path, and the warning that names
+them."""
 
 from __future__ import annotations
 
@@ -17,15 +18,18 @@ from workbench.base.path import ReferencePath
 from workbench.simulation.feasibility import (
     ROLLOVER,
     STEERING_LOCK,
+    STEERING_RATE,
+    STEERING_RATE_WINDOW_S,
     TYRE_GRIP,
     InfeasibleSpan,
     VehicleLimits,
+    _range_extremes,
     check_path,
     feasibility_warnings,
     infeasible_spans,
 )
 from workbench.simulation.run_config import SimulationConfig
-from workbench.simulation.scenarios import make_scenario
+from workbench.simulation.scenarios import ScenarioOptions, make_scenario
 from workbench.simulation.simulator import plan_path_speed
 from workbench.vehicles import make_vehicle
 
@@ -129,10 +133,100 @@ def test_spans_merge_across_a_closed_loops_start(tmp_path: Path) -> None:
 def test_a_path_without_planned_speed_is_refused_and_spans_are_validated() -> None:
     with pytest.raises(WorkbenchInputError, match=r"circle: checking the path against a vehicle needs its planned"):
         infeasible_spans(_circle(30.0), VehicleLimits.of(make_vehicle("dynamic-bicycle")))
-    with pytest.raises(WorkbenchInputError, match=r"reason must be one of steering lock, rollover, tyre grip"):
+    with pytest.raises(WorkbenchInputError, match=r"must be one of steering lock, steering rate, rollover, tyre"):
         InfeasibleSpan(0.0, 1.0, 0.5, 6.5, 9.4, 15.0, "too tight")
     span = InfeasibleSpan(60.971, 79.456, 77.4712, 5.8234, 9.3012, 15.24, STEERING_LOCK)
     assert span.to_dict() == {
         "start_s_m": 60.97, "end_s_m": 79.46, "s_m": 77.47, "radius_m": 5.82, "min_radius_m": 9.3,
-        "speed_kmh": 15.2, "reason": "steering lock",
+        "speed_kmh": 15.2, "reason": "steering lock", "demand_ratio": None,
     }  # fmt: skip
+
+
+def _waypoint_file(folder: Path, name: str, points: list[tuple[float, float]]) -> Path:
+    file = folder / name
+    file.write_text("x,y\n" + "".join(f"{x!r},{y!r}\n" for x, y in points))
+    return file
+
+
+def test_a_curvature_ramp_asks_the_steering_what_the_road_wheel_angle_says() -> None:
+    """Straight, a clothoid to kappa_1 over l, an arc; driven at a constant v by the kinematic car. Within any window
+    W the asked road-wheel angle atan(L kappa) changes most from the clothoid's start: by atan(L kappa_1 min(v W, l)
+    / l), over the rate limit times W."""
+    car = VehicleLimits.of(make_vehicle("kinematic-bicycle"))
+    assert car.max_road_wheel_rate_rad_s == pytest.approx(math.radians(22.9), abs=1e-3)
+    v, wheelbase = 5.0, car.wheelbase_m
+    window_m = v * STEERING_RATE_WINDOW_S
+    for kappa_1, length in ((0.2, 20.0), (0.3, 6.0)):
+        path = ClothoidChain().straight(20.0).clothoid_to(kappa_1, length).arc(30.0).to_path("ramp")
+        path = path.with_speed(np.full(path.s_m.size, v))
+        ratio, _ = car.steering_rate_ratios(path)
+        change = math.atan(wheelbase * kappa_1 * min(window_m, length) / length)
+        # The window holds whole samples: up to one 0.1 m spacing short of v W = 7.5 m (1.3%).
+        expected = change / (car.max_road_wheel_rate_rad_s * STEERING_RATE_WINDOW_S)
+        assert ratio.max() == pytest.approx(expected, rel=0.02)
+        spans = infeasible_spans(path, car)
+        if ratio.max() < 1.0:  # 0.32: 0.19 rad of wheel within 1.5 s, where the steering turns 0.6
+            assert spans == ()
+            continue
+        (span,) = spans  # 1.10: the whole 0.66 rad within 1.2 s
+        assert span.reason == STEERING_RATE and span.min_radius_m is None
+        assert span.demand_ratio == pytest.approx(ratio.max(), rel=1e-12)
+        assert 20.0 - window_m < span.start_s_m < 20.0 and span.end_s_m >= 26.0  # windows reaching past the ramp
+        assert span.radius_m == pytest.approx(1 / kappa_1, rel=1e-6)
+
+
+def test_unfollowable_turns_are_flagged_by_the_steering_rate(tmp_path: Path) -> None:
+    """Two 90-degree turns 0.5 m apart, and a 3 m semicircle between straights: within the car's lock (1.43 m) but
+    changing curvature faster than its steering follows at the planned speed; the loaded truck's lock rules out the
+    turns too."""
+    turns = _waypoint_file(tmp_path, "turns.csv", [(0.0, 0.0), (20.0, 0.0), (20.0, 0.5), (40.0, 0.5)])
+    arc = [(3.0 * math.sin(a), 3.0 - 3.0 * math.cos(a)) for a in np.linspace(0.0, math.pi, 13)[1:-1]]
+    semicircle = [(x, 0.0) for x in range(-20, 1)] + arc + [(x, 6.0) for x in range(0, -21, -1)]
+    tight = _waypoint_file(tmp_path, "r3.csv", [(float(x), float(y)) for x, y in semicircle])
+    car = make_vehicle("kinematic-bicycle")
+    for file in (turns, tight):
+        path = _planned(make_scenario(str(file)).path)
+        spans = check_path(path, car)
+        assert spans and {span.reason for span in spans} == {STEERING_RATE}, file.name
+        assert max(span.demand_ratio for span in spans) > 1.1
+        assert 1.0 / np.abs(path.curvature_1pm).max() > VehicleLimits.of(car).lock_radius_m  # within the lock
+        (warning,) = feasibility_warnings(path.name, VehicleLimits.of(car), spans)
+        assert warning.startswith(
+            f"{file.stem} changes its curvature faster than the kinematic-bicycle's steering follows at the planned "
+            "speed (its road wheels turn at most 23 deg/s: 34 deg in any 1.5 s) at s = "
+        )
+        assert re.search(r"s = \d+\.\d-\d+\.\d m \(the road-wheel angle asked for changes by 1\.\d\d times", warning)
+    truck_spans = check_path(_planned(make_scenario(str(turns)).path), make_vehicle("tractor-semitrailer"))
+    assert {span.reason for span in truck_spans} == {STEERING_LOCK}
+
+
+def test_the_named_scenarios_ask_well_within_every_vehicles_steering_rate() -> None:
+    for name in ("figure8", "dlc", "fig17"):
+        for vehicle_name in ("kinematic-bicycle", "tractor-semitrailer"):
+            vehicle = make_vehicle(vehicle_name)
+            scenario = make_scenario(name, ScenarioOptions(vehicle_width_m=vehicle.geometry.width_m))
+            for speed in (30.0, 100.0):
+                path = _planned(scenario.path, speed_kmh=speed)
+                ratio, _ = VehicleLimits.of(vehicle).steering_rate_ratios(path)
+                assert ratio.max() < 0.4, (name, vehicle_name, speed)
+                assert check_path(path, vehicle) == ()
+
+
+def test_window_extremes_match_a_direct_search() -> None:
+    rng = np.random.default_rng(3)
+    values = rng.normal(size=500)
+    first = np.arange(values.size)
+    last = np.minimum(first + rng.integers(0, 40, size=values.size), values.size - 1)
+    high, low = _range_extremes(values, first, last)
+    assert np.array_equal(high, [values[a : b + 1].max() for a, b in zip(first, last, strict=True)])
+    assert np.array_equal(low, [values[a : b + 1].min() for a, b in zip(first, last, strict=True)])
+
+
+def test_a_steering_rate_span_is_written_with_its_ratio_and_no_minimum_radius() -> None:
+    span = InfeasibleSpan(13.04, 24.11, 13.04, 2.7249, None, 15.04, STEERING_RATE, 1.3712)
+    assert span.to_dict() == {
+        "start_s_m": 13.04, "end_s_m": 24.11, "s_m": 13.04, "radius_m": 2.72, "min_radius_m": None,
+        "speed_kmh": 15.0, "reason": "steering rate", "demand_ratio": 1.37,
+    }  # fmt: skip
+    with pytest.raises(WorkbenchInputError, match=r"demand_ratio must be a finite number > 0; got -1\.0"):
+        InfeasibleSpan(13.0, 24.1, 13.0, 2.7, None, 15.0, STEERING_RATE, -1.0)

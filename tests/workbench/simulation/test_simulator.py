@@ -256,8 +256,9 @@ def test_a_path_tighter_than_the_vehicle_turns_is_named_before_the_run() -> None
     chain = ClothoidChain().straight(20.0).clothoid_to(1.5 * reach, 2.0).arc(5.0).clothoid_to(0.0, 2.0)
     tight = chain.straight(20.0).to_path("hairpin")
     simulation = Simulation(_scenario(tight), vehicle, PurePursuit(vehicle.geometry))
-    (warning,) = simulation.path_warnings()
+    warning, rate = simulation.path_warnings()  # and its 2 m transitions change the curvature faster than it steers
     assert "hairpin curves tighter than the kinematic-bicycle can turn" in warning
+    assert rate.startswith("hairpin changes its curvature faster than the kinematic-bicycle's steering follows")
     assert re.search(r"at s = 21\.[34]-27\.[67] m \(peak 1\.05 1/m\)", warning), warning
     assert Simulation(_scenario(_circle()), vehicle, PurePursuit(vehicle.geometry)).path_warnings() == []
 
