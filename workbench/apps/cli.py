@@ -106,6 +106,12 @@ def _parser(command: str | None = None) -> argparse.ArgumentParser:
         "controllers`)",
     )
     run.add_argument("--vehicle", metavar="NAME", help=f"vehicle model (default: {DEFAULT_VEHICLE})")
+    run.add_argument(
+        "--allow-infeasible",
+        action="store_true",
+        help="run a path the vehicle cannot follow at the planned speed (too tight for its lock, curvature changing "
+        "faster than its steering, beyond its rollover threshold or grip), warning where; refused without it",
+    )
     _run_options(run, several=False)
 
     cmp = sub.add_parser("compare", help="run several controllers (and vehicles) on one scenario; write a report")
@@ -782,10 +788,14 @@ def _run_stages(
     scenario = make_scenario(
         args.scenario, ScenarioOptions(vehicle_width_m=vehicle.geometry.width_m, track_file=args.track)
     )
+    if args.scenario == "zandvoort" and scenario.name != "zandvoort":  # another file given: named by the file
+        progress.warn(scenario.description)
     simulation = Simulation(scenario, vehicle, controller, config)
     label = f"{scenario.name}: {controller.name} on {vehicle.name}"
     if not args.allow_long_run:
         check_run_size(simulation.size, label, _SHORTEN_RUN.format(speed=args.speed), "--allow-long-run")
+    if simulation.infeasible_curvature and not args.allow_infeasible:  # `feasibility.py`: refused before the run
+        raise WorkbenchInputError("; ".join(simulation.path_warnings()) + "; --allow-infeasible runs it anyway")
     for warning in simulation.warnings(label):
         progress.warn(warning)
     progress.stage(
