@@ -1,6 +1,7 @@
 """How each controller degrades away from ideal conditions: one factor at a time around a base (`ideal` by default),
 over the actuation dead time, the pose latency, the position noise, the road's friction and, for a vehicle with a
-payload, a controller built for another payload than the plant carries. Every run is a study run (`PlannedRun`),
+payload, the plant's payload while the controller stays built for the nominal one (`payload_axis`; what that
+mismatch changes differs by controller, `PAYLOAD_MISMATCH`). Every run is a study run (`PlannedRun`),
 executed on the study backends (local processes or Dask) into a resumable store; the report is one self-contained
 HTML file with the degradation curves (max |CTE|, steering oscillation, completion) and a table of the values at
 which each controller stops completing or starts to limit-cycle.
@@ -9,6 +10,7 @@ which each controller stops completing or starts to limit-cycle.
 from __future__ import annotations
 
 import dataclasses
+import html
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -45,6 +47,24 @@ AXES: tuple[Axis, ...] = (
     Axis("localisation_position_noise_m", (0.0, 0.05, 0.1, 0.2, 0.5), "position noise sigma", "m"),
     Axis("road_friction_scale", (1.0, 0.8, 0.6, 0.4), "road friction scale", "", rising=False),
 )
+#: The tolerance table's "how" of a factor at every value of which the controller passed.
+PASSES_ALL = "passes all"
+#: What a payload mismatch (the plant carries another payload than the controller was built for) changes, by
+#: controller: the plant always; of the controller, only what it takes from the vehicle.
+PAYLOAD_MISMATCH: dict[str, str] = {
+    "clothoid": "the plant only: the controller keeps its tuning (lead filter, identified steering lags, curvature "
+    "and rollover limits), made for the preset at its nominal payload",
+    "lmpc": "the plant; the controller keeps predicting with the single-track model (mass, yaw inertia, axle "
+    "loads) of the vehicle at the nominal payload",
+    "nmpc": "the plant; the controller keeps predicting with the single-track model (mass, yaw inertia, axle "
+    "loads) of the vehicle at the nominal payload",
+    "pure-pursuit": "the plant only: the controller uses the path's geometry and the wheelbase, no vehicle model",
+    "stanley": "the plant only: the controller uses the path's geometry and the wheelbase, no vehicle model",
+}
+#: What a payload mismatch changes for a controller not in PAYLOAD_MISMATCH.
+OTHER_CONTROLLER_MISMATCH = "the plant; the controller is built for the vehicle at the nominal payload"
+#: The plant's payloads of the payload axis, as fractions of the nominal payload, from the nominal outward.
+PAYLOAD_FRACTIONS = (1.0, 0.5, 0.0)
 #: A run passes when it completes, its steering does not limit-cycle and its max |CTE| stays within this (m; half
 #: of an ISO 3888 lane's spare width for a 2.5 m wide truck is about 0.25 m, so 0.5 m is leaving the lane).
 PASS_MAX_CTE_M = 0.5
@@ -53,6 +73,28 @@ PASS_MAX_CTE_M = 0.5
 def _payload_kg(vehicle: str) -> float | None:
     """The plant's own payload (None for a vehicle without one)."""
     return getattr(load_vehicle(vehicle).params, "payload_kg", None)
+
+
+def payload_axis(vehicle: str) -> Axis | None:
+    """The payload factor of a vehicle with a payload (None for one without, or with none on board): the plant
+    carries PAYLOAD_FRACTIONS of its nominal payload while the controller stays built for the nominal one
+    (controller_payload_kg), so every run of the axis but the base is a payload mismatch."""
+    nominal = _payload_kg(vehicle)
+    if nominal is None or nominal <= 0:
+        return None
+    values = tuple(nominal * f for f in PAYLOAD_FRACTIONS)
+    return Axis("payload_kg", values, f"plant payload (controller built for {nominal:g} kg)", "kg", rising=False)
+
+
+def robustness_axes(vehicle: str, axes: Sequence[Axis] = AXES) -> tuple[Axis, ...]:
+    """The factors of a study on `vehicle`: `axes`, and the payload factor when the vehicle carries a payload."""
+    payload = payload_axis(vehicle)
+    return (*axes, payload) if payload is not None else tuple(axes)
+
+
+def payload_mismatch(controller: str) -> str:
+    """What a payload mismatch changes for `controller` (PAYLOAD_MISMATCH)."""
+    return PAYLOAD_MISMATCH.get(controller, OTHER_CONTROLLER_MISMATCH)
 
 
 def plan_robustness(
@@ -64,21 +106,20 @@ def plan_robustness(
     seed: int = 0,
     track_file: Path | None = None,
     base_dir: Path | None = None,
-    axes: Sequence[Axis] = AXES,
+    axes: Sequence[Axis] | None = None,
 ) -> list[PlannedRun]:
-    """Every run of the study: per controller, the base run, each axis's other values, and for a vehicle with a
-    payload the two payload mismatches (controller built for the loaded vehicle on the empty one, and the
-    reverse). Each axis's value is set on top of `conditions`."""
+    """Every run of the study: per controller, the base run and each axis's other values (axes: None for
+    `robustness_axes(vehicle)`; the payload axis's runs keep the controller built for the nominal payload). Each
+    axis's value is set on top of `conditions`."""
     base = {"speed_kmh": speed_kmh, "conditions": conditions, "seed": seed}
     grids = [dict(base)]
-    for axis in axes:
+    for axis in robustness_axes(vehicle) if axes is None else axes:
         if axis.parameter == "road_friction_scale" and not load_vehicle(vehicle).has_tyres:
             continue
-        grids.append(base | {axis.parameter: list(axis.values[1:])})
-    payload = _payload_kg(vehicle)
-    if payload is not None:
-        for plant, built_for in ((0.0, payload), (payload, 0.0)):
-            grids.append(base | {"payload_kg": plant, "controller_payload_kg": built_for})
+        grid = base | {axis.parameter: list(axis.values[1:])}
+        if axis.parameter == "payload_kg":
+            grid["controller_payload_kg"] = axis.values[0]
+        grids.append(grid)
     runs: dict[str, PlannedRun] = {}
     for grid in grids:
         spec = StudySpec(
@@ -127,7 +168,6 @@ class RobustnessResult:
         the column is empty), in the axis's order."""
         df = self.rows[self.rows["controller"] == controller]
         others = [a.parameter for a in self.axes if a is not axis and a.parameter in df]
-        others += [c for c in ("controller_payload_kg",) if c in df]
         keep = df[df[others].isna().all(axis=1)].copy()
         column = keep[axis.parameter] if axis.parameter in keep else pd.Series(math.nan, index=keep.index)
         keep["value"] = column.fillna(axis.values[0]).astype(float)
@@ -135,14 +175,14 @@ class RobustnessResult:
 
     def tolerance(self) -> pd.DataFrame:
         """Per controller and axis: the last value, going outward from the base, at which every run so far passed,
-        and the first at which one did not (None when all passed)."""
+        the first at which one did not (None when all passed) and how it failed (PASSES_ALL when none did)."""
         out = []
         for controller in self.controllers:
             for axis in self.axes:
                 rows = self.axis_rows(axis, controller)
                 if len(rows) <= 1:
                     continue
-                tolerated, failed, why = None, None, ""
+                tolerated, failed, why = None, None, PASSES_ALL
                 for _, row in rows.iterrows():
                     if self.passed(row):
                         tolerated = row["value"]
@@ -161,13 +201,51 @@ class RobustnessResult:
                 )
         return pd.DataFrame(out)
 
+    def payload_axis(self) -> Axis | None:
+        """The payload factor among the study's axes (None when the vehicle carries no payload)."""
+        return next((a for a in self.axes if a.parameter == "payload_kg"), None)
+
     def mismatch(self) -> pd.DataFrame:
-        """The payload-mismatch runs: plant payload, controller built for, status, max |CTE|, oscillation."""
-        if "controller_payload_kg" not in self.rows:
+        """The payload axis's runs per controller, the base (matched) run first: the plant's payload, the payload
+        the controller was built for, status, max |CTE|, its change from the base run, oscillation, limit cycle,
+        and what the mismatch changes for that controller (`payload_mismatch`). Empty without a payload axis."""
+        axis = self.payload_axis()
+        if axis is None:
             return pd.DataFrame()
-        df = self.rows[self.rows["controller_payload_kg"].notna()]
-        columns = ["controller", "payload_kg", "controller_payload_kg", "status", "max_abs_cte_m"]
-        return df[[*columns, "steer_oscillation_deg", "limit_cycle"]].reset_index(drop=True)
+        tables = []
+        for controller in self.controllers:
+            rows = self.axis_rows(axis, controller)
+            base = rows["max_abs_cte_m"].iloc[0] if len(rows) else math.nan
+            tables.append(
+                pd.DataFrame(
+                    {
+                        "controller": controller,
+                        "plant payload (kg)": rows["value"],
+                        "controller built for (kg)": axis.values[0],
+                        "status": rows["status"],
+                        "max |CTE| (m)": rows["max_abs_cte_m"],
+                        "change from the base (m)": rows["max_abs_cte_m"] - base,
+                        "steering oscillation (deg)": rows["steer_oscillation_deg"],
+                        "limit cycle": rows["limit_cycle"],
+                        "the mismatch changes": payload_mismatch(controller),
+                    }
+                )
+            )
+        return pd.concat(tables, ignore_index=True)
+
+    def payload_summary(self) -> list[str]:
+        """One line per controller on the payload axis: max |CTE| at each plant payload, from the matched base run
+        outward, and what the mismatch changes for that controller. Empty without a payload axis."""
+        table = self.mismatch()
+        if table.empty:
+            return []
+        axis = self.payload_axis()
+        plants = ", ".join(f"{v:g}" for v in axis.values)
+        lines = [f"payload: the plant carries {plants} kg, every controller is built for {axis.values[0]:g} kg"]
+        for controller, rows in table.groupby("controller", sort=False):
+            cte = " -> ".join("none" if math.isnan(v) else f"{v:.4g}" for v in rows["max |CTE| (m)"].astype(float))
+            lines.append(f"  {controller}: max |CTE| {cte} m; the mismatch changes {payload_mismatch(controller)}")
+        return lines
 
     def figure(self, axis: Axis):  # -> matplotlib Figure
         """Max |CTE|, steering oscillation and completion against the axis's value, a line per controller."""
@@ -206,7 +284,11 @@ class RobustnessResult:
         parts = ["<h2>Where each controller stops passing</h2>", text_table(self.tolerance(), missing="none")]
         mismatch = self.mismatch()
         if len(mismatch):
-            parts += ["<h2>Payload mismatch</h2>", text_table(mismatch, missing="none")]
+            note = (
+                f"The plant carries the payloads shown; every controller stays built for the nominal "
+                f"{self.payload_axis().values[0]:g} kg. The last column says what that changes for each controller."
+            )
+            parts += ["<h2>Payload mismatch</h2>", f"<p>{html.escape(note)}</p>", text_table(mismatch, missing="none")]
         for axis in self.axes:
             if all(len(self.axis_rows(axis, c)) <= 1 for c in self.controllers):
                 continue  # not varied (the friction of a model without tyres)
@@ -241,7 +323,19 @@ def run_robustness(
     rows, _ = execute_runs(runs, RunStore(out_dir), backend, progress, "robustness")
     write_results(out_dir, rows)
     frame = pd.DataFrame(rows)
-    return RobustnessResult(frame, scenario, vehicle, tuple(controllers), conditions, speed_kmh, max_cte_m=max_cte_m)
+    axes = robustness_axes(vehicle)
+    return RobustnessResult(frame, scenario, vehicle, tuple(controllers), conditions, speed_kmh, axes, max_cte_m)
 
 
-__all__ = ["AXES", "Axis", "RobustnessResult", "plan_robustness", "run_robustness"]
+__all__ = [
+    "AXES",
+    "PASSES_ALL",
+    "PAYLOAD_MISMATCH",
+    "Axis",
+    "RobustnessResult",
+    "payload_axis",
+    "payload_mismatch",
+    "plan_robustness",
+    "robustness_axes",
+    "run_robustness",
+]

@@ -17,24 +17,27 @@ the path, timed out, diverged, the controller failed mid-run) keeps the simulato
 
 from __future__ import annotations
 
-import dataclasses
-import math
 import time
 import traceback
 from typing import Any
 
-from controllers import CONTROLLERS, make_controller
+from controllers import make_controller
 from tuning.own_tuning import with_vehicle_tuning
-from workbench.apps.controller_config import read_controller_config
-from workbench.apps.studies.condition_parameters import CONDITION_FIELDS, run_conditions
-from workbench.apps.studies.lead_filter_scaling import scaled_filter
-from workbench.apps.studies.spec import EXTRA_RUN_PARAMETERS, LEAD_FILTER_SCALES, PlannedRun
+from workbench.apps.studies.run_build import (
+    option_text,
+    plant_and_controller_vehicles,
+    simulation_config,
+    split_values,
+    started_scenario,
+    untuned_controller_config,
+    with_scaled_filter,
+)
+from workbench.apps.studies.spec import PlannedRun
 from workbench.simulation.metrics import METRIC_KEYS
 from workbench.simulation.result import SimulationResult
 from workbench.simulation.scenarios import ScenarioOptions, make_scenario
-from workbench.simulation.simulator import Simulation, SimulationConfig
+from workbench.simulation.simulator import Simulation
 from workbench.vehicles.base import VehicleModel
-from workbench.vehicles.presets import load_vehicle
 
 #: The status of a run that raised.
 ERROR_STATUS = "error"
@@ -46,55 +49,28 @@ RESULT_COLUMNS = (*ROW_METRICS, "status", "message", "traceback", "run_time_s")
 TIMING_COLUMNS = ("step_time_median_us", "step_time_p99_us", "run_time_s")
 
 
-def option_text(value: Any) -> str:
-    """A typed option value as the text of a `--set KEY=VALUE` override (floats by repr: exact round trip)."""
-    if value is None:
-        return "none"
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    if isinstance(value, float):
-        return repr(value)
-    return str(value)
-
-
 def build_controller_config(run: PlannedRun, vehicle: VehicleModel | None = None) -> Any:
     """The run's controller config: the controller-config file's table, then the run's options (file options read
-    into their objects). With lead-filter scales other than 1, the config holds the scaled filter (of its own lead
-    filter, else of the vehicle's tuning)."""
-    options = dict(run.options)
-    scales = {k: options.pop(k) for k in LEAD_FILTER_SCALES if k in options}
-    config_type = CONTROLLERS[run.controller].config_type
-    overrides = [f"{key}={option_text(value)}" for key, value in options.items()]
+    into their objects), then the vehicle's tuning (when a vehicle is given). With lead-filter scales other than
+    1, the config holds the scaled filter (of its own lead filter, else of the vehicle's tuning)."""
     geometry = vehicle.geometry if vehicle is not None else None
-    config = read_controller_config(run.controller_config, run.controller, config_type, overrides, geometry)
+    config, scales = untuned_controller_config(run.controller, run.controller_config, dict(run.options), geometry)
     if vehicle is not None:
         config = with_vehicle_tuning(config, vehicle)
-    zero, pole = (scales.get(k, 1.0) for k in LEAD_FILTER_SCALES)
-    if zero != 1.0 or pole != 1.0:
-        tuning = getattr(config, "tuning", None)
-        own = tuning.filter_schedule if tuning is not None and config.lead_filter is None else None
-        config = dataclasses.replace(config, lead_filter=scaled_filter(config.lead_filter, zero, pole, own))
-    return config
+    return with_scaled_filter(config, scales)
 
 
 def simulate(run: PlannedRun, progress: bool = False) -> SimulationResult:
     """Build and simulate the run; return the SimulationResult."""
-    values = dict(run.values)
-    extra = {k: values.pop(k, None) for k in EXTRA_RUN_PARAMETERS}
-    name = values.pop("conditions", None)
-    fields = {k: values.pop(k) for k in list(values) if k in CONDITION_FIELDS}
-    config = SimulationConfig(**values, conditions=run_conditions(name, fields))
-    vehicle = load_vehicle(run.vehicle, extra["payload_kg"])  # a preset name or a vehicle file
-    scenario = make_scenario(run.scenario, ScenarioOptions(vehicle.geometry.width_m, run.track_file))
-    heading_deg = extra["initial_heading_error_deg"]
-    scenario = scenario.with_initial_error(
-        extra["initial_offset_m"], None if heading_deg is None else math.radians(heading_deg)
-    )
+    values, extra = split_values(dict(run.values))
+    config = simulation_config(values)
     # The controller is built for the vehicle with controller_payload_kg when given (a payload mismatch), else for
     # the plant itself.
-    built_for = vehicle
-    if extra["controller_payload_kg"] is not None:
-        built_for = load_vehicle(run.vehicle, extra["controller_payload_kg"])
+    vehicle, built_for = plant_and_controller_vehicles(run.vehicle, extra["payload_kg"], extra["controller_payload_kg"])
+    scenario = make_scenario(run.scenario, ScenarioOptions(vehicle.geometry.width_m, run.track_file))
+    scenario = started_scenario(
+        scenario, extra["initial_offset_m"], extra["initial_heading_error_deg"], config.max_abs_cte_m
+    )
     options = build_controller_config(run, built_for)
     controller = make_controller(run.controller, vehicle.geometry, options, vehicle=built_for)
     return Simulation(scenario, vehicle, controller, config).run(progress=progress)

@@ -18,8 +18,9 @@ The spec is checked before any run starts, so that a mistake costs no runs: unkn
 missing files, empty lists, NaN and wrong types are WorkbenchInputError naming the key and what is allowed; every
 file the spec names is read as the runs will read it (`_check_files`); a study planning more than max_runs runs
 (`run_count`, from the axes' sizes, before anything is planned; an optimisation: trials x runs) is refused saying
-how many. A value refused only in combination (by the run's vehicle, scenario, simulation or controller) is that
-run's error.
+how many. Every planned value is then built into the objects its runs build (`value_check.py`): a value every run
+with it would refuse (speed_kmh = 0, laps = 0, initial_offset_m = 1000, a controller option out of its range) is
+refused naming the key and the value; a value refused only in combination with others stays that run's error.
 """
 
 from __future__ import annotations
@@ -40,6 +41,8 @@ from typing import Any
 from controllers import CONTROLLERS
 from workbench.apps.studies.condition_parameters import CONDITION_PARAMETERS, resolve_conditions
 from workbench.apps.studies.distributions import SEARCHABLE, Distribution, key_rng
+from workbench.apps.studies.run_build import EXTRA_RUN_PARAMETERS, LEAD_FILTER_SCALES
+from workbench.apps.studies.value_check import check_values
 from workbench.base.errors import WorkbenchInputError, value_text
 from workbench.base.input_files import check_input_file, read_json, read_toml
 from workbench.base.typed_tables import type_name, typed_value, unwrap
@@ -54,13 +57,6 @@ from workbench.simulation.scenarios import (
 from workbench.simulation.simulator import SimulationConfig
 from workbench.vehicles import VEHICLES
 
-#: The run parameters besides SimulationConfig's fields, with their types.
-EXTRA_RUN_PARAMETERS: dict[str, Any] = {
-    "payload_kg": float,
-    "controller_payload_kg": float,
-    "initial_offset_m": float,
-    "initial_heading_error_deg": float,
-}
 #: Every run parameter and its type: SimulationConfig's fields (its conditions as `conditions`, a preset name or a
 #: file, and each scalar field of them, `condition_parameters.py`), then the extras.
 RUN_PARAMETERS: dict[str, Any] = {
@@ -72,8 +68,6 @@ RUN_PARAMETERS: dict[str, Any] = {
     **CONDITION_PARAMETERS,
     **EXTRA_RUN_PARAMETERS,
 }
-#: Factors on a lead filter's zero and pole frequencies, parameters of controllers that read one (`filter_file`).
-LEAD_FILTER_SCALES = ("lead_filter_zero_scale", "lead_filter_pole_scale")
 #: Metrics an objective may weigh: the numeric metrics.json fields except the wall-clock step times and the limit
 #: cycle's frequency and amplitude (null for a run without one, which would fail the trial). limit_cycle counts as
 #: 1 or 0 (a penalty on runs that limit-cycle).
@@ -356,7 +350,7 @@ class StudySpec:
     def __post_init__(self) -> None:
         """Check and type the study, in this order: the names (controllers, scenarios, vehicles), the files and
         scalars of [study], the axes and draws, the samples, the optimisation, then its size and every file a run
-        will read."""
+        will read, then every value planned, built into the objects its runs build (`value_check.py`)."""
         object.__setattr__(self, "base_dir", Path(self.base_dir).resolve())
         self._resolve_names()
         self._resolve_study_files()
@@ -368,7 +362,8 @@ class StudySpec:
         if isinstance(self.max_runs, bool) or not isinstance(self.max_runs, int) or self.max_runs < 1:
             raise WorkbenchInputError(f"study.max_runs must be a whole number >= 1; got {value_text(self.max_runs)}")
         self._check_size()
-        self._check_files(models)
+        scenarios = self._check_files(models)
+        check_values(self, models, scenarios)
 
     # ------------------------------------------------------------------------------------------- typing
     def _resolve_names(self) -> None:
@@ -518,26 +513,24 @@ class StudySpec:
             "limit with study.max_runs or --max-runs N"
         )
 
-    def _check_files(self, models: Mapping[str, Any]) -> None:
+    def _check_files(self, models: Mapping[str, Any]) -> dict[str, Any]:
         """Read every file the runs will read, as they will: the controller-config file for each controller
         (its keys and values), waypoint and track files, and each file a controller option names (in the config
         file, the grid or a choice). A WorkbenchInputError names the key and the file; a controller-config file
-        without a controller's table is warned about on stderr (`controller_config.missing_table_warning`)."""
+        without a controller's table is warned about on stderr (`controller_config.missing_table_warning`). Returns
+        each scenario built (sized for the first vehicle), by its name in the spec."""
         from workbench.apps.controller_config import read_controller_config
         from workbench.base.console import warn_on_stderr
         from workbench.simulation.scenarios import make_scenario
 
+        scenarios = {}
+        width = next(iter(models.values())).geometry.width_m
         for scenario in self.scenarios:
-            if scenario not in SCENARIOS:
-                try:
-                    make_scenario(scenario)
-                except WorkbenchInputError as exc:
-                    raise WorkbenchInputError(f"study.scenarios: {exc}") from None
-        if "zandvoort" in self.scenarios:
+            key, track = ("study.track_file", self.track_file) if scenario == "zandvoort" else ("study.scenarios", None)
             try:
-                make_scenario("zandvoort", ScenarioOptions(track_file=self.track_file))
+                scenarios[scenario] = make_scenario(scenario, ScenarioOptions(width, track))
             except WorkbenchInputError as exc:
-                raise WorkbenchInputError(f"study.track_file: {exc}") from None
+                raise WorkbenchInputError(f"{key}: {exc}") from None
         geometry = next(iter(models.values())).geometry
         checked: set[Path] = set()
         for controller in self.controllers:
@@ -558,6 +551,7 @@ class StudySpec:
                 if path is not None and path not in checked:
                     _check_option_file(where, key, path, geometry)
                     checked.add(path)
+        return scenarios
 
     def _checked_optimise(self, optimise: OptimiseSettings) -> OptimiseSettings:
         """The [optimise] settings checked against the study (one controller, its options fixed or searched), with
@@ -591,6 +585,15 @@ class StudySpec:
         return dataclasses.replace(optimise, search=search)
 
     # ------------------------------------------------------------------------------------------- planning
+    def drawn(self, controller: str | None = None) -> dict[str, Any]:
+        """The random draws, parameter -> one value per sample: of the run parameters (controller None), or of
+        that controller's options."""
+        samples = self.samples or 1
+        if controller is None:
+            return {k: d.draw(key_rng(self.seed, k), samples) for k, d in self.random.items()}
+        table = self.controller_random.get(controller, {})
+        return {k: d.draw(key_rng(self.seed, f"{controller}.{k}"), samples) for k, d in table.items()}
+
     def plan(self, options: Mapping[str, Any] | None = None) -> list[PlannedRun]:
         """Every run of the study, in order: per scenario, vehicle and controller, the product of the run-parameter
         axes (first listed outermost), the controller's axes, and the random samples. `options` adds controller
@@ -606,14 +609,11 @@ class StudySpec:
                     raise WorkbenchInputError(f"unknown option {key!r} for {self.controllers[0]}")
                 extra[key] = typed_value(key, value, allowed[key], self.base_dir)
         samples = self.samples or 1
-        run_draws = {k: d.draw(key_rng(self.seed, k), samples) for k, d in self.random.items()}
+        run_draws = self.drawn()
         runs: list[PlannedRun] = []
         for scenario, vehicle, controller in itertools.product(self.scenarios, self.vehicles, self.controllers):
             axes = self.controller_grid.get(controller, {})
-            draws = {
-                k: d.draw(key_rng(self.seed, f"{controller}.{k}"), samples)
-                for k, d in self.controller_random.get(controller, {}).items()
-            }
+            draws = self.drawn(controller)
             for run_values in itertools.product(*self.grid.values()):
                 for option_values in itertools.product(*axes.values()):
                     for i in range(samples):

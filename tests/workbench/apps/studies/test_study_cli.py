@@ -36,12 +36,12 @@ def test_bad_specs(tmp_path: Path, tiny_spec: Path, capsys: pytest.CaptureFixtur
 
 
 def test_a_sweep_with_errored_runs_exits_1(tiny_spec: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    """TINY_SPEC: 6 runs, 2 of which raise (min_lookahead_m above max_lookahead_m): the rows are kept, exit code 1."""
+    """TINY_SPEC: 10 runs, 2 of which raise (min_lookahead_m above max_lookahead_m): the rows are kept, exit code 1."""
     out = tmp_path / "out"
     assert main(["sweep", str(tiny_spec), "--out", str(out), "--workers", "1", "--no-plots"]) == 1
     captured = capsys.readouterr()
-    assert "6 runs (0 already done, 6 run now): 4 completed, 2 error" in captured.out
-    assert captured.err.startswith("workbench: 2 of 6 runs raised an error (status error;")
+    assert "10 runs (0 already done, 10 run now): 8 completed, 2 error" in captured.out
+    assert captured.err.startswith("workbench: 2 of 10 runs raised an error (status error;")
     assert captured.err.rstrip().endswith("exit code 1")
     assert (out / "results.parquet").is_file()
 
@@ -60,9 +60,34 @@ def test_a_bad_controller_config_stops_the_sweep_before_any_run(
     assert not out.exists()
 
 
+@pytest.mark.parametrize(
+    ("grid", "message"),
+    [
+        ("speed_kmh = [20, 0]", "grid.speed_kmh = 0.0: speed_kmh must be in [0.001, 400.0] km/h"),
+        ("laps = [0]", "grid.laps = 0: laps must be a whole number >= 1; got 0"),
+        ("initial_offset_m = [1000]", "grid.initial_offset_m = 1000.0: initial_offset_m must be in [-50.0, 50.0] m"),
+    ],
+)
+def test_a_value_every_run_would_refuse_stops_the_sweep_before_any_run(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], grid: str, message: str
+) -> None:
+    head = '[study]\nscenarios = ["dlc"]\ncontrollers = ["clothoid"]\nvehicles = ["kinematic-bicycle"]\n'
+    spec = write_spec(tmp_path / "bad", f"{head}[grid]\n{grid}\n")
+    for command in ("sweep", "optimise"):
+        if command == "optimise":
+            spec.write_text(
+                f"{head}[grid]\n{grid}\n[optimise]\ntrials = 2\n[optimise.objective]\nrms_cte_m = 1.0\n"
+                "[optimise.search]\nfrechet_threshold_m = {log_uniform = [0.01, 0.5]}\n"
+            )
+        assert main([command, str(spec), "--out", str(tmp_path / "out"), "--workers", "1"]) == 2
+        err = capsys.readouterr().err
+        assert err.startswith("workbench: error: spec ") and message in err and len(err.splitlines()) == 1
+        assert not (tmp_path / "out").exists()
+
+
 def test_max_runs(tiny_spec: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["sweep", str(tiny_spec), "--out", str(tmp_path / "out"), "--max-runs", "5"]) == 2
-    assert "the study plans 6 runs" in capsys.readouterr().err
+    assert "the study plans 10 runs" in capsys.readouterr().err
     assert main(["optimise", str(tiny_spec), "--out", str(tmp_path / "out"), "--max-runs", "0"]) == 2
     assert "--max-runs must be a whole number >= 1; got 0" in capsys.readouterr().err
     assert not (tmp_path / "out").exists()

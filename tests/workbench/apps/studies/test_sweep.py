@@ -24,7 +24,7 @@ from workbench.apps.studies.plots import pareto_mask
 
 @pytest.fixture(scope="module")
 def local_sweep(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, SweepResult]:
-    """The tiny study on the local pool of 2 workers (study_helpers.TINY_SPEC: 6 runs, 2 of them failing)."""
+    """The tiny study on the local pool of 2 workers (study_helpers.TINY_SPEC: 10 runs, 2 of them failing)."""
     from study_helpers import TINY_SPEC
 
     folder = tmp_path_factory.mktemp("local")
@@ -37,8 +37,9 @@ def test_the_results_table_has_a_row_per_run_with_real_values(local_sweep: tuple
     table = pd.read_parquet(result.out_dir / "results.parquet")
     assert_same_results(table, result.table)
     runs = load_spec(spec_path).plan()
-    assert list(table["run_id"]) == [r.run_id for r in runs] and result.ran == 6
-    assert list(table["status"]) == ["completed"] * 3 + ["error", "completed", "error"]
+    assert list(table["run_id"]) == [r.run_id for r in runs] and result.ran == 10
+    clothoid = ["completed", "completed", "error", "completed"]  # (min, max) lookahead (5, 20), (5, 31), (30, 20), ...
+    assert list(table["status"]) == ["completed"] * 2 + clothoid * 2
     # each row holds exactly what its run gives when executed here
     for run, (_, row) in zip(runs, table.iterrows(), strict=True):
         if row["status"] == "completed":
@@ -55,10 +56,11 @@ def test_a_failing_run_is_recorded_with_its_error(local_sweep: tuple[Path, Sweep
     _, result = local_sweep
     errors = result.errors()
     assert len(errors) == 2 and set(errors["clothoid.min_lookahead_m"]) == {30.0}
+    assert set(errors["clothoid.max_lookahead_m"]) == {20.0}
     for message in errors["message"]:
         assert message.startswith("WorkbenchInputError: max_lookahead_m must be") and "30.0" in message
     assert errors["completed"].eq(False).all() and errors["rms_cte_m"].isna().all()
-    assert result.status_counts() == {"completed": 4, "error": 2}
+    assert result.status_counts() == {"completed": 8, "error": 2}
     summary = result.summary().set_index("controller")
     assert summary.loc["clothoid", "errors"] == 2 and summary.loc["pure-pursuit", "completed"] == 2
     assert (summary["limit_cycles"] == 0).all() and (summary["median_steer_oscillation_deg"] > 0).all()
@@ -67,7 +69,7 @@ def test_a_failing_run_is_recorded_with_its_error(local_sweep: tuple[Path, Sweep
 def test_dask_gives_the_local_results_bit_for_bit(local_sweep: tuple[Path, SweepResult], tmp_path: Path) -> None:
     spec_path, local = local_sweep
     dask = run_sweep(load_spec(spec_path), tmp_path, DaskBackend(workers=2))
-    assert dask.ran == 6
+    assert dask.ran == 10
     assert_same_results(dask.table, local.table)
     assert (dask.table["step_time_median_us"] != local.table["step_time_median_us"]).any()  # wall clock: differs
 
