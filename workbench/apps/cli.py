@@ -161,6 +161,11 @@ def _parser(command: str | None = None) -> argparse.ArgumentParser:
     rob.add_argument(
         "--max-cte", type=float, default=0.5, metavar="M", help="a run passes within this max |CTE| (default 0.5 m)"
     )
+    rob.add_argument(
+        "--allow-long-run",
+        action="store_true",
+        help="start even when each run's time-out allows more than 2,000,000 controller steps or a trace over 1 GB",
+    )
     _conditions_options(rob)
     _backend_options(rob, command in (None, "robustness"))
 
@@ -613,7 +618,15 @@ def _robustness(args: argparse.Namespace) -> int:
     require_positive("--max-cte", args.max_cte)
     controllers = _names(args.controllers, "controllers")
     runs = plan_robustness(
-        args.scenario, controllers, args.vehicle, args.speed, args.conditions, args.seed, args.track, Path.cwd()
+        args.scenario,
+        controllers,
+        args.vehicle,
+        args.speed,
+        args.conditions,
+        args.seed,
+        args.track,
+        Path.cwd(),
+        allow_long_run=args.allow_long_run,
     )
     backend = make_backend(args.backend, args.scheduler, args.workers)
 

@@ -23,6 +23,7 @@ from workbench.apps.studies.spec import PlannedRun, StudySpec
 from workbench.apps.studies.store import RunStore, write_results
 from workbench.apps.studies.sweep import execute_runs
 from workbench.base.errors import WorkbenchInputError, require_positive
+from workbench.simulation.scenarios import SCENARIOS
 from workbench.vehicles import load_vehicle
 
 
@@ -107,10 +108,15 @@ def plan_robustness(
     track_file: Path | None = None,
     base_dir: Path | None = None,
     axes: Sequence[Axis] | None = None,
+    allow_long_run: bool = False,
 ) -> list[PlannedRun]:
     """Every run of the study: per controller, the base run and each axis's other values (axes: None for
     `robustness_axes(vehicle)`; the payload axis's runs keep the controller built for the nominal payload). Each
-    axis's value is set on top of `conditions`."""
+    axis's value is set on top of `conditions`. A study whose runs may simulate more than the
+    bounds of `run_size` (a very low speed) is refused before any run, unless allow_long_run
+    (`--allow-long-run`)."""
+    if not allow_long_run:
+        _check_run_size(scenario, vehicle, speed_kmh, track_file, base_dir)
     base = {"speed_kmh": speed_kmh, "conditions": conditions, "seed": seed}
     grids = [dict(base)]
     for axis in robustness_axes(vehicle) if axes is None else axes:
@@ -130,10 +136,31 @@ def plan_robustness(
             track_file=track_file,
             base_dir=base_dir or Path.cwd(),
             description="robustness",
+            allow_long_runs=True,  # sized above, as the option asks
         )
         for run in spec.plan():
             runs.setdefault(run.run_id, run)
     return [dataclasses.replace(run, index=i) for i, run in enumerate(runs.values())]
+
+
+def _check_run_size(
+    scenario: str, vehicle: str, speed_kmh: float, track_file: Path | None, base_dir: Path | None
+) -> None:
+    """Refuse runs that may simulate more than the bounds of `run_size` (`check_run_size`): every run of the study
+    drives the scenario at the same speed, so one size is every run's."""
+    from workbench.simulation.run_config import SimulationConfig
+    from workbench.simulation.run_size import RunSize, check_run_size
+    from workbench.simulation.scenarios import ScenarioOptions, make_scenario
+    from workbench.simulation.simulator import plan_path_speed
+
+    model = load_vehicle(vehicle)
+    if scenario not in SCENARIOS:
+        scenario = str((base_dir or Path.cwd()) / scenario)
+    path = make_scenario(scenario, ScenarioOptions(model.geometry.width_m, track_file)).path
+    config = SimulationConfig(speed_kmh=speed_kmh)
+    size = RunSize.of(plan_path_speed(path, config), config, len(model.output_names))
+    shorten = f"a higher --speed (now {speed_kmh:g} km/h) shortens it"
+    check_run_size(size, f"each run on {path.name}", shorten, "--allow-long-run")
 
 
 @dataclass(frozen=True)

@@ -42,6 +42,7 @@ from controllers import CONTROLLERS
 from workbench.apps.studies.condition_parameters import CONDITION_PARAMETERS, resolve_conditions
 from workbench.apps.studies.distributions import SEARCHABLE, Distribution, key_rng
 from workbench.apps.studies.run_build import EXTRA_RUN_PARAMETERS, LEAD_FILTER_SCALES
+from workbench.apps.studies.study_size import check_run_sizes
 from workbench.apps.studies.value_check import check_values
 from workbench.base.errors import WorkbenchInputError, value_text
 from workbench.base.input_files import check_input_file, read_json, read_toml
@@ -88,6 +89,7 @@ STUDY_KEYS = (
     "samples",
     "description",
     "max_runs",
+    "allow_long_runs",
 )
 OPTIMISE_KEYS = ("trials", "batch_size", "seed", "startup_trials", "aggregate", "objective", "search")
 SCENARIO_FILE_SUFFIXES = (".csv", ".txt")
@@ -328,7 +330,8 @@ class OptimiseSettings:
 class StudySpec:
     """A study: see the module docstring. base_dir: the folder relative paths are taken from (the spec file's).
     grid / random: run-parameter axes / distributions; controller_grid / controller_random: the same per
-    controller; max_runs: the most runs the study may plan (an optimisation: trials x runs per trial). Values are
+    controller; max_runs: the most runs the study may plan (an optimisation: trials x runs per trial);
+    allow_long_runs: let runs longer than the bounds of `run_size` start (`study_size.py`). Values are
     checked and typed on construction (paths made absolute, the files they name read)."""
 
     scenarios: Sequence[str]
@@ -346,6 +349,7 @@ class StudySpec:
     base_dir: Path = field(default_factory=Path.cwd)
     optimise: OptimiseSettings | None = None
     max_runs: int = DEFAULT_MAX_RUNS
+    allow_long_runs: bool = False
 
     def __post_init__(self) -> None:
         """Check and type the study, in this order: the names (controllers, scenarios, vehicles), the files and
@@ -364,6 +368,7 @@ class StudySpec:
         self._check_size()
         scenarios = self._check_files(models)
         check_values(self, models, scenarios)
+        check_run_sizes(self, models, scenarios)
 
     # ------------------------------------------------------------------------------------------- typing
     def _resolve_names(self) -> None:
@@ -407,6 +412,10 @@ class StudySpec:
                 object.__setattr__(self, name, check_input_file(path, f"study.{name}: file {str(value)!r}"))
 
     def _check_scalars(self) -> None:
+        if not isinstance(self.allow_long_runs, bool):
+            raise WorkbenchInputError(
+                f"study.allow_long_runs must be true or false; got {value_text(self.allow_long_runs)}"
+            )
         if not isinstance(self.description, str):
             raise WorkbenchInputError(f"study.description must be text; got {self.description!r}")
         if isinstance(self.seed, bool) or not isinstance(self.seed, int) or self.seed < 0:
@@ -765,6 +774,7 @@ def _from_document(document: Mapping[str, Any], kind: str, base_dir: Path, max_r
         base_dir=base_dir,
         optimise=optimise,
         max_runs=max_runs if max_runs is not None else study.get("max_runs", DEFAULT_MAX_RUNS),
+        allow_long_runs=study.get("allow_long_runs", False),
     )
 
 
