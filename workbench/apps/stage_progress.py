@@ -15,6 +15,10 @@ from tqdm import tqdm
 
 from workbench.base.console import warn_on_stderr
 
+#: The bar: the stages done of all, the time since the command started and the current stage (no rate: stages
+#: differ in length).
+BAR_FORMAT = "{l_bar}{bar}| {n_fmt}/{total_fmt} stages [{elapsed}{postfix}]"
+
 
 class StageProgress:
     """The stages of `command` (`stages` of them) on `stream` (default: stderr): `stage(text)` starts the next one.
@@ -27,7 +31,9 @@ class StageProgress:
         self.terminal = self.stream.isatty() if terminal is None else terminal
         self.started = 0
         self.bar = (
-            tqdm(total=stages, unit="stage", desc=command, leave=False, file=self.stream) if self.terminal else None
+            tqdm(total=stages, desc=command, leave=False, file=self.stream, bar_format=BAR_FORMAT)
+            if self.terminal
+            else None
         )
 
     def stage(self, text: str) -> None:

@@ -26,5 +26,5 @@ def test_on_a_terminal_a_bar_counts_the_stages_and_names_the_current_one() -> No
     progress.warn("a warning")
     progress.close()
     text = stream.getvalue()
-    assert "run:  33%" in text and "simulating 12 m" in text and "building" in text
+    assert "run:  33%" in text and "1/3 stages [00:00, simulating 12 m]" in text and "building" in text
     assert "workbench run: " not in text  # no lines: the bar
