@@ -143,8 +143,8 @@ def read_config_tables(path: str | Path) -> dict[str, dict[str, Any]]:
     loose = [f"{key} = {value_text(value)}" for key, value in document.items() if not isinstance(value, dict)]
     if loose:
         raise WorkbenchInputError(
-            f"{what}: {'; '.join(loose)} outside any table; options go in their controller's table, [NAME] with NAME "
-            f"one of {', '.join(CONTROLLERS)}"
+            f"{what}: {'; '.join(loose)} {'is' if len(loose) == 1 else 'are'} outside any table; options go in their "
+            f"controller's table, [NAME] with NAME one of {', '.join(CONTROLLERS)}"
         )
     for name in document:
         if name not in CONTROLLERS:

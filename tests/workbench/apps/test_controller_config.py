@@ -87,7 +87,7 @@ def test_every_controller_template_reads_back_to_its_defaults(name: str, tmp_pat
         ("[stanly]\ngain_per_s = 3.0\n", r"\[stanly\] names no controller; did you mean \[stanley\]\?"),
         ("[Clothoid]\nfrechet_threshold_m = 0.1\n", r"\[Clothoid\] names no controller; did you mean \[clothoid\]\?"),
         ("[nothing-alike]\n", r"\[nothing-alike\] names no controller; the tables a file may hold: \[clothoid\]"),
-        ("frechet_threshold_m = 0.1\n[clothoid]\n", r"frechet_threshold_m = 0\.1 outside any table"),
+        ("frechet_threshold_m = 0.1\n[clothoid]\n", r"frechet_threshold_m = 0\.1 is outside any table; options go in"),
     ],
 )
 def test_tables_naming_no_controller_and_keys_outside_tables_are_refused(
