@@ -14,7 +14,8 @@ Steering rate: the road-wheel angle the path asks for (as above, signed) as a fu
 speed must not change by more than the steering's rate limit allows (`max_steer_wheel_rate_rad_s` over the
 steering ratio) within any STEERING_RATE_WINDOW_S. A curvature that changes too fast for the speed (a circle
 entered without a transition, two turns closer than the steering can reverse between) asks for that; a short
-burst above the rate costs a lag a controller recovers from, a sustained one leaves the path.
+burst above the rate costs a lag a controller recovers from, a sustained one leaves the path. The wheels are
+straight when a run starts, so a path that starts in a tight curve asks the same of the steering at once.
 Rollover: v^2 kappa against the vehicle's static rollover threshold, for a model that states one (the
 tractor-semitrailer's `Derived.rollover_threshold_g`, 0.45 g loaded; a dynamic manoeuvre lifts a wheel up to about
 25% earlier, SAE 2003-01-3385, which this static check does not claim to catch).
@@ -52,8 +53,9 @@ REASONS = (STEERING_LOCK, STEERING_RATE, ROLLOVER, TYRE_GRIP)
 #: 0.11-0.38 on the loaded truck; a stadium whose 6.5 m hairpins start without a transition 0.72 (car, tracked within
 #: 0.29 m by pure pursuit) and 0.76 (truck); a 3 m semicircle between straights 1.37 (car, the clothoid controller
 #: 4.8 m off the path) and 1.19 (truck); two 90-degree turns 0.5 m apart 1.14 (car, 21 m off the path; the truck's
-#: lock rules them out). Over a 1 s window the hairpins the car tracks would be 1.08: a shorter window judges a lag
-#: the controllers recover from.
+#: lock rules them out); a 3 m circle, from the straight wheels a run starts with, 1.19 (car; the clothoid controller
+#: 5.1 m off the path, pure pursuit 2.8 m). Over a 1 s window the hairpins the car tracks would be 1.08: a shorter
+#: window judges a lag the controllers recover from.
 STEERING_RATE_WINDOW_S = 1.5
 #: Two infeasible stretches of one reason closer than this along the path (m) are one span: a curvature that
 #: dips under the limit for a few samples inside a hairpin is one place, not several.
@@ -148,7 +150,9 @@ class VehicleLimits:
         """What the path, at its planned speed, asks of the steering's rate over what it allows, for the window of
         STEERING_RATE_WINDOW_S starting at each sample: the most the asked road-wheel angle changes within the
         window over the rate limit times the window (> 1: infeasible); and the index of each window's last sample
-        (on a closed loop counted on past the seam: index mod (n - 1)). None without a rate limit."""
+        (on a closed loop counted on past the seam: index mod (n - 1)). None without a rate limit. A run starts
+        with the wheels straight: the first window counts the change from a road-wheel angle of zero too (a path
+        that starts in a tight curve asks the steering to wind into it at once)."""
         if self.max_road_wheel_rate_rad_s is None:
             return None
         angle = self.road_wheel_angle_rad(path.curvature_1pm, path.speed_mps)
@@ -163,6 +167,7 @@ class VehicleLimits:
         first = np.arange(n)
         high, low = _range_extremes(angle, first, last)
         change = np.maximum(high - angle[:n], angle[:n] - low)
+        change[0] = max(change[0], high[0], -low[0])  # a run starts with the wheels straight
         return change / (self.max_road_wheel_rate_rad_s * STEERING_RATE_WINDOW_S), last
 
     def demand_ratios(self, curvature_1pm: np.ndarray, speed_mps: np.ndarray) -> dict[str, np.ndarray]:

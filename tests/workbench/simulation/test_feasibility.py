@@ -230,3 +230,19 @@ def test_a_steering_rate_span_is_written_with_its_ratio_and_no_minimum_radius() 
     }  # fmt: skip
     with pytest.raises(WorkbenchInputError, match=r"demand_ratio must be a finite number > 0; got -1\.0"):
         InfeasibleSpan(13.0, 24.1, 13.0, 2.7, None, 15.0, STEERING_RATE, -1.0)
+
+
+def test_a_path_starting_in_a_tight_curve_asks_the_straight_wheels_to_wind_in_at_once() -> None:
+    """A 3 m circle: constant curvature, within the car's lock, but a run starts with the wheels straight and the
+    0.71 rad the circle asks for take the car's steering 1.8 s (1.19 times what it turns in 1.5 s): flagged at the
+    start only. A 30 m circle asks 0.086 rad: nothing."""
+    car = make_vehicle("kinematic-bicycle")
+    path = _planned(_circle(3.0))
+    (span,) = check_path(path, car)
+    limits = VehicleLimits.of(car)
+    wind_in = math.atan(limits.wheelbase_m / 3.0) / (limits.max_road_wheel_rate_rad_s * STEERING_RATE_WINDOW_S)
+    assert (span.reason, span.start_s_m) == (STEERING_RATE, 0.0)
+    assert span.demand_ratio == pytest.approx(wind_in, rel=1e-6) and span.radius_m == pytest.approx(3.0, rel=1e-6)
+    ratio, _ = limits.steering_rate_ratios(path)
+    assert ratio[1:].max() < 1e-6  # elsewhere the angle asked for stays the same
+    assert check_path(_planned(_circle(30.0)), car) == ()
