@@ -171,6 +171,11 @@ class Controller(ABC):
         limit = self.geometry.max_steer_wheel_angle_rad
         return min(max(steer_wheel_rad, -limit), limit)
 
+    def run_warnings(self, path: ReferencePath, sample_time_s: float) -> list[str]:
+        """What to tell a person before a run on `path` with steps every sample_time_s (s): settings that cannot act
+        as configured on it (`SteeringController.run_warnings`); none unless a subclass says otherwise."""
+        return []
+
     # ------------------------------------------------------------------ what subclasses implement
     @abstractmethod
     def _reset(self, path: ReferencePath, sample_time_s: float) -> None:

@@ -625,7 +625,10 @@ def _add_margins_parser(sub: argparse._SubParsersAction, command: str | None = N
     )
     if not _builds(command, "margins"):
         return
+    from controllers.clothoid import ClothoidConfig
     from controllers.clothoid.loop_analysis import REQUIRED_GAIN_MARGIN_DB, REQUIRED_PHASE_MARGIN_DEG
+
+    default_max_lookahead = ClothoidConfig().max_lookahead_m
 
     marg.add_argument(
         "--lag", type=Path, metavar="lag.json", help="path-curvature lag (fit-lag; default: the vehicle's)"
@@ -653,6 +656,13 @@ def _add_margins_parser(sub: argparse._SubParsersAction, command: str | None = N
     marg.add_argument("--out", type=Path, required=True, metavar="margins.csv", help="output table (CSV)")
     marg.add_argument("--plot", type=Path, metavar="FILE.png", help="margins against lookahead per speed")
     _overwrite_option(marg)
+    marg.add_argument(
+        "--max-lookahead-m",
+        type=float,
+        default=default_max_lookahead,
+        help=f"the clothoid controller's max_lookahead_m: a floor above it is named, with what the controller then "
+        f"does (default {default_max_lookahead:g} m, its default)",
+    )
     marg.add_argument("--prediction-time-s", type=float, default=0.2, help="pose prediction (default 0.2 s)")
     marg.add_argument("--controller-rate-hz", type=float, default=50.0, help="controller rate (default 50 Hz)")
     marg.add_argument(
@@ -697,6 +707,7 @@ def _margin_lookaheads(text: str) -> tuple[float, ...]:
 
 
 def _margins(args: argparse.Namespace) -> int:
+    from controllers.clothoid.controller import MAX_LOOKAHEAD_M
     from controllers.clothoid.loop_analysis import PlantLags
     from tuning.filter_file import read_filter_file
     from tuning.margins import MarginStudy, run_margins
@@ -710,6 +721,7 @@ def _margins(args: argparse.Namespace) -> int:
         ("--arc-lateral-accel-g", args.arc_lateral_accel_g, 0.0, 2.0, "g"),
         ("--phase-margin-deg", args.phase_margin_deg, 0.0, 180.0, "deg"),
         ("--gain-margin-db", args.gain_margin_db, 0.0, 60.0, "dB"),
+        ("--max-lookahead-m", args.max_lookahead_m, 0.5, MAX_LOOKAHEAD_M, "m"),
     ):
         require_in_range(flag, value, low, high, unit)
     try:
@@ -771,6 +783,7 @@ def _margins(args: argparse.Namespace) -> int:
         geometry=vehicle.geometry if vehicle is not None else None,
         arc_lateral_accel_g=args.arc_lateral_accel_g,
         limits=limits,
+        max_lookahead_m=args.max_lookahead_m,
     )
     result = run_margins(study)
     try:

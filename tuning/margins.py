@@ -22,14 +22,17 @@ import numpy as np
 import pandas as pd
 from scipy.constants import g as G_MPS2  # standard gravity, 9.80665 m/s^2
 
+from controllers.clothoid.controller import MAX_FLOOR_LOOKAHEAD_M, MAX_LOOKAHEAD_M
 from controllers.clothoid.curvature_limits import CurvatureLimits
 from controllers.clothoid.filter_schedule import FilterSchedule
 from controllers.clothoid.loop_analysis import (
+    MAX_CURVATURE_LOOKAHEAD,
     REQUIRED_GAIN_MARGIN_DB,
     REQUIRED_PHASE_MARGIN_DEG,
     LoopSettings,
     Margins,
     PlantLags,
+    keeps_margins,
     lookahead_floor,
     loop_margins,
     loop_transfer,
@@ -55,9 +58,6 @@ COLUMNS = (
     "limit_cycle_hz",
     "limit_cycle_steer_wheel_deg",
 )
-#: Rows with |path curvature| x lookahead at or above this are left out (no target on the arc that far ahead; the
-#: floor search skips them too).
-MAX_CURVATURE_LOOKAHEAD = 1.8
 #: Most lookaheads a study may hold.
 MAX_LOOKAHEADS = 2000
 #: Most (speed, lookahead) pairs a study may analyse: each is one loop analysis per path curvature, about 20 ms
@@ -72,8 +72,9 @@ class MarginStudy:
     arc_lateral_accel_g (also, at each speed, the arc of this lateral acceleration, a g / v^2, capped at the
     curvature limit; None or 0: none), sample_time_s, prediction_time_s, measurement_delay_s, the required
     margins, the vehicle geometry (for the curvature-rate limit and the steering amplitude of a predicted limit
-    cycle; None: not predicted) and limits (the controller's curvature and curvature-rate limits against speed; None:
-    the steering lock and the steering-rate limit of the geometry)."""
+    cycle; None: not predicted), limits (the controller's curvature and curvature-rate limits against speed; None:
+    the steering lock and the steering-rate limit of the geometry) and max_lookahead_m (the controller's longest
+    lookahead, m: a floor above it is said to hold the lookahead outside the range; None: not compared)."""
 
     lags_at: Callable[[float], PlantLags]
     lead: FilterSchedule | None
@@ -88,6 +89,7 @@ class MarginStudy:
     geometry: VehicleGeometry | None = None
     arc_lateral_accel_g: float | None = None
     limits: CurvatureLimits | None = None
+    max_lookahead_m: float | None = None
 
     def __post_init__(self) -> None:
         if not callable(self.lags_at):
@@ -117,6 +119,8 @@ class MarginStudy:
             raise WorkbenchInputError("give at least one path curvature or an arc_lateral_accel_g > 0")
         require_in_range("phase_margin_deg", self.phase_margin_deg, 0.0, 180.0, "deg")
         require_in_range("gain_margin_db", self.gain_margin_db, 0.0, 60.0, "dB")
+        if self.max_lookahead_m is not None:
+            require_in_range("max_lookahead_m", self.max_lookahead_m, 0.5, MAX_LOOKAHEAD_M, "m")
         if self.limits is not None and not isinstance(self.limits, CurvatureLimits):
             raise WorkbenchInputError(f"limits must be CurvatureLimits or None; got {self.limits!r}")
 
@@ -207,6 +211,18 @@ class MarginResult:
                 lines.append(
                     f"{speed:6g} km/h: floor none (no lookahead in {low:g}-{high:g} m keeps the margins about {kinds})"
                 )
+                top = max(study.max_lookahead_m or 0.0, MAX_FLOOR_LOOKAHEAD_M)
+                if study.max_lookahead_m is not None and high >= top:
+                    lines.append(
+                        f"{' ' * 13}the clothoid controller would hold its lookahead at the top of its floor search, "
+                        f"{top:g} m, without these margins, and its Fréchet search would not act: use a lead filter "
+                        "with more phase margin"
+                    )
+                elif study.max_lookahead_m is not None:
+                    lines.append(
+                        f"{' ' * 13}analyse up to {top:g} m (the top of the clothoid controller's floor search) to see "
+                        "where it would hold its lookahead"
+                    )
             else:
                 parts = [
                     f"{_curvature_label(kr)}: PM {m.phase_margin_deg:.1f} deg, GM +{m.gain_margin_db:.1f} / "
@@ -214,6 +230,13 @@ class MarginResult:
                     for kr, m in self.margins_at_floor(speed).items()
                 ]
                 lines.append(f"{speed:6g} km/h: floor {floor:g} m ({'; '.join(parts)})")
+                if study.max_lookahead_m is not None and floor > study.max_lookahead_m:
+                    lines.append(
+                        f"{' ' * 13}floor above max_lookahead_m ({study.max_lookahead_m:g} m): the clothoid controller "
+                        f"would hold its lookahead at {floor:g} m, outside its range, and its Fréchet search would "
+                        f"not act: raise max_lookahead_m to at least {floor:g} m or use a lead filter with more phase "
+                        "margin"
+                    )
             below, where = self.table[(self.table["speed_kmh"] == speed)], "in the range"
             if math.isfinite(floor):
                 below, where = below[below["lookahead_m"] < floor], "below it"
@@ -361,12 +384,7 @@ def run_margins(study: MarginStudy) -> MarginResult:
         low, high = min(study.lookaheads_m), max(study.lookaheads_m)
         pm, gm = study.phase_margin_deg, study.gain_margin_db
         floor = lookahead_floor(lags, settings, v, low, high, study.lookahead_step_m(), curvatures, pm, gm)
-        ok = all(
-            loop_margins(lags, settings, v, floor, kr).meets(pm, gm)
-            for kr in curvatures
-            if abs(kr) * floor < MAX_CURVATURE_LOOKAHEAD
-        )
-        floors[speed] = floor if ok else math.nan
+        floors[speed] = floor if keeps_margins(lags, settings, v, floor, curvatures, pm, gm) else math.nan
     return MarginResult(study, pd.DataFrame(rows, columns=list(COLUMNS)), floors)
 
 

@@ -56,7 +56,7 @@ from workbench.base.path import PathTracker, ReferencePath
 from workbench.vehicles.base import VehicleGeometry
 
 if TYPE_CHECKING:  # the loop analysis (python-control, ~0.9 s to import) only where floors are computed
-    from controllers.clothoid.loop_analysis import LoopSettings, PlantLags
+    from controllers.clothoid.loop_analysis import DelayRobustness, LoopSettings, PlantLags
 
 LOOKAHEAD_MODES = ("adaptive", "fixed", "speed")
 INITIAL_CURVATURE = ("yaw-rate", "command", "steering")
@@ -379,7 +379,7 @@ class ClothoidController(Controller):
             elif self.tuning is not None:
                 self.filter_schedule = self.tuning.filter_schedule
         self._buffers = np.empty((4, MAX_CURVE_POINTS))
-        top = max(cfg.max_lookahead_m, MAX_FLOOR_LOOKAHEAD_M)
+        top = self._floor_search_top_m
         self._scores = np.empty(candidate_count(cfg.min_lookahead_m, top, cfg.lookahead_step_m))
         self._results = np.empty((self._scores.size, 8))  # each candidate's evaluation (lookahead.adaptive_search)
         self._floors: dict[int, float] = {}  # per speed band, for the sample time _floors_dt
@@ -419,9 +419,9 @@ class ClothoidController(Controller):
             self._lag_speeds, self._schedule, self._schedule_speeds, self._floor_table, self._filter_table,
             self._buffers, self._scores, self._results, self._scratch, self._diag, self._history,
         )  # fmt: skip
-        if path.speed_mps is not None:  # the planned speeds' floors now, not in a step (~0.04 s a band, model 0.5 s)
-            for speed_mps in np.unique(np.round(path.speed_mps * 3.6 / FLOOR_SPEED_BAND_KMH)) * FLOOR_SPEED_BAND_KMH:
-                self.lookahead_floor_m(float(speed_mps) / 3.6)
+        # The planned speeds' floors now, not in a step (~0.04 s a band, with the delay model 0.5 s).
+        for band in self._planned_bands(path):
+            self._band_floor_m(band)
 
     def _tables(self) -> None:
         """The tables the compiled step reads (step_kernel.py): the limits, the identified lags and the lead
@@ -500,28 +500,115 @@ class ClothoidController(Controller):
         cfg = self.config
         floor = self._floors.get(band)
         if floor is None:
-            speed_kmh = band * FLOOR_SPEED_BAND_KMH
-            lags = self.plant_lags(speed_kmh)
-            if lags is None or (cfg.min_phase_margin_deg <= 0.0 and cfg.min_gain_margin_db <= 0.0):
+            inputs = self._floor_inputs(band)
+            if inputs is None:
                 floor = cfg.min_lookahead_m
             else:
-                # python-control: imported when used
-                from controllers.clothoid.loop_analysis import DelayRobustness, lookahead_floor
+                from controllers.clothoid.loop_analysis import lookahead_floor  # python-control: imported when used
 
-                v = speed_kmh / 3.6
-                kappa_max, _ = self.limits.at_speed(v)
-                arc = min(kappa_max, FLOOR_ARC_LATERAL_ACCEL_G * G_MPS2 / v**2)
+                lags, settings, v, curvatures, delayed = inputs
                 floor = lookahead_floor(
-                    lags, self.loop_settings(speed_kmh), v, cfg.min_lookahead_m,
-                    max(cfg.max_lookahead_m, MAX_FLOOR_LOOKAHEAD_M), cfg.lookahead_step_m, (0.0, arc),
-                    cfg.min_phase_margin_deg, cfg.min_gain_margin_db,
-                    DelayRobustness(
-                        cfg.min_delayed_phase_margin_deg, cfg.min_delayed_gain_margin_db,
-                        cfg.known_delay_uncertainty_s,
-                    ),
+                    lags, settings, v, cfg.min_lookahead_m, self._floor_search_top_m, cfg.lookahead_step_m,
+                    curvatures, cfg.min_phase_margin_deg, cfg.min_gain_margin_db, delayed,
                 )  # fmt: skip
             self._floors[band] = floor
         return floor
+
+    @property
+    def _floor_search_top_m(self) -> float:
+        """The longest lookahead (m) the floor search considers: max_lookahead_m, or MAX_FLOOR_LOOKAHEAD_M when
+        longer (a floor above the range raises its top with it)."""
+        return max(self.config.max_lookahead_m, MAX_FLOOR_LOOKAHEAD_M)
+
+    def _floor_inputs(
+        self, band: int
+    ) -> tuple[PlantLags, LoopSettings, float, tuple[float, float], DelayRobustness] | None:
+        """What the floor of speed band `band` is analysed with: the lags, the loop settings, the speed (m/s), the
+        path curvatures (the straight and the FLOOR_ARC_LATERAL_ACCEL_G arc, capped by the curvature limit) and the
+        margins kept with the delay (`loop_analysis.DelayRobustness`); None without a tuning or with the margins
+        set to 0 (no floor)."""
+        cfg = self.config
+        speed_kmh = band * FLOOR_SPEED_BAND_KMH
+        lags = self.plant_lags(speed_kmh)
+        if lags is None or (cfg.min_phase_margin_deg <= 0.0 and cfg.min_gain_margin_db <= 0.0):
+            return None
+        from controllers.clothoid.loop_analysis import DelayRobustness  # python-control: imported when used
+
+        v = speed_kmh / 3.6
+        kappa_max, _ = self.limits.at_speed(v)
+        arc = min(kappa_max, FLOOR_ARC_LATERAL_ACCEL_G * G_MPS2 / v**2)
+        delayed = DelayRobustness(
+            cfg.min_delayed_phase_margin_deg, cfg.min_delayed_gain_margin_db, cfg.known_delay_uncertainty_s
+        )
+        return lags, self.loop_settings(speed_kmh), v, (0.0, arc), delayed
+
+    def _band_keeps_margins(self, band: int) -> bool:
+        """Whether the lookahead floor of speed band `band` keeps the configured margins (False: no lookahead up to
+        the floor search's top does, and the floor is that top)."""
+        floor, inputs = self._band_floor_m(band), self._floor_inputs(band)
+        if inputs is None or floor < self._floor_search_top_m - 1e-9:
+            return True  # the search returns a floor below its top only where the margins hold
+        from controllers.clothoid.loop_analysis import keeps_margins
+
+        lags, settings, v, curvatures, delayed = inputs
+        cfg = self.config
+        return keeps_margins(
+            lags, settings, v, floor, curvatures, cfg.min_phase_margin_deg, cfg.min_gain_margin_db, delayed
+        )
+
+    @staticmethod
+    def _planned_bands(path: ReferencePath) -> list[int]:
+        """The floor's speed bands of the path's planned speeds (none without them)."""
+        if path.speed_mps is None:
+            return []
+        return [int(b) for b in np.unique(np.maximum(1.0, np.round(path.speed_mps * 3.6 / FLOOR_SPEED_BAND_KMH)))]
+
+    def run_warnings(self, path: ReferencePath, sample_time_s: float) -> list[str]:
+        """What to tell a person before a run on `path` (at its planned speeds) with steps every sample_time_s: the
+        speed bands whose lookahead floor lies above max_lookahead_m. There the lookahead is held at the floor, a
+        constant lookahead outside the configured range, and the Fréchet search does not act; where no lookahead
+        up to the floor search's top keeps the margins, it is held at that top without them. The run is not
+        refused: the floor is what keeps the loop's margins with this tuning (a study of weak lead filters must
+        be able to run it), but it is not the controller the range describes, and the message says what to
+        change. None in the "fixed" lookahead mode (no floor applies) or without planned speeds."""
+        cfg = self.config
+        if cfg.lookahead_mode == "fixed" or path.speed_mps is None:
+            return []
+        self.reset(path, sample_time_s)  # the planned bands' floors, as the run computes them (and keeps)
+        above = [(band, self._band_floor_m(band)) for band in self._planned_bands(path)]
+        above = [(band, floor) for band, floor in above if floor > cfg.max_lookahead_m + 1e-9]
+        if not above:
+            return []
+        top = self._floor_search_top_m
+        keeps = {band: self._band_keeps_margins(band) for band, _ in above}
+        kept = [floor for band, floor in above if keeps[band]]
+        spans: list[list] = []  # [first band, last band, what]: neighbouring bands that say the same, together
+        for band, floor in above:
+            what = f"floor {floor:g} m" if keeps[band] else f"floor none: no lookahead up to {top:g} m keeps them"
+            if spans and spans[-1][1] == band - 1 and spans[-1][2] == what:
+                spans[-1][1] = band
+            else:
+                spans.append([band, band, what])
+        places = ", ".join(
+            f"{first * FLOOR_SPEED_BAND_KMH:g}{f'-{last * FLOOR_SPEED_BAND_KMH:g}' if last > first else ''} km/h "
+            f"({what})"
+            for first, last, what in spans
+        )
+        remedies = []
+        if kept:
+            remedies.append(f"raise max_lookahead_m to at least {max(kept):g} m (--set max_lookahead_m=...)")
+        remedies.append(
+            "use a lead filter with more phase margin (`tuning margins` shows the floors per speed; `tuning schedule "
+            "--design margins` designs the shortest)"
+        )
+        return [
+            f"the clothoid controller's lookahead floor (the shortest lookahead keeping {cfg.min_phase_margin_deg:g} "
+            f"deg / {cfg.min_gain_margin_db:g} dB margins with its lead filter and lags) lies above max_lookahead_m "
+            f"= {cfg.max_lookahead_m:g} m at {places}: there the lookahead is held at the floor"
+            f"{'' if all(keeps.values()) else f' ({top:g} m where none)'}, a constant outside the configured "
+            f"{cfg.min_lookahead_m:g}-{cfg.max_lookahead_m:g} m, and the Fréchet search does not act; "
+            f"{' or '.join(remedies)}"
+        ]
 
     def feedforward_timing(self, speed_mps: float) -> FeedforwardTiming:
         """The feed-forward's timing at this speed: the options, else from the identified lags (path_feedforward.py):

@@ -580,6 +580,57 @@ def loop_margins(
     return _margins_from(omega, response, poles)
 
 
+#: Paths whose |curvature| x lookahead reaches this have no target on the arc that far ahead: not analysed.
+MAX_CURVATURE_LOOKAHEAD = 1.8
+
+
+def _margin_checks(
+    settings: LoopSettings, phase_margin_deg: float, gain_margin_db: float, delayed: DelayRobustness
+) -> list[tuple[LoopSettings, float, float]]:
+    """(loop, phase margin, gain margin) to keep: the nominal loop, then with the model the loop itself, with its
+    delay as known and as it may be (`lookahead_floor`)."""
+    nominal = settings.nominal
+    checks = [(nominal, phase_margin_deg, gain_margin_db)]
+    if nominal is not settings:
+        checks.append((settings, delayed.phase_margin_deg, delayed.gain_margin_db))
+        fraction = UNCERTAIN_DELAY_MARGIN_FRACTION
+        for error in delayed.delay_errors_s(settings.known_delay_s + settings.measurement_delay_s):
+            late = dataclasses.replace(settings, measurement_delay_s=settings.measurement_delay_s + error)
+            checks.append((late, fraction * delayed.phase_margin_deg, fraction * delayed.gain_margin_db))
+    return checks
+
+
+def _meets(
+    lags: PlantLags,
+    checks: list[tuple[LoopSettings, float, float]],
+    speed_mps: float,
+    lookahead_m: float,
+    path_curvatures_1pm: tuple[float, ...],
+) -> bool:
+    return all(
+        loop_margins(lags, loop, speed_mps, lookahead_m, kr).meets(pm, gm)
+        for kr in path_curvatures_1pm
+        if abs(kr) * lookahead_m < MAX_CURVATURE_LOOKAHEAD
+        for loop, pm, gm in checks
+    )
+
+
+def keeps_margins(
+    lags: PlantLags,
+    settings: LoopSettings,
+    speed_mps: float,
+    lookahead_m: float,
+    path_curvatures_1pm: tuple[float, ...] = (0.0,),
+    phase_margin_deg: float = REQUIRED_PHASE_MARGIN_DEG,
+    gain_margin_db: float = REQUIRED_GAIN_MARGIN_DB,
+    delayed: DelayRobustness = DelayRobustness(),
+) -> bool:
+    """Whether the loop at this lookahead keeps the margins `lookahead_floor` asks for, about each path curvature:
+    what tells a floor at the top of its search that keeps them from one returned because no lookahead does."""
+    checks = _margin_checks(settings, phase_margin_deg, gain_margin_db, delayed)
+    return _meets(lags, checks, float(speed_mps), float(lookahead_m), path_curvatures_1pm)
+
+
 def lookahead_floor(
     lags: PlantLags,
     settings: LoopSettings,
@@ -593,35 +644,20 @@ def lookahead_floor(
     delayed: DelayRobustness = DelayRobustness(),
 ) -> float:
     """The shortest lookahead (m, on a grid of step_m from min_lookahead_m) from which every lookahead up to
-    max_lookahead_m keeps the required margins about each of the path curvatures; max_lookahead_m when none does.
-    The margins are those of the nominal loop (`LoopSettings.nominal`: with the model's delay compensation the
-    delay-free one, which it leaves when its model is the vehicle); with that compensation the loop itself keeps
-    `delayed`'s margins at the steering sent (`DelayRobustness`). A bisection on the grid
-    (margins mostly improve with the lookahead: the loop's gain falls as L^-3), then a check every _FLOOR_CHECK_M
-    above the result; a failure there restarts the bisection above it."""
+    max_lookahead_m keeps the required margins about each of the path curvatures; max_lookahead_m when none does
+    (`keeps_margins` tells that from a floor there that keeps them). The margins are those of the nominal loop
+    (`LoopSettings.nominal`: with the model's delay compensation the delay-free one, which it leaves when its model
+    is the vehicle); with that compensation the loop itself keeps `delayed`'s margins at the steering sent
+    (`DelayRobustness`). A bisection on the grid (margins mostly improve with the lookahead: the loop's gain falls
+    as L^-3), then a check every _FLOOR_CHECK_M above the result; a failure there restarts the bisection above
+    it."""
     grid = np.arange(min_lookahead_m, max_lookahead_m + 1e-9, step_m)
     if grid.size == 0 or grid[-1] < max_lookahead_m - 1e-9:
         grid = np.append(grid, max_lookahead_m)
-
-    # (loop, phase margin, gain margin) to keep: the nominal loop, then with the model the loop itself, with its
-    # delay as known and as it may be
-    nominal = settings.nominal
-    checks = [(nominal, phase_margin_deg, gain_margin_db)]
-    if nominal is not settings:
-        checks.append((settings, delayed.phase_margin_deg, delayed.gain_margin_db))
-        fraction = UNCERTAIN_DELAY_MARGIN_FRACTION
-        for error in delayed.delay_errors_s(settings.known_delay_s + settings.measurement_delay_s):
-            late = dataclasses.replace(settings, measurement_delay_s=settings.measurement_delay_s + error)
-            checks.append((late, fraction * delayed.phase_margin_deg, fraction * delayed.gain_margin_db))
+    checks = _margin_checks(settings, phase_margin_deg, gain_margin_db, delayed)
 
     def ok(i: int) -> bool:
-        v, lookahead = float(speed_mps), float(grid[i])
-        return all(
-            loop_margins(lags, loop, v, lookahead, kr).meets(pm, gm)
-            for kr in path_curvatures_1pm
-            if abs(kr) * grid[i] < 1.8
-            for loop, pm, gm in checks
-        )
+        return _meets(lags, checks, float(speed_mps), float(grid[i]), path_curvatures_1pm)
 
     if not ok(grid.size - 1):
         return float(grid[-1])

@@ -15,6 +15,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from controllers.clothoid.filter_schedule import FilterSchedule
 from controllers.clothoid.lead_filter import LeadFilterParams
 from controllers.clothoid.loop_analysis import LoopSettings, PlantLags, lookahead_floor, loop_margins, loop_transfer
 from tuning.cli import main
@@ -171,6 +172,7 @@ def test_study_predicts_limit_cycles_where_the_loop_is_unstable() -> None:
         (["--lag", "LAG", "--controller-rate-hz", "0"], "--controller-rate-hz"),
         (["--lag", "LAG", "--arc-lateral-accel-g", "-1"], "--arc-lateral-accel-g"),
         (["--lag", "LAG", "--phase-margin-deg", "inf"], "--phase-margin-deg"),
+        (["--lag", "LAG", "--max-lookahead-m", "0"], "--max-lookahead-m must be in [0.5, 200.0] m; got 0.0"),
         (["--lag", "LAG", "--speeds", "1,2,...,200", "--lookahead", "3:40:0.25"],
          "200 speeds x 149 lookaheads = 29,800 cases to analyse; at most 20,000 (about 20 ms each): fewer speeds"),
     ],
@@ -191,3 +193,32 @@ def test_a_study_is_bounded_in_speeds_x_lookaheads() -> None:
     assert len(MarginStudy(lambda _s: LAGS, None, speeds, lookaheads).speeds_kmh) * MAX_LOOKAHEADS == MAX_STUDY_PAIRS
     with pytest.raises(WorkbenchInputError, match=f"= {MAX_STUDY_PAIRS + MAX_LOOKAHEADS:,} cases to analyse; at most"):
         MarginStudy(lambda _s: LAGS, None, (*speeds, 100.0), lookaheads)
+
+
+def _floor_study(lookaheads: tuple[float, ...], max_lookahead_m: float | None) -> MarginStudy:
+    lead = FilterSchedule((0.0,), (LEAD,))
+    return MarginStudy(lambda _s: LAGS, lead, (30.0, 90.0), lookaheads, arc_lateral_accel_g=0.0,
+                       max_lookahead_m=max_lookahead_m)  # fmt: skip
+
+
+def test_a_floor_above_max_lookahead_and_none_are_explained_in_words() -> None:
+    result = run_margins(_floor_study((10.0, 20.0, 30.0, 40.0), 15.0))
+    assert result.floors[30.0] == 20.0 and math.isnan(result.floors[90.0])  # above 15 m; none in 10-40 m
+    summary = result.summary()
+    assert (
+        "floor above max_lookahead_m (15 m): the clothoid controller would hold its lookahead at 20 m, outside its "
+        "range, and its Fréchet search would not act: raise max_lookahead_m to at least 20 m or use a lead filter "
+        "with more phase margin"
+    ) in summary
+    assert (
+        "the clothoid controller would hold its lookahead at the top of its floor search, 40 m, without these "
+        "margins, and its Fréchet search would not act: use a lead filter with more phase margin"
+    ) in summary
+    assert "floor above" not in run_margins(_floor_study((10.0, 20.0, 30.0, 40.0), 20.0)).summary()  # 20 m: inside
+    assert "clothoid controller" not in run_margins(_floor_study((10.0, 20.0, 30.0, 40.0), None)).summary()
+
+
+def test_none_below_the_controllers_search_top_asks_for_a_longer_range() -> None:
+    summary = run_margins(_floor_study((10.0, 20.0, 30.0), 15.0)).summary()
+    assert "floor none (no lookahead in 10-30 m" in summary
+    assert "analyse up to 40 m (the top of the clothoid controller's floor search)" in summary

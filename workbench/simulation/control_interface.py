@@ -58,6 +58,12 @@ class SteeringController(Protocol):
         """The steering-wheel angle command (rad) for this measurement: finite, within the vehicle's limit."""
         ...
 
+    def run_warnings(self, path: ReferencePath, sample_time_s: float) -> list[str]:
+        """Optional: what to tell a person before a run on `path` (planned speeds included) with steps every
+        `sample_time_s` s, one sentence each (e.g. an option that cannot act at these speeds); the simulation prints
+        them before the run (`Simulation.warnings`). A controller without the method has none."""
+        ...
+
     @property
     def diagnostics(self) -> Mapping[str, float]:
         """The last step's signals to log (`ctrl_<name>` columns), MEASUREMENT_REJECTED and COMMAND_REJECTED

@@ -130,10 +130,19 @@ class Simulation:
         self.infeasible_curvature = check_path(self.path, vehicle)
 
     def warnings(self, label: str = "the run") -> list[str]:
-        """What to tell a person before this run: `path_warnings`, and the planned top speed when it falls short of
-        the speed asked for (`top_speed_warning`)."""
+        """What to tell a person before this run: `path_warnings`, the planned top speed when it falls short of
+        the speed asked for (`top_speed_warning`), and the controller's own (`controller_warnings`)."""
         top = self.top_speed_warning(label)
-        return self.path_warnings() + ([top] if top is not None else [])
+        return self.path_warnings() + ([top] if top is not None else []) + self.controller_warnings(label)
+
+    def controller_warnings(self, label: str = "the run") -> list[str]:
+        """What the controller says about this run before it starts (`SteeringController.run_warnings` on the
+        planned path at the controller rate: e.g. the clothoid controller's lookahead floor above its range), each
+        after `label`; none from a controller without that method."""
+        run_warnings = getattr(self.controller, "run_warnings", None)
+        if run_warnings is None:
+            return []
+        return [f"{label}: {w}" for w in run_warnings(self.path, 1.0 / self.config.controller_rate_hz)]
 
     def top_speed_warning(self, label: str = "the run") -> str | None:
         """The planned top speed and what limited it, when it falls short of the speed asked for (`TopSpeed`);
