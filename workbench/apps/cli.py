@@ -175,7 +175,7 @@ def _parser(command: str | None = None) -> argparse.ArgumentParser:
     swp.add_argument("spec", type=Path, metavar="SPEC.toml", help="the study spec (see README: Studies)")
     swp.add_argument("--out", type=Path, required=True, metavar="DIR", help="output directory (rerun to resume)")
     _backend_options(swp, command in (None, "sweep"))
-    swp.add_argument("--no-plots", action="store_true", help="write the results without the figures")
+    swp.add_argument("--no-plots", action="store_true", help="write the results without the figures and report.html")
     opt = sub.add_parser(
         "optimise", help="tune a controller's options against the spec's objective (optuna TPE); DIR/best.toml"
     )
@@ -663,7 +663,9 @@ def _sweep(args: argparse.Namespace) -> int:
     def study() -> int:
         print(f"{n} runs; running those not yet in {args.out} on the {backend.describe()}")
         result = run_sweep(spec, args.out, backend, progress=sys.stderr.isatty())
-        written = [args.out / "results.parquet"] + ([] if args.no_plots else result.save_figures(args.out))
+        report = f"Sweep: {args.spec}"
+        figures = [] if args.no_plots else [*result.save_figures(args.out), result.save_report(args.out, report)]
+        written = [args.out / "results.parquet", *figures]
         counts = ", ".join(f"{v} {k}" for k, v in result.status_counts().items())
         print(f"{n} runs ({n - result.ran} already done, {result.ran} run now): {counts}")
         print(result.summary().to_string(index=False, float_format=lambda v: f"{v:.3g}"))

@@ -1,6 +1,7 @@
-"""Figures of a study's results table: CTE against speed per controller, and the Pareto front of CTE against
-steering effort. Each draws on the given axes (or a new figure) and returns the axes; only completed runs are
-drawn (a run that left the path has no meaningful CTE figure)."""
+"""Figures of a study's results table: a metric against a swept parameter (speed, or any other) per controller,
+and the Pareto front of CTE against steering effort, its points labelled with the values swept. Each draws on the
+given axes (or a new figure) and returns the axes; only completed runs are drawn (a run that left the path has no
+meaningful CTE figure)."""
 
 from __future__ import annotations
 
@@ -8,6 +9,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 import pandas as pd
+
+from workbench.apps.studies.runner import RESULT_COLUMNS
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -45,6 +48,30 @@ def series(table: pd.DataFrame) -> list[tuple[str, pd.DataFrame]]:
     return out
 
 
+def swept_columns(table: pd.DataFrame) -> list[str]:
+    """The parameter columns of a results table that take more than one value (`PlannedRun.parameters`: run
+    parameters and `<controller>.<option>` columns; speed_kmh included), in the table's order."""
+    fixed = {"run_id", "index", "scenario", "controller", "vehicle", "sample", "trial", *RESULT_COLUMNS}
+    return [c for c in table.columns if c not in fixed and table[c].dropna().astype(str).nunique() > 1]
+
+
+def shown_value(value: object) -> str:
+    """A parameter's value as figures and reports show it: a float to 3 significant digits, anything else as text."""
+    return f"{value:.3g}" if isinstance(value, float | np.floating) else str(value)
+
+
+def value_label(row: pd.Series, columns: list[str]) -> str:
+    """The row's values of `columns` as `name=value` text (`shown_value`; missing ones left out), controller
+    options without their controller's prefix."""
+    parts = []
+    for column in columns:
+        value = row[column]
+        if value is None or (isinstance(value, float) and np.isnan(value)):
+            continue
+        parts.append(f"{column.split('.', 1)[-1]}={shown_value(value)}")
+    return ", ".join(parts)
+
+
 def pareto_mask(x: np.ndarray, y: np.ndarray) -> np.ndarray:
     """True where (x, y) is on the Pareto front of minimising both: no other point is at least as good in both and
     better in one. NaN points are never on it."""
@@ -61,16 +88,23 @@ def pareto_mask(x: np.ndarray, y: np.ndarray) -> np.ndarray:
 
 def cte_vs_speed(table: pd.DataFrame, ax: Axes | None = None, metric: str = "rms_cte_m") -> Axes:
     """`metric` of every completed run against its speed (points) and the median per speed (line), per series."""
+    return metric_vs_parameter(table, "speed_kmh", ax, metric)
+
+
+def metric_vs_parameter(table: pd.DataFrame, parameter: str, ax: Axes | None = None, metric: str = "rms_cte_m") -> Axes:
+    """`metric` of every completed run against a numeric parameter column (points) and the median per value
+    (line), per series; a series without the parameter (another controller's option) is left out."""
     ax = _axes(ax)
     for i, (label, group) in enumerate(series(table)):
         colour = f"C{i % 10}"
-        values = group[["speed_kmh", metric]].astype(float)
-        ax.scatter(values["speed_kmh"], values[metric], s=10, alpha=0.35, color=colour, linewidths=0)
-        median = values.groupby("speed_kmh")[metric].median()
+        values = group[[parameter, metric]].astype(float).dropna(subset=[parameter])
+        if values.empty:
+            continue
+        ax.scatter(values[parameter], values[metric], s=10, alpha=0.35, color=colour, linewidths=0)
+        median = values.groupby(parameter)[metric].median()
         ax.plot(median.index, median.to_numpy(), "o-", color=colour, label=f"{label} (median)")
-    ax.set(
-        xlabel=LABELS["speed_kmh"], ylabel=LABELS.get(metric, metric), title=f"{LABELS.get(metric, metric)} vs speed"
-    )
+    name = LABELS.get(parameter, parameter)
+    ax.set(xlabel=name, ylabel=LABELS.get(metric, metric), title=f"{LABELS.get(metric, metric)} vs {name}")
     ax.grid(alpha=0.3)
     if ax.get_legend_handles_labels()[0]:
         ax.legend(fontsize="small")
@@ -78,10 +112,16 @@ def cte_vs_speed(table: pd.DataFrame, ax: Axes | None = None, metric: str = "rms
 
 
 def pareto(
-    table: pd.DataFrame, ax: Axes | None = None, effort: str = "rms_steer_rate_deg_s", error: str = "rms_cte_m"
+    table: pd.DataFrame,
+    ax: Axes | None = None,
+    effort: str = "rms_steer_rate_deg_s",
+    error: str = "rms_cte_m",
+    label_columns: list[str] | None = None,
 ) -> Axes:
     """Every completed run as (steering effort, tracking error), per series, with its Pareto front (runs no other
-    run of the series beats in both) as a line."""
+    run of the series beats in both) as a line. With `label_columns`, each front point is numbered as its row of
+    `pareto_fronts(table, label_columns, ...)`, which holds its swept values (a front is often too dense for the
+    values themselves to be legible on it)."""
     ax = _axes(ax)
     for i, (label, group) in enumerate(series(table)):
         colour = f"C{i % 10}"
@@ -90,6 +130,9 @@ def pareto(
         front = pareto_mask(x, y)
         order = np.argsort(x[front])
         ax.plot(x[front][order], y[front][order], "o-", drawstyle="steps-post", color=colour, label=f"{label} front")
+        if label_columns:
+            for number, (xi, yi) in enumerate(zip(x[front][order], y[front][order], strict=True), start=1):
+                ax.annotate(str(number), (xi, yi), xytext=(3, 3), textcoords="offset points", fontsize=7, color=colour)
     ax.set(
         xlabel=LABELS.get(effort, effort),
         ylabel=LABELS.get(error, error),
@@ -101,4 +144,40 @@ def pareto(
     return ax
 
 
-__all__ = ["cte_vs_speed", "pareto", "pareto_mask", "series"]
+def pareto_fronts(
+    table: pd.DataFrame,
+    label_columns: list[str],
+    effort: str = "rms_steer_rate_deg_s",
+    error: str = "rms_cte_m",
+) -> pd.DataFrame:
+    """The runs on each series' Pareto front (`pareto`), by increasing effort: series, point (its number on the
+    figure), the values of `label_columns` that vary within the series (`value_label`), effort and error."""
+    rows = []
+    for label, group in series(table):
+        x, y = group[effort].to_numpy(dtype=float), group[error].to_numpy(dtype=float)
+        front = group[pareto_mask(x, y)].sort_values(effort, kind="stable")
+        varying = [c for c in label_columns if group[c].dropna().astype(str).nunique() > 1]
+        for number, (_, row) in enumerate(front.iterrows(), start=1):
+            rows.append(
+                {
+                    "series": label,
+                    "point": number,
+                    "swept values": value_label(row, varying),
+                    LABELS.get(effort, effort): row[effort],
+                    LABELS.get(error, error): row[error],
+                }
+            )
+    return pd.DataFrame(rows)
+
+
+__all__ = [
+    "cte_vs_speed",
+    "metric_vs_parameter",
+    "pareto",
+    "pareto_fronts",
+    "pareto_mask",
+    "series",
+    "shown_value",
+    "swept_columns",
+    "value_label",
+]

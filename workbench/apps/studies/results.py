@@ -1,8 +1,9 @@
 """The result of a sweep: the table of runs (one row per run: its parameters, the metrics.json fields, status,
-message), its summary and its figures."""
+message), its summary, its figures and its report (one self-contained HTML page, `report.html_page`)."""
 
 from __future__ import annotations
 
+import html
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -20,6 +21,19 @@ if TYPE_CHECKING:
 
 #: The figures a sweep writes: file name, SweepResult method.
 FIGURES: tuple[tuple[str, str], ...] = (("cte_vs_speed.png", "plot_cte_vs_speed"), ("pareto.png", "plot_pareto"))
+#: The report of a sweep, in its folder.
+REPORT_FILE = "report.html"
+#: The most runs the report's table lists (the first ones, in the study's order; results.parquet holds them all).
+REPORT_MAX_ROWS = 1000
+#: The metrics of each run in the report's table, with their headings.
+REPORT_METRICS: tuple[tuple[str, str], ...] = (
+    ("status", "status"),
+    ("rms_cte_m", "RMS CTE (m)"),
+    ("max_abs_cte_m", "max |CTE| (m)"),
+    ("rms_steer_rate_deg_s", "RMS steering rate (deg/s)"),
+    ("steer_oscillation_deg", "steering oscillation (deg)"),
+    ("limit_cycle", "limit cycle"),
+)
 
 
 @dataclass(frozen=True, eq=False)
@@ -88,7 +102,61 @@ class SweepResult:
     def plot_pareto(
         self, ax: Axes | None = None, effort: str = "rms_steer_rate_deg_s", error: str = "rms_cte_m"
     ) -> Axes:
-        return plots.pareto(self.table, ax, effort, error)
+        """The Pareto fronts, each front point numbered as its row of `pareto_fronts()`."""
+        return plots.pareto(self.table, ax, effort, error, label_columns=self.swept())
+
+    def pareto_fronts(self, effort: str = "rms_steer_rate_deg_s", error: str = "rms_cte_m") -> pd.DataFrame:
+        """The runs on each Pareto front with their swept values (`plots.pareto_fronts`)."""
+        return plots.pareto_fronts(self.table, self.swept(), effort, error)
+
+    def swept(self) -> list[str]:
+        """The parameter columns that take more than one value in this sweep (`plots.swept_columns`)."""
+        return plots.swept_columns(self.table)
+
+    def report_html(self, title: str = "Sweep") -> str:
+        """The sweep's report: what was swept, the summary per scenario, vehicle and controller, the first error
+        messages, a table of the runs (their swept values and metrics; at most REPORT_MAX_ROWS), then the figures:
+        RMS CTE against speed and each other numeric swept parameter, and the Pareto fronts, numbered, with a
+        table of each front point's swept values."""
+        from workbench.apps.report import figure_png, html_page, png_figure, text_table
+
+        swept = self.swept()
+        counts = ", ".join(f"{n} {status}" for status, n in self.status_counts().items())
+        values = "; ".join(f"{c}: {', '.join(plots.shown_value(v) for v in self._values(c))}" for c in swept)
+        intro = f"{len(self.table)} runs: {counts}. Swept: {values or 'nothing'}."
+        body = ["<h2>Summary</h2>", text_table(self.summary())]
+        errors = list(dict.fromkeys(self.errors()["message"]))
+        if errors:
+            body.append("<h2>Errors</h2>")
+            body += [f"<p class='failed'>{html.escape(str(m))}</p>" for m in errors[:5]]
+        keys = [k for k in ("scenario", "vehicle", "controller") if self.table[k].nunique() > 1] or ["controller"]
+        runs = self.table[[*keys, *swept, *(c for c, _ in REPORT_METRICS)]].head(REPORT_MAX_ROWS)
+        runs = runs.rename(columns=dict(REPORT_METRICS))
+        more = len(self.table) > REPORT_MAX_ROWS
+        shown = f" (the first {REPORT_MAX_ROWS:,}; results.parquet holds all)" if more else ""
+        body += [f"<h2>Runs{shown}</h2>", text_table(runs)]
+        body.append("<h2>Figures</h2>")
+        numeric = [c for c in swept if pd.api.types.is_numeric_dtype(self.table[c].dropna())]
+        for column in ["speed_kmh", *(c for c in numeric if c != "speed_kmh")]:
+            ax = plots.metric_vs_parameter(self.table, column)
+            body.append(png_figure(figure_png(ax.figure), f"RMS CTE against {column}"))
+        caption = "Tracking error against steering effort; the Pareto-front points numbered as in the table below"
+        body.append(png_figure(figure_png(self.plot_pareto().figure), caption))
+        body += ["<h2>Pareto fronts: the swept values of each point</h2>", text_table(self.pareto_fronts())]
+        return html_page(title, body, intro)
+
+    def _values(self, column: str) -> list[Any]:
+        """The distinct values of a column, in the order they first appear (missing ones left out)."""
+        return list(dict.fromkeys(self.table[column].dropna().tolist()))
+
+    def save_report(self, out_dir: str | Path | None = None, title: str = "Sweep") -> Path:
+        """Write the report (`report_html`) to out_dir/REPORT_FILE (default: the sweep's folder); return its path."""
+        out = Path(out_dir) if out_dir is not None else self.out_dir
+        if out is None:
+            raise WorkbenchInputError("save_report needs an output folder")
+        path = out / REPORT_FILE
+        path.write_text(self.report_html(title), encoding="utf-8")
+        return path
 
     def save_figures(self, out_dir: str | Path | None = None) -> list[Path]:
         """Write the figures (FIGURES) as PNG to out_dir (default: the sweep's folder); return their paths."""
@@ -106,4 +174,4 @@ class SweepResult:
         return written
 
 
-__all__ = ["FIGURES", "SweepResult"]
+__all__ = ["FIGURES", "REPORT_FILE", "REPORT_MAX_ROWS", "SweepResult"]

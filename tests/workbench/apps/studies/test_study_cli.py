@@ -43,7 +43,9 @@ def test_a_sweep_with_errored_runs_exits_1(tiny_spec: Path, tmp_path: Path, caps
     assert "10 runs (0 already done, 10 run now): 8 completed, 2 error" in captured.out
     assert captured.err.startswith("workbench: 2 of 10 runs raised an error (status error;")
     assert captured.err.rstrip().endswith("exit code 1")
-    assert (out / "results.parquet").is_file()
+    assert (out / "results.parquet").is_file() and not (out / "report.html").exists()  # --no-plots: no report
+    assert main(["sweep", str(tiny_spec), "--out", str(out), "--workers", "1"]) == 1  # resumed: nothing to run
+    assert f"{out / 'report.html'}" in capsys.readouterr().out and (out / "report.html").is_file()
 
 
 def test_a_bad_controller_config_stops_the_sweep_before_any_run(

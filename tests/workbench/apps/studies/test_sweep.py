@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import multiprocessing
 import os
+import re
 import shutil
 import signal
 import subprocess
@@ -152,6 +153,35 @@ def test_the_figures(local_sweep: tuple[Path, SweepResult], tmp_path: Path) -> N
     written = result.save_figures(tmp_path)
     assert [p.name for p in written] == ["cte_vs_speed.png", "pareto.png"]
     assert all(p.stat().st_size > 10_000 for p in written)
+
+
+def test_the_report_shows_what_was_swept_the_runs_and_the_fronts_with_their_swept_values(
+    local_sweep: tuple[Path, SweepResult], tmp_path: Path
+) -> None:
+    import matplotlib.pyplot as plt
+
+    _, result = local_sweep
+    assert result.swept() == ["speed_kmh", "clothoid.min_lookahead_m", "clothoid.max_lookahead_m"]  # not the fixed
+    page = result.report_html("Sweep: tiny")
+    assert page.startswith("<!DOCTYPE html>") and "<title>Sweep: tiny</title>" in page
+    assert "10 runs: 8 completed, 2 error. Swept: speed_kmh: 20, 30; clothoid.min_lookahead_m: 5, 30; " in page
+    assert "clothoid.max_lookahead_m: 20, 31." in page
+    assert page.count("<tr>") == 1 + 2 + 1 + 10 + 1 + len(result.pareto_fronts())  # summary, runs, fronts
+    assert "max_lookahead_m must be &gt;= min_lookahead_m" in page  # the error's message
+    captions = re.findall(r"<figcaption>([^<]*)</figcaption>", page)
+    assert captions[:3] == [f"RMS CTE against {c}" for c in result.swept()]
+    assert len(captions) == 4 and captions[3].startswith("Tracking error against steering effort")
+    fronts = result.pareto_fronts()
+    clothoid = fronts[fronts["series"] == "clothoid"]
+    assert list(clothoid["point"]) == list(range(1, len(clothoid) + 1))
+    assert clothoid["swept values"].str.contains("min_lookahead_m=").all()
+    assert fronts.loc[fronts["series"] == "pure-pursuit", "swept values"].str.fullmatch(r"speed_kmh=\d+").all()
+    ax = result.plot_pareto()
+    numbers = sorted(t.get_text() for t in ax.texts)
+    assert numbers == sorted(str(p) for p in fronts["point"])  # each front point numbered as in the table
+    plt.close(ax.figure)
+    path = result.save_report(tmp_path, "Sweep: tiny")
+    assert path == tmp_path / "report.html" and "data:image/png;base64," in path.read_text()
 
 
 def test_pareto_mask() -> None:
