@@ -58,6 +58,9 @@ def test_the_example_declares_a_controller_and_a_vehicle() -> None:
 def test_the_plugins_are_listed_and_shown(plugin_env: dict[str, str]) -> None:
     listed = _workbench(plugin_env, "controllers")
     assert listed.returncode == 0 and re.search(r"^lateral-pd +Lateral PD: ", listed.stdout, re.M), listed.stderr
+    shown_controller = _workbench(plugin_env, "controllers", "--show", "lateral-pd")
+    assert shown_controller.returncode == 0 and "cte_gain_1pm2 = 0.1" in shown_controller.stdout
+    assert "k_y, the feedback on the cross-track error" in shown_controller.stdout
     vehicles = _workbench(plugin_env, "vehicles")
     assert vehicles.returncode == 0 and "example-kart" in vehicles.stdout and "wheelbase 1.05" in vehicles.stdout
     shown = _workbench(plugin_env, "vehicles", "--show", "example-kart")

@@ -14,20 +14,22 @@ from dataclasses import dataclass
 from typing import ClassVar
 
 from controllers.base import Controller, Measurement
-from controllers.config_checks import check_number
+from controllers.config_checks import Number, check_options, option
 from workbench.base.path import ReferencePath, wrap_angle
 
 
 @dataclass(frozen=True)
 class LateralPDConfig:
-    """The feedback gains (the defaults: damping ratio 0.7 at a natural wavelength of 2 pi / sqrt(k_y) = 20 m)."""
+    """The feedback gains (the defaults: damping ratio 0.7 at a natural wavelength of 2 pi / sqrt(k_y) = 20 m); each
+    field's unit, range and meaning in its metadata, which `workbench controllers --show lateral-pd` prints."""
 
-    cte_gain_1pm2: float = 0.1  #: k_y (1/m^2), feedback on the cross-track error; range (0, 10], default 0.1
-    heading_gain_1pm: float = 0.44  #: k_psi (1/m), feedback on the heading error; range [0, 10], default 0.44
+    cte_gain_1pm2: float = option(
+        0.1, "k_y, the feedback on the cross-track error", Number(0.0, 10.0, "1/m^2", low_open=True)
+    )
+    heading_gain_1pm: float = option(0.44, "k_psi, the feedback on the heading error", Number(0.0, 10.0, "1/m"))
 
     def __post_init__(self) -> None:
-        check_number("cte_gain_1pm2", self.cte_gain_1pm2, 0.0, 10.0, "1/m^2", low_open=True)
-        check_number("heading_gain_1pm", self.heading_gain_1pm, 0.0, 10.0, "1/m")
+        check_options(self)
 
 
 class LateralPD(Controller):
