@@ -198,19 +198,26 @@ def _backend_options(parser: argparse.ArgumentParser, shown: bool = True) -> Non
     """The options of the study commands; `shown` False: the parser of another command is being run, and the
     help text (the studies' default size, `workbench.apps.studies` imported for it) is not needed."""
     if shown:
+        from workbench.apps.studies.backends import MAX_WORKERS_PER_CPU
         from workbench.apps.studies.spec import DEFAULT_MAX_RUNS
 
         max_runs = f"{DEFAULT_MAX_RUNS:,}"
+        most_workers = f"; at most {MAX_WORKERS_PER_CPU} per CPU"
     else:
-        max_runs = "the studies' default"
+        max_runs, most_workers = "the studies' default", ""
     parser.add_argument(
         "--backend", choices=("local", "dask"), default="local", help="local process pool (default) or dask"
     )
     parser.add_argument(
-        "--scheduler", metavar="ADDRESS", help="a dask scheduler (e.g. tcp://host:8786); default: a LocalCluster"
+        "--scheduler",
+        metavar="ADDRESS",
+        help="a dask scheduler, tcp://HOST:PORT (e.g. tcp://10.0.0.5:8786); default: a LocalCluster",
     )
     parser.add_argument(
-        "--workers", type=int, metavar="N", help="worker processes (local pool or LocalCluster; default: the CPUs)"
+        "--workers",
+        type=int,
+        metavar="N",
+        help=f"worker processes (local pool or LocalCluster; default: the CPUs{most_workers})",
     )
     parser.add_argument(
         "--max-runs",
@@ -568,21 +575,45 @@ def _fig17(args: argparse.Namespace) -> int:
     return 0 if all(r.completed for r in result.fair.results) else EXIT_RUN_FAILED
 
 
-def _interruptible(study: Callable[[], int], out: Path) -> int:
-    """Run a study; SIGTERM stops it as Ctrl-C does: the rows written so far stay and the same command resumes."""
+def _interruptible(study: Callable[[], int], out: Path, backend: Backend) -> int:
+    """Run a study on `backend`. SIGINT (Ctrl-C) and SIGTERM stop it at once, whatever its runs are doing: the
+    backend is closed (queued runs cancelled; runs in progress abandoned: a local pool's workers killed, a Dask
+    client's runs cancelled and its LocalCluster stopped), the rows written so far stay, exit code 130, and the
+    same command resumes. Further signals while it stops are ignored (a second Ctrl-C cannot cut the clean-up
+    short)."""
     from workbench.apps.studies.backends import BackendError
 
-    previous = signal.signal(signal.SIGTERM, signal.default_int_handler)
+    def stop(signum: int, frame: object) -> None:
+        for stop_signal in stop_signals:
+            signal.signal(stop_signal, signal.SIG_IGN)
+        raise KeyboardInterrupt
+
+    stop_signals = (signal.SIGINT, signal.SIGTERM)
+    previous = {s: signal.signal(s, stop) for s in stop_signals}
     try:
         return study()
     except KeyboardInterrupt:
-        print(f"workbench: interrupted; finished runs are kept in {out / 'runs'}: rerun to resume", file=sys.stderr)
+        backend.close()
+        print(
+            f"workbench: interrupted; stopped the {backend.describe()} (runs in progress abandoned); finished runs "
+            f"are kept in {out / 'runs'}: rerun to resume",
+            file=sys.stderr,
+        )
         return EXIT_INTERRUPTED
     except BackendError as exc:
         print(f"workbench: {exc}; finished runs are kept in {out / 'runs'}: rerun to resume", file=sys.stderr)
         return EXIT_RUN_FAILED
     finally:
-        signal.signal(signal.SIGTERM, previous)
+        for stop_signal, handler in previous.items():
+            signal.signal(stop_signal, signal.SIG_DFL if handler is None else handler)
+
+
+def _max_runs(args: argparse.Namespace) -> int | None:
+    """A study command's --max-runs (sweep, optimise, robustness): None (the default limit) or a whole number
+    >= 1."""
+    if args.max_runs is not None and args.max_runs < 1:
+        raise WorkbenchInputError(f"--max-runs must be a whole number >= 1; got {args.max_runs}")
+    return args.max_runs
 
 
 def _start_study(args: argparse.Namespace, kind: str) -> tuple[StudySpec, Backend]:
@@ -593,9 +624,7 @@ def _start_study(args: argparse.Namespace, kind: str) -> tuple[StudySpec, Backen
 
     check_study_dir(args.out)
     _check_inputs(args)
-    if args.max_runs is not None and args.max_runs < 1:
-        raise WorkbenchInputError(f"--max-runs must be a whole number >= 1; got {args.max_runs}")
-    spec = load_spec(args.spec, kind, max_runs=args.max_runs)
+    spec = load_spec(args.spec, kind, max_runs=_max_runs(args))
     backend = make_backend(args.backend, args.scheduler, args.workers)
     copy = args.out / "spec.toml"
     try:
@@ -610,12 +639,14 @@ def _start_study(args: argparse.Namespace, kind: str) -> tuple[StudySpec, Backen
 def _robustness(args: argparse.Namespace) -> int:
     from workbench.apps.robustness import plan_robustness, run_robustness
     from workbench.apps.studies import make_backend
+    from workbench.apps.studies.spec import DEFAULT_MAX_RUNS
     from workbench.base.errors import require_positive
     from workbench.base.output_dir import check_study_dir
 
     check_study_dir(args.out)
     _check_inputs(args)
     require_positive("--max-cte", args.max_cte)
+    max_runs = _max_runs(args)
     controllers = _names(args.controllers, "controllers")
     runs = plan_robustness(
         args.scenario,
@@ -628,6 +659,13 @@ def _robustness(args: argparse.Namespace) -> int:
         Path.cwd(),
         allow_long_run=args.allow_long_run,
     )
+    limit = DEFAULT_MAX_RUNS if max_runs is None else max_runs
+    if len(runs) > limit:
+        raise WorkbenchInputError(
+            f"the robustness study plans {len(runs):,} runs ({len(controllers)} controller(s), each at the base and "
+            f"at every other value of each factor), more than the limit of {limit:,}: name fewer controllers or "
+            "raise the limit with --max-runs N"
+        )
     backend = make_backend(args.backend, args.scheduler, args.workers)
 
     def study() -> int:
@@ -643,6 +681,7 @@ def _robustness(args: argparse.Namespace) -> int:
                 args.conditions,
                 args.speed,
                 progress=sys.stderr.isatty(),
+                max_cte_m=args.max_cte,
             )
         written = result.save(args.out)
         print(result.tolerance().to_string(index=False, float_format=lambda v: f"{v:.3g}", na_rep="-"))
@@ -651,7 +690,7 @@ def _robustness(args: argparse.Namespace) -> int:
         print(f"wrote {', '.join(str(p) for p in written)} and {args.out / 'results.parquet'}")
         return 0
 
-    return _interruptible(study, args.out)
+    return _interruptible(study, args.out, backend)
 
 
 def _sweep(args: argparse.Namespace) -> int:
@@ -682,7 +721,7 @@ def _sweep(args: argparse.Namespace) -> int:
             return EXIT_RUN_FAILED
         return 0
 
-    return _interruptible(study, args.out)
+    return _interruptible(study, args.out, backend)
 
 
 def _optimise(args: argparse.Namespace) -> int:
@@ -709,7 +748,7 @@ def _optimise(args: argparse.Namespace) -> int:
         print(f"wrote {result.config_file} (use with --controller-config), best.json, history.parquet, results.parquet")
         return 0
 
-    return _interruptible(study, args.out)
+    return _interruptible(study, args.out, backend)
 
 
 def _run(args: argparse.Namespace) -> int:
@@ -911,4 +950,4 @@ def __getattr__(name: str) -> object:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(console())

@@ -7,10 +7,15 @@ workers change how fast a study runs, never its rows (but for the wall-clock TIM
 - `LocalBackend(workers)`: a `concurrent.futures.ProcessPoolExecutor` of `workers` processes (default: the CPUs
   this process may use), forked from this process when it runs a single thread, else started from a fork server
   that has imported the workbench once (`start_context`), so a worker starts in milliseconds. Each worker ignores
-  Ctrl-C (the study's process stops the pool) and leaves when the process that started the pool is gone.
+  SIGINT and SIGTERM: the study's process owns its workers. Closing the pool while runs are in progress (an
+  interrupted study) cancels the queued runs and kills the workers (SIGKILL: a worker holds nothing worth saving,
+  the rows are written by the study's process), so the study stops in milliseconds rather than when its longest
+  run ends; a worker also leaves by itself within ORPHAN_CHECK_S when the study's process is gone.
 - `DaskBackend(scheduler, workers)`: `dask.distributed`; with no scheduler address a `LocalCluster` of `workers`
-  single-threaded worker processes, else the cluster at that address (its workers must have this package
-  installed and see the files the spec names). Workers of either backend run BLAS/OpenMP on one thread each
+  single-threaded worker processes, else the cluster at that address, `tcp://HOST:PORT` (its workers must have this
+  package installed and see the files the spec names); a scheduler that does not answer within
+  SCHEDULER_TIMEOUT_S is refused. Closing it cancels the runs in progress. Workers of either backend run BLAS/OpenMP
+  on one thread each
   (`threadpoolctl`; a Dask worker plugin). A run whose worker dies each time it runs it (Dask's
   `KilledWorker`) is recorded as an error row; any other failure of the machinery stops the study, keeping the
   rows already written.
@@ -24,12 +29,14 @@ from __future__ import annotations
 import logging
 import multiprocessing
 import os
+import re
 import signal
 import threading
 import time
 from collections.abc import Iterator, Sequence
-from concurrent.futures import ProcessPoolExecutor, as_completed
+from concurrent.futures import Future, ProcessPoolExecutor, as_completed
 from concurrent.futures.process import BrokenProcessPool
+from contextlib import contextmanager
 from types import TracebackType
 from typing import Any, Protocol, Self
 
@@ -37,7 +44,7 @@ from threadpoolctl import threadpool_limits
 
 from workbench.apps.studies.runner import execute_run, failed_row
 from workbench.apps.studies.spec import PlannedRun
-from workbench.base.errors import WorkbenchInputError
+from workbench.base.errors import WorkbenchInputError, value_text
 from workbench.simulation.plot_worker import usable_cpus
 
 BACKENDS = ("local", "dask")
@@ -50,6 +57,18 @@ class BackendError(RuntimeError):
 
 #: How often (s) a local worker checks that the process which started it is still there.
 ORPHAN_CHECK_S = 1.0
+#: How long (s) closing an interrupted local pool waits for its killed workers to be reaped.
+KILLED_WORKER_JOIN_S = 2.0
+#: How long (s) connecting to a dask scheduler may take before it is refused as unreachable.
+SCHEDULER_TIMEOUT_S = 10.0
+#: The most workers per usable CPU. A run is single-threaded and CPU-bound, so workers beyond the CPUs only share
+#: them (no run ends sooner) while each holds its own copy of the workbench in memory (~0.2-0.3 GB with numba's
+#: kernels loaded); a few per CPU still leaves room to measure that.
+MAX_WORKERS_PER_CPU = 4
+#: The signals a local worker ignores (the study's process stops it) and blocks while it starts.
+_STOP_SIGNALS = frozenset({signal.SIGINT, signal.SIGTERM})
+#: A dask scheduler's address: tcp://HOST:PORT (HOST a name, an IPv4 address or a bracketed IPv6 address).
+_SCHEDULER_ADDRESS = re.compile(r"tcp://(?P<host>[A-Za-z0-9._-]+|\[[0-9A-Fa-f:.]+\]):(?P<port>[0-9]{1,5})")
 
 
 class Backend(Protocol):
@@ -77,17 +96,46 @@ def default_workers() -> int:
     return usable_cpus()
 
 
+def max_workers() -> int:
+    """The most workers a backend starts here: MAX_WORKERS_PER_CPU per usable CPU."""
+    return MAX_WORKERS_PER_CPU * default_workers()
+
+
 def _require_workers(workers: int | None) -> None:
-    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
-        raise WorkbenchInputError(f"workers must be a whole number >= 1; got {workers!r}")
+    """None (the default) or a whole number from 1 to max_workers()."""
+    if workers is None:
+        return
+    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
+        raise WorkbenchInputError(f"workers must be a whole number >= 1; got {value_text(workers)}")
+    if workers > max_workers():
+        raise WorkbenchInputError(
+            f"workers must be at most {max_workers()} ({MAX_WORKERS_PER_CPU} per usable CPU, {default_workers()} "
+            f"here: a run is single-threaded, so more workers only share the CPUs, each holding its own copy of the "
+            f"workbench in memory); got {workers}"
+        )
+
+
+def _require_scheduler(scheduler: object) -> None:
+    """A dask scheduler address, tcp://HOST:PORT with a port from 1 to 65535."""
+    match = _SCHEDULER_ADDRESS.fullmatch(scheduler) if isinstance(scheduler, str) else None
+    if match is None or not 1 <= int(match["port"]) <= 65535:
+        raise WorkbenchInputError(
+            f"scheduler must be a dask scheduler's address, tcp://HOST:PORT with a port from 1 to 65535 (e.g. "
+            f"tcp://10.0.0.5:8786); got {scheduler!r}"
+        )
 
 
 def _init_worker(parent_pid: int) -> None:
     """A local worker runs its numerical libraries on one thread (a run is one CPU's work: OpenBLAS would otherwise
-    start a thread per CPU in every worker, and the workers would compete for the CPUs), ignores Ctrl-C (the study's
-    process stops the pool) and leaves when the study's process is gone (killed without cleaning up)."""
+    start a thread per CPU in every worker, and the workers would compete for the CPUs), ignores SIGINT and SIGTERM
+    (Ctrl-C reaches the whole process group; the study's process stops the pool) and leaves when the study's
+    process is gone (killed without cleaning up). A forked worker starts with the stop signals blocked
+    (`_stop_signals_blocked`), so that the study's own handlers, which it inherits, never run in it; they are
+    unblocked once ignored."""
+    for signum in _STOP_SIGNALS:
+        signal.signal(signum, signal.SIG_IGN)
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, _STOP_SIGNALS)
     threadpool_limits(1)
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
 
     def watch() -> None:
         while True:
@@ -118,6 +166,17 @@ def start_context() -> multiprocessing.context.BaseContext:
     return multiprocessing.get_context("spawn")
 
 
+@contextmanager
+def _stop_signals_blocked() -> Iterator[None]:
+    """Block SIGINT and SIGTERM in this thread while local workers may be forked (they inherit the mask and unblock
+    the signals in `_init_worker`, after ignoring them); a signal that arrives meanwhile is delivered on leaving."""
+    previous = signal.pthread_sigmask(signal.SIG_BLOCK, _STOP_SIGNALS)
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, previous)
+
+
 class _StartedInWith:
     """`with backend:` starts it and closes it, whatever happens inside."""
 
@@ -146,6 +205,7 @@ class LocalBackend(_StartedInWith):
         _require_workers(workers)
         self.workers = workers or default_workers()
         self._pool: ProcessPoolExecutor | None = None
+        self._futures: list[Future[dict[str, Any]]] = []
 
     def describe(self) -> str:
         return f"local process pool, {self.workers} worker{'s' if self.workers != 1 else ''}"
@@ -164,15 +224,31 @@ class LocalBackend(_StartedInWith):
             )
 
     def close(self) -> None:
-        """Stop the pool: queued runs are cancelled, runs in progress finish (their rows are not kept)."""
-        if self._pool is not None:
-            self._pool.shutdown(wait=True, cancel_futures=True)
-            self._pool = None
+        """Stop the pool. Idle, its workers leave as asked; with runs in progress (an interrupted study), the queued
+        runs are cancelled and the workers killed at once (their runs' rows are not kept: rerunning the study runs
+        them), and reaped."""
+        pool, self._pool = self._pool, None
+        futures, self._futures = self._futures, []
+        if pool is None:
+            return
+        if all(future.done() for future in futures):
+            pool.shutdown(wait=True)
+            return
+        workers = list((pool._processes or {}).values())  # the pool has no public way to end running tasks
+        pool.shutdown(wait=False, cancel_futures=True)
+        for worker in workers:
+            if worker.is_alive():
+                worker.kill()
+        deadline = time.monotonic() + KILLED_WORKER_JOIN_S
+        for worker in workers:
+            worker.join(max(0.0, deadline - time.monotonic()))
 
     def map_runs(self, runs: Sequence[PlannedRun]) -> Iterator[dict[str, Any]]:
         if self._pool is None:
             raise RuntimeError("start the backend first: with LocalBackend(...) as backend: ...")
-        futures = {self._pool.submit(execute_run, run): run for run in runs}
+        with _stop_signals_blocked():  # the first submit forks the workers
+            futures = {self._pool.submit(execute_run, run): run for run in runs}
+        self._futures = list(futures)
         try:
             for future in as_completed(futures):
                 try:
@@ -200,12 +276,13 @@ class DaskBackend(_StartedInWith):
                 f"workers ({workers}) applies to a LocalCluster; with a scheduler ({scheduler}) the cluster's own "
                 "workers run the study: drop one"
             )
-        if scheduler is not None and (not isinstance(scheduler, str) or not scheduler.strip()):
-            raise WorkbenchInputError(f"scheduler must be an address such as tcp://host:8786; got {scheduler!r}")
+        if scheduler is not None:
+            _require_scheduler(scheduler)
         self.scheduler = scheduler
         self.workers = None if scheduler else workers or default_workers()
         self._client: Any = None
         self._cluster: Any = None
+        self._futures: list[Any] = []
 
     def describe(self) -> str:
         if self.scheduler:
@@ -224,9 +301,11 @@ class DaskBackend(_StartedInWith):
             return
         if self.scheduler:
             try:
-                self._client = Client(self.scheduler, timeout="10s")
+                self._client = Client(self.scheduler, timeout=f"{SCHEDULER_TIMEOUT_S}s")
             except (OSError, TimeoutError) as exc:
-                raise WorkbenchInputError(f"cannot reach the dask scheduler {self.scheduler!r}: {exc}") from None
+                raise WorkbenchInputError(
+                    f"cannot reach the dask scheduler {self.scheduler!r} within {SCHEDULER_TIMEOUT_S:g} s: {exc}"
+                ) from None
         else:
             self._cluster = LocalCluster(
                 n_workers=self.workers,
@@ -241,13 +320,18 @@ class DaskBackend(_StartedInWith):
         self._client.register_plugin(SingleThreadedLibraries())
 
     def close(self) -> None:
-        """Disconnect, and stop the LocalCluster if this backend started one."""
-        if self._client is not None:
-            self._client.close()
-            self._client = None
-        if self._cluster is not None:
-            self._cluster.close()
-            self._cluster = None
+        """Cancel the runs not finished (an interrupted study), disconnect, and stop the LocalCluster if this backend
+        started one (its worker processes with it)."""
+        client, self._client = self._client, None
+        cluster, self._cluster = self._cluster, None
+        futures, self._futures = self._futures, []
+        if client is not None:
+            pending = [future for future in futures if not future.done()]
+            if pending:
+                client.cancel(pending)
+            client.close()
+        if cluster is not None:
+            cluster.close()
 
     def map_runs(self, runs: Sequence[PlannedRun]) -> Iterator[dict[str, Any]]:
         from distributed import as_completed
@@ -261,6 +345,7 @@ class DaskBackend(_StartedInWith):
             future = self._client.submit(execute_run, run, key=f"workbench-run-{run.run_id}", pure=False)
             by_key[future.key] = run
             futures.append(future)
+        self._futures = futures
         try:
             for future in as_completed(futures):
                 try:
