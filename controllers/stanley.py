@@ -1,20 +1,40 @@
 """Stanley (Thrun et al. 2006, the DARPA Grand Challenge winner): heading error plus a front-axle cross-track term.
 
-The law: phi = (psi_path - psi) + atan(k e / (k_soft + v)), with e the front axle's signed CTE.
+The law: delta = (psi_path - psi) + atan(-k e / (k_soft + v)) [+ delta_ff], with e the front axle's signed CTE
+(left of the path positive) and psi_path the path's heading at the front axle's foot point. The front-axle
+position is the measured rear-axle position moved one wheelbase L along the heading.
 
-The front-axle position is the measured rear-axle position moved one wheelbase along the heading. A path-curvature
-feedforward, atan(L kappa), is optional (off by default, as in the original law).
+The curvature feed-forward delta_ff (optional, off by default as in the original law) is what the law lacks to
+hold a circle of curvature kappa at speed v with the rear axle, the reference point where the workbench measures
+the CTE, on it. In a steady turn every point of the vehicle circles one centre, so the front axle's velocity is
+tangent to the concentric circle through it, which is the path's tangent at its foot point: the heading term
+psi_path - psi equals the direction gamma_f of the front axle's velocity in the vehicle frame, the whole
+kinematic steer (atan(L kappa) when the rear axle holds the circle) included. The road wheels hold the turn at
+delta_ss = gamma_f + alpha_f, alpha_f the front axle's slip angle. With the rear axle on the circle and its
+velocity beta_r = -alpha_r off the heading (alpha_r the rear axle's slip angle), the front axle lies off the
+circle by
+
+    e_f = -(L^2 kappa + 2 L sin(beta_r)) / (1 + sqrt(1 + L^2 kappa^2 + 2 L kappa sin(beta_r)))
+
+(outside it: |P - C| = sqrt(R^2 + L^2 + 2 L R sin(beta_r)) from the centre C). The law's steady command equals
+delta_ss when delta_ff = alpha_f + atan(k e_f / (k_soft + v)): the front tyres' slip plus what cancels the law's
+pull of the front axle back onto the path. The slip angles are the vehicle's single track's at a_y = v^2 kappa
+(`SingleTrackParams.steady_slip_angles_rad`); a vehicle without tyres (or none given) has none, and then
+delta_ff = atan(k e_f / (k_soft + v)) with e_f = -(sqrt(R^2 + L^2) - R). The path's curvature is taken at the
+front axle's foot point (one wheelbase of preview). Adding atan(L kappa) instead would count the kinematic steer
+twice: the heading term already holds it.
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import ClassVar
+from typing import Any, ClassVar
 
 from controllers.base import Controller, Measurement
 from controllers.config_checks import Flag, Number, check_options, option
 from workbench.base.path import PathTracker, ReferencePath, wrap_angle
+from workbench.vehicles.geometry import VehicleGeometry
 
 
 @dataclass(frozen=True)
@@ -47,9 +67,31 @@ class Stanley(Controller):
     name: ClassVar[str] = "stanley"
     config_type: ClassVar[type] = StanleyConfig
 
+    def __init__(self, geometry: VehicleGeometry, config: Any | None = None, vehicle: object | None = None) -> None:
+        """As `Controller`; `vehicle` (a `VehicleModel`) gives the curvature feed-forward its tyres' slip (none
+        without it: the kinematic single track)."""
+        super().__init__(geometry, config)
+        single_track = getattr(vehicle, "single_track", None)
+        self._tyres = single_track().single_track if self.config.curvature_feedforward and single_track else None
+
     def _reset(self, path: ReferencePath, sample_time_s: float) -> None:
         self._tracker: PathTracker = path.tracker(0.0)
-        self._diag = self._declare_diagnostics(("front_cte_m", "heading_term_rad", "cross_track_term_rad"))
+        self._diag = self._declare_diagnostics(
+            ("front_cte_m", "heading_term_rad", "cross_track_term_rad", "feedforward_term_rad")
+        )
+
+    def feedforward_rad(self, curvature_1pm: float, speed_mps: float) -> float:
+        """delta_ff (road-wheel angle, rad): the term that makes the law's steady command on a circle of this
+        curvature at this speed the one that holds the rear axle on it (module docstring)."""
+        cfg, wheelbase = self.config, self.geometry.wheelbase_m
+        alpha_f = alpha_r = 0.0
+        if self._tyres is not None:
+            alpha_f, alpha_r = self._tyres.steady_slip_angles_rad(speed_mps * speed_mps * curvature_1pm)
+        lk, twice_l_sin_beta = wheelbase * curvature_1pm, -2.0 * wheelbase * math.sin(alpha_r)
+        front_cte = -(wheelbase * lk + twice_l_sin_beta) / (
+            1.0 + math.sqrt(1.0 + lk * lk + curvature_1pm * twice_l_sin_beta)
+        )
+        return alpha_f + math.atan2(cfg.gain_per_s * front_cte, cfg.softening_mps + speed_mps)
 
     def _command(self, measurement: Measurement, path: ReferencePath) -> float:
         cfg, m, wheelbase = self.config, measurement, self.geometry.wheelbase_m
@@ -58,9 +100,8 @@ class Stanley(Controller):
         foot = self._tracker.update(front_x, front_y)
         heading_term = wrap_angle(foot.heading_rad - m.yaw_rad)
         cross_track_term = math.atan2(-cfg.gain_per_s * foot.cte_m, cfg.softening_mps + m.speed_mps)
-        road_wheel = heading_term + cross_track_term
-        if cfg.curvature_feedforward:
-            road_wheel += math.atan(wheelbase * foot.curvature_1pm)
-        self._diag[:] = (foot.cte_m, heading_term, cross_track_term)
+        feedforward = self.feedforward_rad(foot.curvature_1pm, m.speed_mps) if cfg.curvature_feedforward else 0.0
+        road_wheel = heading_term + cross_track_term + feedforward
+        self._diag[:] = (foot.cte_m, heading_term, cross_track_term, feedforward)
         limit = self.geometry.max_road_wheel_angle_rad
         return self.saturate(min(max(road_wheel, -limit), limit) * self.geometry.steering_ratio)

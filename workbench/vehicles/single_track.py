@@ -9,6 +9,7 @@ carries the kingpin's share of the trailer at the fifth wheel (`TractorSemitrail
 from __future__ import annotations
 
 import dataclasses
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -65,6 +66,22 @@ class SingleTrackParams:
         a, b, m = self.cg_to_front_axle_m, self.cg_to_rear_axle_m, self.mass_kg
         cf, cr = self.front_cornering_stiffness_n_per_rad, self.rear_cornering_stiffness_n_per_rad
         return m / (a + b) * (b / cf - a / cr)
+
+    def steady_slip_angles_rad(self, lateral_accel_mps2: float) -> tuple[float, float]:
+        """Front and rear axle slip angles (rad) in steady cornering at this lateral acceleration (m/s^2, signed):
+        the axle forces that hold the turn, m a_y b / L and m a_y a / L (moment balance about the CG, cos(delta)
+        taken as 1), each through the magic formula inverted without its small curvature factor E (a force
+        beyond 99 % of the axle's peak is taken as 99 % of it)."""
+        a, b, m = self.cg_to_front_axle_m, self.cg_to_rear_axle_m, self.mass_kg
+        shape, force = self.tyre_shape_factor, m * lateral_accel_mps2 / (a + b)
+        slips = []
+        for axle_force, peak, stiffness in (
+            (force * b, self.front_peak_force_n, self.front_cornering_stiffness_n_per_rad),
+            (force * a, self.rear_peak_force_n, self.rear_cornering_stiffness_n_per_rad),
+        ):
+            ratio = min(max(axle_force / peak, -0.99), 0.99)
+            slips.append(math.tan(math.asin(ratio) / shape) * shape * peak / stiffness)
+        return slips[0], slips[1]
 
     def fastest_lateral_mode_per_s(self, speed_mps: float) -> float:
         """|lambda|max of the linear single track's (v_y, r) dynamics at this speed (1/s)."""
