@@ -5,9 +5,11 @@ steering).
 `compare(scenario, runs)` simulates each (controller, vehicle) pair with the same `SimulationConfig` and returns a
 `Comparison`: `summary()` is a DataFrame with one row per pair (the metrics.json fields, the distance to converge
 within `CONVERGED_CTE_M` of the path, and each controller's step-time ratio to a reference controller), and the
-`plot_*` methods draw every run on one axis. A run that fails (a controller error, the vehicle leaving the path)
-keeps its row with its status and message: nothing is dropped. `workbench compare` and `workbench fig17` write
-the result with `save` (traces, metrics, summary.csv, figures) and `workbench.apps.report.write_report` (report.html).
+`plot_*` methods draw every run on one axis, alike on every figure (`styles`: a colour per controller, a line style
+per vehicle), the trajectories with an inset magnifying the hardest stretch (`hardest_stretch`). A run that fails
+(a controller error, the vehicle leaving the path) keeps its row with its status and message: nothing is dropped.
+`workbench compare` and `workbench fig17` write the result with `save` (traces, metrics, summary.csv, figures) and
+`workbench.apps.report.write_report` (report.html).
 
 Every run is built (vehicle, scenario, controller options and files) before the first one is simulated, so a bad
 input is refused before any work, a run that may simulate more than the bounds of `run_size` is refused without
@@ -36,6 +38,7 @@ from workbench.base.console import warn_on_stderr
 from workbench.base.errors import WorkbenchInputError
 from workbench.simulation.limit_cycle import LimitCycle, detect_limit_cycle
 from workbench.simulation.metrics import METRIC_KEYS
+from workbench.simulation.plots import RunStyle, Stretch, run_styles
 from workbench.simulation.result import SimulationResult
 from workbench.simulation.run_size import check_run_size
 from workbench.simulation.scenarios import Scenario, ScenarioOptions, make_scenario
@@ -49,6 +52,11 @@ if TYPE_CHECKING:
 
 #: |CTE| (m) within which a run counts as converged onto the path (the fig17 scenario starts 1 m off it).
 CONVERGED_CTE_M = 0.1
+#: The stretch the trajectories' inset magnifies (`hardest_stretch`) reaches this many times the largest |CTE| either
+#: side of it along the path, and at least ZOOM_MIN_HALF_LENGTH_M (m): the runs' spread then shows at the inset's
+#: scale.
+ZOOM_CTE_FACTOR = 8.0
+ZOOM_MIN_HALF_LENGTH_M = 1.0
 #: What shortens a comparison's run refused as too long (`run_size.check_run_size`).
 LONG_RUN_SHORTENED = "a higher speed, fewer laps or a max_time_s (--speed, --laps, --max-time-s) shortens it"
 #: The comparison figures: file name, Comparison method (Figures 17a, 17b, 18a, 18b).
@@ -112,6 +120,13 @@ def converge_distance_m(progress_m: np.ndarray, cte_m: np.ndarray, tolerance_m: 
     if last + 1 >= cte_m.size:
         return math.nan
     return float(progress_m[last + 1] - progress_m[0])
+
+
+def approach_end(cte_m: np.ndarray, tolerance_m: float = CONVERGED_CTE_M) -> int:
+    """Index of the first sample with |CTE| within tolerance_m: where a run that started off the path has come
+    onto it (0 for one that started on it; also 0 when it never comes within, so that the whole run counts)."""
+    within = np.flatnonzero(np.abs(cte_m) <= tolerance_m)
+    return int(within[0]) if within.size else 0
 
 
 def step_time_ratios(table: pd.DataFrame, reference_controller: str | None) -> list[float]:
@@ -186,30 +201,58 @@ class Comparison:
             frames.append(frame)
         return pd.concat(frames, ignore_index=True)
 
-    # Figures 17 and 18: every run on one axis; each returns the axes.
+    # Figures 17 and 18: every run on one axis, in its style (`styles`); each returns the axes.
     def plot_trajectories(self, ax: Axes | None = None) -> Axes:
+        """Figure 17a, with an inset on the hardest stretch (`hardest_stretch`)."""
         from workbench.simulation import plots
 
-        return plots.trajectories(self.results, self.labels, ax)
+        return plots.trajectories(self.results, self.labels, ax, self.styles, self.hardest_stretch())
 
-    def plot_cte(self, ax: Axes | None = None) -> Axes:
+    def plot_cte(self, ax: Axes | None = None, zoom: bool = True) -> Axes:
+        """Figure 17b; zoom: the stretch the trajectories' inset shows shaded."""
         from workbench.simulation import plots
 
-        return plots.cte_comparison(self.results, self.labels, ax)
+        stretch = self.hardest_stretch() if zoom else None
+        return plots.cte_comparison(self.results, self.labels, ax, self.styles, stretch)
 
     def plot_speed(self, ax: Axes | None = None) -> Axes:
         from workbench.simulation import plots
 
-        return plots.speed_comparison(self.results, self.labels, ax)
+        return plots.speed_comparison(self.results, self.labels, ax, self.styles)
 
     def plot_steering(self, ax: Axes | None = None) -> Axes:
         from workbench.simulation import plots
 
-        return plots.steering_comparison(self.results, self.labels, ax)
+        return plots.steering_comparison(self.results, self.labels, ax, self.styles)
 
     @property
     def labels(self) -> list[str]:
         return [s.label for s in self.specs]
+
+    @property
+    def styles(self) -> list[RunStyle]:
+        """How each run is drawn on every figure (`plots.run_styles`): a colour per controller (with its options and
+        file: another controller here) and a line style per vehicle (with its payload)."""
+        return run_styles(
+            [(s.controller, s.overrides, s.config_file) for s in self.specs],
+            [(s.vehicle, s.payload_kg) for s in self.specs],
+        )
+
+    def hardest_stretch(self) -> Stretch | None:
+        """The stretch of the course around the largest |CTE| of any run once it has converged (`approach_end`),
+        ZOOM_CTE_FACTOR times that |CTE| either side along the path (at least ZOOM_MIN_HALF_LENGTH_M); None when no
+        run has a sample after its approach."""
+        peak, where = -1.0, math.nan
+        for result in self.results:
+            cte = np.abs(result.trace["cte_m"])
+            start = approach_end(cte)
+            if start < cte.size and float(np.max(cte[start:])) > peak:
+                k = start + int(np.argmax(cte[start:]))
+                peak, where = float(cte[k]), float(result.trace["progress_m"][k])
+        if peak < 0.0:
+            return None
+        half = max(ZOOM_MIN_HALF_LENGTH_M, ZOOM_CTE_FACTOR * peak)
+        return Stretch(where - half, where + half, f"largest |CTE| {peak:.3g} m")
 
     def save_figures(self, out_dir: str | Path, prefix: str = "") -> list[Path]:
         """Write the four comparison figures as PNG; return their paths."""
@@ -308,8 +351,11 @@ def compare(
 
 __all__ = [
     "CONVERGED_CTE_M",
+    "ZOOM_CTE_FACTOR",
+    "ZOOM_MIN_HALF_LENGTH_M",
     "Comparison",
     "RunSpec",
+    "approach_end",
     "compare",
     "converge_distance_m",
 ]

@@ -144,14 +144,14 @@ def _convergence_figure(comparison: Comparison) -> Figure:
     import matplotlib.pyplot as plt
 
     fig, (ax_cte, ax_steer) = plt.subplots(2, 1, figsize=(9, 7), sharex=True, layout="constrained")
-    comparison.plot_cte(ax_cte)
+    comparison.plot_cte(ax_cte, zoom=False)
     ax_cte.axhspan(-CONVERGED_CTE_M, CONVERGED_CTE_M, color="tab:green", alpha=0.12, label=f"±{CONVERGED_CTE_M:g} m")
     cte_seen, steer_seen = [0.0], [0.0]
-    for result, label in zip(comparison.results, comparison.labels, strict=True):
+    for result, label, style in zip(comparison.results, comparison.labels, comparison.styles, strict=True):
         distance = result.trace["progress_m"] - result.trace["progress_m"][0]
         shown = distance <= CONVERGENCE_VIEW_M
         steer_deg = np.degrees(result.trace["steer_wheel_rad"])
-        ax_steer.plot(distance, steer_deg, lw=1.3, label=label)
+        ax_steer.plot(distance, steer_deg, color=style.colour, ls=style.line_style, lw=1.3, label=label)
         cte_seen += [float(np.min(result.trace["cte_m"][shown])), float(np.max(result.trace["cte_m"][shown]))]
         steer_seen += [float(np.min(steer_deg[shown])), float(np.max(steer_deg[shown]))]
     for ax, seen in ((ax_cte, cte_seen), (ax_steer, steer_seen)):

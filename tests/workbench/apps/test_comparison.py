@@ -8,14 +8,25 @@ import re
 from html.parser import HTMLParser
 from pathlib import Path
 
+import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
 import pytest
+from matplotlib.colors import to_rgba
 
-from workbench.apps.comparison import RunSpec, compare, converge_distance_m, step_time_ratios
+from workbench.apps.comparison import (
+    CONVERGED_CTE_M,
+    FIGURES,
+    RunSpec,
+    approach_end,
+    compare,
+    converge_distance_m,
+    step_time_ratios,
+)
 from workbench.apps.report import ReportSection, render_report, write_report
 from workbench.base.errors import WorkbenchInputError
 from workbench.simulation.metrics import METRIC_KEYS
+from workbench.simulation.plots import CONTROLLER_COLOURS, VEHICLE_LINE_STYLES, Stretch, run_styles
 from workbench.simulation.simulator import SimulationConfig
 
 RUNS = (
@@ -169,3 +180,81 @@ def test_step_time_ratio_with_the_reference_run_more_than_once_on_a_plant() -> N
     assert ratios == pytest.approx([0.8, 1.2, 10.0, 1.0, 700.0 / 40.0])  # bus: over the median of all clothoid runs
     assert all(math.isnan(r) for r in step_time_ratios(table, None))
     assert all(math.isnan(r) for r in step_time_ratios(table, "stanley"))
+
+
+def _run_lines(ax, labels: list[str]) -> dict[str, tuple[tuple[float, ...], object]]:
+    """Each run's line on the axes (by its label): its colour (RGBA) and line style."""
+    lines = {line.get_label(): line for line in ax.get_lines()}
+    return {label: (to_rgba(lines[label].get_color()), lines[label].get_linestyle()) for label in labels}
+
+
+def test_each_figure_draws_a_colour_per_controller_and_a_style_per_vehicle(comparison) -> None:
+    """Alike on the four figures: runs of one controller share a colour, runs on one vehicle a line style, and no two
+    controllers (vehicles) share one."""
+    drawn = []
+    for _, method in FIGURES:
+        ax = getattr(comparison, method)()
+        drawn.append(_run_lines(ax, comparison.labels))
+        plt.close(ax.figure)
+    assert all(styles == drawn[0] for styles in drawn[1:])  # the same on every figure
+    styles = drawn[0]
+    for a in RUNS:
+        for b in RUNS:
+            colour_a, line_a = styles[a.label]
+            colour_b, line_b = styles[b.label]
+            assert (colour_a == colour_b) == (a.controller == b.controller)
+            assert (line_a == line_b) == (a.vehicle == b.vehicle)
+
+
+def test_run_styles_three_controllers_on_two_vehicles() -> None:
+    controllers = ["clothoid", "stanley", "pure-pursuit"] * 2
+    vehicles = ["kinematic-bicycle"] * 3 + ["dynamic-bicycle"] * 3
+    styles = run_styles(controllers, vehicles)
+    assert [s.colour for s in styles] == list(CONTROLLER_COLOURS[:3]) * 2
+    assert [s.line_style for s in styles] == [VEHICLE_LINE_STYLES[0]] * 3 + [VEHICLE_LINE_STYLES[1]] * 3
+    assert len({(s.colour, s.line_style) for s in styles}) == 6
+
+
+def test_the_trajectories_inset_bounds_the_hardest_stretch(comparison) -> None:
+    """One inset, on the stretch round the largest |CTE| any run has once on the path, showing every run there."""
+    stretch = comparison.hardest_stretch()
+    peak, where = -1.0, math.nan
+    for result in comparison.results:  # the largest |CTE| after each run's approach, found here on its own
+        cte = np.abs(result.trace["cte_m"])
+        on_path = np.flatnonzero(cte <= CONVERGED_CTE_M)[0]
+        k = on_path + int(np.argmax(cte[on_path:]))
+        if cte[k] > peak:
+            peak, where = float(cte[k]), float(result.trace["progress_m"][k])
+    assert stretch.from_m < where < stretch.to_m and f"{peak:.3g} m" in stretch.reason
+    ax = comparison.plot_trajectories()
+    (inset,) = ax.child_axes
+    (x0, x1), (y0, y1) = inset.get_xlim(), inset.get_ylim()
+    for result in comparison.results:
+        progress = result.trace["progress_m"]
+        there = (progress >= stretch.from_m) & (progress <= stretch.to_m)
+        assert there.any()
+        x, y = result.trace["x_m"][there], result.trace["y_m"][there]
+        assert x0 <= x.min() and x.max() <= x1 and y0 <= y.min() and y.max() <= y1
+    # a magnified view: the inset spans the stretch, not the course
+    assert max(x1 - x0, y1 - y0) < 0.5 * min(np.ptp(ax.get_xlim()), np.ptp(ax.get_ylim()))
+    courses = {result.scenario.description for result in comparison.results}  # the dlc: sized per vehicle
+    assert len(inset.get_lines()) == len(courses) + len(RUNS)  # each course's reference and every run
+    plt.close(ax.figure)
+    # the CTE figure shades the same stretch
+    ax = comparison.plot_cte()
+    (span,) = [p for p in ax.patches if p.get_label() == "the trajectories' inset"]
+    corners = span.get_path().transformed(span.get_patch_transform()).vertices  # a Rectangle or a Polygon
+    assert corners[:, 0].min() == pytest.approx(stretch.from_m) and corners[:, 0].max() == pytest.approx(stretch.to_m)
+    plt.close(ax.figure)
+
+
+@pytest.mark.parametrize(
+    ("cte", "expected"), [([1.0, 0.5, 0.05, 0.2], 2), ([0.0, 0.3], 0), ([1.0, 0.9], 0)]
+)
+def test_approach_end(cte: list[float], expected: int) -> None:
+    assert approach_end(np.array(cte)) == expected
+
+
+def test_a_stretch_runs_forward() -> None:
+    with pytest.raises(WorkbenchInputError, match="from_m must be below to_m; got from_m = 5, to_m = 2"):
+        Stretch(5.0, 2.0)
