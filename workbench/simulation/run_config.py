@@ -8,6 +8,11 @@ from workbench.base.errors import WorkbenchInputError, require_in_range, require
 from workbench.simulation.conditions import CONDITIONS, Conditions
 
 
+#: The longest time-out a run may be given (s; about 32 years): beyond it a number of steps no longer fits a
+#: machine integer, and `run_size` refuses far shorter runs anyway.
+MAX_TIME_S = 1e9
+
+
 @dataclass(frozen=True)
 class SimulationConfig:
     """How a run is simulated.
@@ -53,7 +58,8 @@ class SimulationConfig:
         if isinstance(self.laps, bool) or not isinstance(self.laps, int) or self.laps < 1:
             raise WorkbenchInputError(f"laps must be a whole number >= 1; got {self.laps!r}")
         if self.max_time_s is not None:
-            require_positive("max_time_s", self.max_time_s)
+            period_s = 1.0 / self.controller_rate_hz
+            require_in_range("max_time_s", self.max_time_s, period_s, MAX_TIME_S, "s (one controller period at least)")
         require_positive("max_abs_cte_m", self.max_abs_cte_m)
         require_positive("max_past_end_m", self.max_past_end_m)
         if not isinstance(self.speed_feedforward, bool):
