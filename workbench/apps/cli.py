@@ -64,6 +64,8 @@ _SHORTEN_RUN = "a higher --speed (now {speed:g} km/h), fewer --laps or a --max-t
 #: compare's `--controller-config NAME=FILE.toml` and `--set NAME:KEY=VALUE`: a controller name's shape.
 _CONTROLLER_NAME = re.compile(r"[A-Za-z][A-Za-z0-9_-]*")
 
+#: The scenario that --track gives the track of (the paper's Zandvoort lap).
+TRACK_SCENARIO = "zandvoort"
 #: The input-file options of the commands (argparse dest -> what the message calls it).
 INPUT_FILES = {
     "track": "--track",
@@ -372,6 +374,12 @@ def _check_inputs(args: argparse.Namespace) -> None:
     if scenario is not None and scenario not in SCENARIOS:
         if os.path.lexists(scenario) or Path(scenario).suffix.lower() in (".csv", ".txt"):
             check_input_file(scenario, f"waypoint file {scenario!r}")
+    track = getattr(args, "track", None)
+    if track is not None and scenario is not None and scenario != TRACK_SCENARIO:
+        raise WorkbenchInputError(
+            f"--track {str(track)!r} is the track of the {TRACK_SCENARIO} scenario, and scenario {scenario!r} does not "
+            "read it: drop --track, or give the track file itself as the scenario"
+        )
 
 
 @contextmanager
@@ -826,7 +834,7 @@ def _run_stages(
 
     config = _run_config(args)
     progress.stage("building the vehicle, the controller and the scenario")
-    name = args.vehicle if args.vehicle or args.vehicle_file else DEFAULT_VEHICLE
+    name = args.vehicle if args.vehicle is not None or args.vehicle_file else DEFAULT_VEHICLE
     vehicle = make_vehicle(name, payload_kg=args.payload_kg, vehicle_file=args.vehicle_file)
     if args.controller not in CONTROLLERS:
         make_controller(args.controller, vehicle.geometry)  # raises the unknown-name error
@@ -864,10 +872,13 @@ def _run_stages(
 
 
 def _scenarios(args: argparse.Namespace) -> None:
-    from workbench.simulation.scenarios import ScenarioOptions, describe_scenarios
+    from workbench.simulation.scenarios import ScenarioOptions, describe_scenarios, make_scenario
 
     _check_inputs(args)
-    for name, description in describe_scenarios(ScenarioOptions(track_file=args.track)):
+    options = ScenarioOptions(track_file=args.track)
+    if args.track is not None:
+        make_scenario(TRACK_SCENARIO, options)  # a track that cannot be used is refused, not described
+    for name, description in describe_scenarios(options):
         print(f"{name:<12} {description}")
 
 
@@ -899,8 +910,12 @@ def _controllers(args: argparse.Namespace) -> None:
             raise WorkbenchInputError(f"unknown controller {args.show!r}; choose one of {', '.join(CONTROLLERS)}")
         print(config_template(args.show, CONTROLLERS[args.show].config_type), end="")
         return
-    for name, cls in CONTROLLERS.items():
-        print(f"{name:<14} {cls.summary()}")
+    for name in CONTROLLERS:
+        try:
+            summary = CONTROLLERS[name].summary()
+        except WorkbenchInputError as exc:  # an installed package's controller that cannot be used
+            summary = f"(not usable: {exc})"
+        print(f"{name:<14} {summary}")
 
 
 def console() -> int:
