@@ -152,11 +152,16 @@ def load_vehicle(name_or_file: str, payload_kg: float | None = None) -> VehicleM
         source = str(path)
         text = read_text(path, f"vehicle file {source}")
     kind, params = params_from_toml(text, source)
-    if payload_kg is not None:
-        if not carries_payload(kind):
-            carriers = [k for k in MODEL_TYPES if carries_payload(k)]
-            raise WorkbenchInputError(f"vehicle {kind!r} has no payload; a payload applies to: {', '.join(carriers)}")
-        if isinstance(payload_kg, bool) or not isinstance(payload_kg, int | float):
-            raise WorkbenchInputError(f"payload_kg must be a number; got {value_text(payload_kg)}")
-        params = dataclasses.replace(params, payload_kg=float(payload_kg))
-    return MODEL_TYPES[kind][0](params)
+    model = MODEL_TYPES[kind][0](params)
+    return model if payload_kg is None else with_payload(model, payload_kg)
+
+
+def with_payload(model: VehicleModel, payload_kg: float) -> VehicleModel:
+    """The same vehicle carrying payload_kg instead of its own payload (a model type with a payload only)."""
+    kind = model.name
+    if not carries_payload(kind):
+        carriers = [k for k in MODEL_TYPES if carries_payload(k)]
+        raise WorkbenchInputError(f"vehicle {kind!r} has no payload; a payload applies to: {', '.join(carriers)}")
+    if isinstance(payload_kg, bool) or not isinstance(payload_kg, int | float):
+        raise WorkbenchInputError(f"payload_kg must be a number; got {value_text(payload_kg)}")
+    return MODEL_TYPES[kind][0](dataclasses.replace(model.params, payload_kg=float(payload_kg)))

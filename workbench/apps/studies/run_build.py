@@ -68,16 +68,16 @@ def started_scenario(
 
 
 def plant_and_controller_vehicles(
-    vehicle: str, payload_kg: float | None, controller_payload_kg: float | None
+    vehicle: VehicleModel, payload_kg: float | None, controller_payload_kg: float | None
 ) -> tuple[VehicleModel, VehicleModel]:
-    """(the plant: the vehicle with payload_kg; the vehicle the controller is built for: the same with
-    controller_payload_kg when given, a payload mismatch, else the plant itself). vehicle: a preset or a file."""
-    from workbench.vehicles.presets import load_vehicle
+    """(the plant: the vehicle with payload_kg, its own payload when None; the vehicle the controller is built for:
+    the vehicle with controller_payload_kg when given, a payload mismatch, else the plant itself)."""
+    from workbench.vehicles.presets import with_payload
 
-    plant = load_vehicle(vehicle, payload_kg)
+    plant = vehicle if payload_kg is None else with_payload(vehicle, payload_kg)
     if controller_payload_kg is None:
         return plant, plant
-    return plant, load_vehicle(vehicle, controller_payload_kg)
+    return plant, with_payload(vehicle, controller_payload_kg)
 
 
 def option_text(value: Any) -> str:

@@ -38,6 +38,7 @@ from workbench.simulation.result import SimulationResult
 from workbench.simulation.scenarios import ScenarioOptions, make_scenario
 from workbench.simulation.simulator import Simulation
 from workbench.vehicles.base import VehicleModel
+from workbench.vehicles.presets import load_vehicle
 
 #: The status of a run that raised.
 ERROR_STATUS = "error"
@@ -66,7 +67,9 @@ def simulate(run: PlannedRun, progress: bool = False) -> SimulationResult:
     config = simulation_config(values)
     # The controller is built for the vehicle with controller_payload_kg when given (a payload mismatch), else for
     # the plant itself.
-    vehicle, built_for = plant_and_controller_vehicles(run.vehicle, extra["payload_kg"], extra["controller_payload_kg"])
+    vehicle, built_for = plant_and_controller_vehicles(
+        load_vehicle(run.vehicle), extra["payload_kg"], extra["controller_payload_kg"]
+    )  # run.vehicle: a preset name or a vehicle file
     scenario = make_scenario(run.scenario, ScenarioOptions(vehicle.geometry.width_m, run.track_file))
     scenario = started_scenario(
         scenario, extra["initial_offset_m"], extra["initial_heading_error_deg"], config.max_abs_cte_m

@@ -140,8 +140,8 @@ def check_values(spec: Any, models: Mapping[str, Any], scenarios: Mapping[str, A
         axes,
         draws,
         samples,
-        list(models),
-        lambda vehicle, v: plant_and_controller_vehicles(vehicle, v.get("payload_kg"), v.get("controller_payload_kg")),
+        list(models.values()),
+        lambda model, v: plant_and_controller_vehicles(model, v.get("payload_kg"), v.get("controller_payload_kg")),
     )
 
     def start(scenario: Any, values: dict[str, Any]) -> object:
