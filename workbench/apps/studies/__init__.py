@@ -4,8 +4,10 @@ A TOML spec (`spec.py`) names scenarios, controllers, vehicles and parameter gri
 (`distributions.py`); it plans independent, deterministic runs with stable ids. `runner.py` executes one run into
 a row (its parameters and the metrics.json fields; an exception becomes an "error" row), `backends.py` runs them on
 a local process pool or on Dask, `store.py` keeps each row as it finishes (so a restarted study resumes) and
-assembles DIR/results.parquet, `results.py` and `plots.py` summarise and draw them, and `optimise.py` tunes a
-controller's options with optuna through the same machinery.
+assembles DIR/results.parquet, `results.py` and `plots.py` summarise and draw them (and write DIR/report.html), and
+`optimise.py` tunes a controller's options with optuna through the same machinery. Every value a spec plans is built
+when it loads (`value_check.py`, with `run_build.py`, how a run's objects are built), so that a value every run would
+refuse stops the study before any run.
 
     from workbench.apps.studies import load_spec, run_sweep, make_backend
     result = run_sweep(load_spec("examples/sweep_dlc.toml"), "runs/sweep", make_backend("local", workers=2))
