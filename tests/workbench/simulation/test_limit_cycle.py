@@ -9,8 +9,12 @@ import pytest
 
 from workbench.base.errors import WorkbenchInputError
 from workbench.simulation.limit_cycle import (
+    AMPLITUDE_TOLERANCE,
+    HALF_PERIOD_TOLERANCE,
     LIMIT_CYCLE_MIN_AMPLITUDE_DEG,
     LimitCycle,
+    _longest_cycle,
+    _regular,
     detect_limit_cycle,
     oscillation,
     residual_gain,
@@ -144,3 +148,124 @@ def test_the_cycle_in_words() -> None:
     assert cycle.describe() == "1.0 Hz, ±150° steering wheel for 40.0 s from t = 113.0 s"
     assert LimitCycle(True, 0.384, 12.0, 1.0, 8.0).brief() == "0.38 Hz, ±12°"
     assert LimitCycle(False).brief() == "no" and LimitCycle(False).describe() == "no limit cycle"
+
+
+# ------------------------------------------------------------------ each threshold just inside and just outside
+def _sine(freq_hz: float, amp_deg: float, dt_s: float, duration_s: float) -> tuple[np.ndarray, np.ndarray]:
+    """A whole trace of one sinusoid (t, steering wheel in rad)."""
+    t = np.arange(0.0, duration_s, dt_s)
+    return t, np.radians(amp_deg * np.sin(2 * np.pi * freq_hz * t))
+
+
+@pytest.mark.parametrize(("scale", "detected"), [(1.01, True), (0.99, False)])
+def test_the_amplitude_threshold_is_5_deg_about_the_moving_average(scale: float, detected: bool) -> None:
+    """2 Hz sampled at 200 Hz (the peaks are samples): the half amplitude about the moving average is the
+    amplitude times the average's residual gain, set 1 % above and below LIMIT_CYCLE_MIN_AMPLITUDE_DEG = 5."""
+    dt = 0.005
+    t = np.arange(0.0, 20.0, dt)
+    gain = residual_gain(2.0, window_samples(t), dt)
+    t, sw = _sine(2.0, scale * 5.0 / gain, dt, 20.0)
+    assert LIMIT_CYCLE_MIN_AMPLITUDE_DEG == 5.0
+    assert detect_limit_cycle(t, sw).detected is detected
+
+
+@pytest.mark.parametrize(("freq_hz", "detected"), [(9.5, True), (10.5, False)])
+def test_the_frequency_range_ends_at_10_hz(freq_hz: float, detected: bool) -> None:
+    """At 1 kHz the half-periods of 9.5 Hz are 52-53 samples (>= 0.05 s), those of 10.5 Hz 47-48 (< 0.05 s)."""
+    t, sw = _sine(freq_hz, 20.0, 0.001, 10.0)
+    assert detect_limit_cycle(t, sw).detected is detected
+
+
+@pytest.mark.parametrize(("freq_hz", "detected"), [(0.21, True), (0.19, False)])
+def test_the_frequency_range_starts_at_0_2_hz(freq_hz: float, detected: bool) -> None:
+    """Half-periods of 2.38 s (<= 2.5 s) and 2.63 s; the 1 s average leaves ~7 % of the swing, hence 300°."""
+    t, sw = _sine(freq_hz, 300.0, 0.02, 80.0)
+    assert detect_limit_cycle(t, sw).detected is detected
+
+
+def test_the_least_duration_is_inclusive() -> None:
+    """A cycle exactly as long as min_duration_s is one; a hair longer asked for, it is not."""
+    t, sw = _sine(2.0, 40.0, 0.02, 12.0)
+    duration = detect_limit_cycle(t, sw).duration_s
+    assert detect_limit_cycle(t, sw, min_duration_s=duration).detected
+    assert not detect_limit_cycle(t, sw, min_duration_s=math.nextafter(duration, math.inf)).detected
+
+
+@pytest.mark.parametrize(
+    ("values", "tolerance", "regular"),
+    [
+        ([2.0, 2.0, 3.0], 0.5, True),  # exactly at the tolerance: regular
+        ([2.0, 2.0, 3.0000001], 0.5, False),
+        ([1.0, 1.0, 1.0, 1.34], HALF_PERIOD_TOLERANCE, True),
+        ([1.0, 1.0, 1.0, 1.36], HALF_PERIOD_TOLERANCE, False),
+        ([1.0, 1.0, 1.0, 0.66], HALF_PERIOD_TOLERANCE, True),
+        ([1.0, 1.0, 1.0, 0.64], HALF_PERIOD_TOLERANCE, False),
+        ([1.0, 1.0, 1.0, 1.49], AMPLITUDE_TOLERANCE, True),
+        ([1.0, 1.0, 1.0, 1.51], AMPLITUDE_TOLERANCE, False),
+        ([1.0, 1.0, 1.0, 0.51], AMPLITUDE_TOLERANCE, True),
+        ([1.0, 1.0, 1.0, 0.49], AMPLITUDE_TOLERANCE, False),
+    ],
+)
+def test_regularity_is_within_the_tolerance_of_the_median(values: list, tolerance: float, regular: bool) -> None:
+    """HALF_PERIOD_TOLERANCE = 0.35 and AMPLITUDE_TOLERANCE = 0.5, each just inside and just outside."""
+    assert _regular(np.array(values), tolerance) is regular
+
+
+def _runs(*runs: tuple[int, float, float]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(eligible, half_periods, half_amplitudes) of stretches (count, half-period, half amplitude); a count of 0
+    is one ineligible half-cycle of 1 s."""
+    eligible, periods, amplitudes = [], [], []
+    for count, period, amplitude in runs:
+        eligible += [count > 0] * max(count, 1)
+        periods += [period if count else 1.0] * max(count, 1)
+        amplitudes += [amplitude if count else 1.0] * max(count, 1)
+    return np.array(eligible), np.array(periods), np.array(amplitudes)
+
+
+@pytest.mark.parametrize(
+    ("runs", "expected"),
+    [
+        (((6, 1.0, 10.0),), (0, 6)),  # LIMIT_CYCLE_MIN_CYCLES = 3: 6 half-cycles are enough
+        (((5, 1.0, 10.0),), (0, 0)),  # 5 are not
+        (((6, 0.1, 10.0),), (0, 6)),  # however short in time
+        (((8, 1.0, 10.0),), (0, 8)),
+        (((6, 1.1, 10.0), (0, 0, 0), (6, 1.0, 10.0)), (0, 6)),  # the longer in time: 6.6 s against 6 s
+        (((0, 0, 0), (6, 1.0, 10.0), (0, 0, 0), (6, 1.1, 10.0)), (8, 14)),  # 6.6 s after 6 s
+        (((6, 1.0, 10.0), (0, 0, 0), (6, 1.0, 10.0)), (0, 6)),  # a tie: the first
+        (((8, 1.0, 10.0), (0, 0, 0), (10, 1.0, 10.0)), (9, 19)),  # a longer stretch after a long one
+        (((7, 1.0, 10.0), (1, 3.0, 10.0)), (0, 7)),  # an eligible half-cycle too long ends the run
+        (((7, 1.0, 10.0), (1, 1.0, 40.0)), (0, 7)),  # so does one too large
+    ],
+)
+def test_the_longest_regular_run(runs: tuple, expected: tuple[int, int]) -> None:
+    assert _longest_cycle(*_runs(*runs)) == expected
+
+
+def test_a_flat_trace_has_no_turning_points() -> None:
+    points = turning_points(np.zeros(10), 1.0)
+    assert points.dtype == np.dtype(int) and points.size == 0
+
+
+@pytest.mark.parametrize(
+    ("x", "deadband", "expected"),
+    [
+        ([0.0, 5.0, 0.0, 5.0, 0.0], 5.0, []),  # reversals of exactly the deadband are not turning points
+        ([0.0, 5.0, 0.0, 5.0, 0.0], 4.999, [0, 1, 2, 3]),
+        ([0.0, 10.0, 0.0, 10.0], 1.0, [0, 1, 2]),  # an extremum at the second sample
+        ([0.0, 10.0, 10.0, 0.0, 0.0, 10.0], 1.0, [0, 1, 3]),  # a plateau's first sample
+    ],
+)
+def test_turning_points_at_the_deadband(x: list, deadband: float, expected: list) -> None:
+    assert turning_points(np.array(x), deadband).tolist() == expected
+
+
+def test_checks_name_what_is_wrong() -> None:
+    with pytest.raises(WorkbenchInputError, match=r"must be 1-D and equally long; got \(2, 3\), \(2, 3\)"):
+        detect_limit_cycle(np.ones((2, 3)), np.ones((2, 3)))
+    with pytest.raises(WorkbenchInputError, match="strictly increasing; it is not at entry 0"):
+        detect_limit_cycle(np.array([1.0, 0.0]), np.zeros(2))
+
+
+def test_the_frequency_shows_one_decimal_from_1_hz() -> None:
+    assert LimitCycle(True, 1.0, 12.0, 1.0, 8.0).brief() == "1.0 Hz, ±12°"
+    assert LimitCycle(True, math.nextafter(1.0, 0.0), 12.0, 1.0, 8.0).brief() == "1.00 Hz, ±12°"
