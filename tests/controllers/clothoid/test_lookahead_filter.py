@@ -67,3 +67,73 @@ def test_steps_stay_bounded_and_within_the_range(
 def test_bad_settings_are_refused(kwargs: dict, needle: str) -> None:
     with pytest.raises(WorkbenchInputError, match=needle):
         LookaheadFilterSettings(**kwargs)
+
+
+# ------------------------------------------------------------------ each threshold and rate limit at its boundary
+def _started(at_m: float, settings: LookaheadFilterSettings | None = None) -> LookaheadFilter:
+    f = LookaheadFilter(settings or LookaheadFilterSettings())
+    assert f.step(at_m, 5.0, 20.0, 0.2) == at_m
+    return f
+
+
+def test_the_default_hysteresis_is_half_a_metre_inclusive() -> None:
+    f = _started(10.0)
+    assert f.step(10.5, 5.0, 20.0, 10.0) == 10.0  # exactly the hysteresis: ignored
+    assert f.step(9.5, 5.0, 20.0, 10.0) == 10.0
+    assert f.step(10.5001, 5.0, 20.0, 10.0) == 10.5001  # just beyond: followed (the rate allows 3 m here)
+    f = _started(10.0)
+    assert f.step(9.4999, 5.0, 20.0, 10.0) == 9.4999
+
+
+@pytest.mark.parametrize(
+    ("choice", "distance", "expected"),
+    [(20.0, 1.0, 10.3), (5.0, 1.0, 9.5), (10.59, 2.0, 10.59), (10.61, 2.0, 10.6), (9.01, 2.0, 9.01), (8.99, 2.0, 9.0)],
+)
+def test_the_default_rates_are_0_3_longer_and_0_5_shorter_per_metre(
+    choice: float, distance: float, expected: float
+) -> None:
+    """At most 0.3 m longer and 0.5 m shorter per metre travelled; a choice within the rate is taken."""
+    assert _started(10.0).step(choice, 5.0, 20.0, distance) == pytest.approx(expected, abs=1e-12)
+
+
+def test_the_rate_limit_scales_with_the_distance_travelled() -> None:
+    assert _started(10.0).step(20.0, 5.0, 20.0, 0.0) == 10.0  # standing still: no change
+    assert _started(10.0).step(20.0, 5.0, 20.0, 2.0) == pytest.approx(10.6, abs=1e-12)
+    assert _started(10.0).step(5.0, 5.0, 20.0, 2.0) == pytest.approx(9.0, abs=1e-12)
+
+
+def test_a_falling_floor_takes_the_lookahead_down_by_as_much() -> None:
+    f = _started(12.0, LookaheadFilterSettings(max_growth_m_per_m=0.3))
+    assert f.step(12.0, 10.0, 20.0, 0.0) == 12.0  # a floor below the lookahead changes nothing
+    assert f.step(12.0, 8.0, 20.0, 0.0) == 10.0  # the floor fell by 2 m: so does the lookahead (and no growth at 0 m)
+    assert f.step(12.0, 8.0, 20.0, 0.0) == 10.0  # the same floor again: no further fall
+    assert f.step(10.0, 3.0, 20.0, 0.0) == 5.0  # down by 5 m with the floor; the choice waits for distance travelled
+
+
+def test_a_ceiling_below_the_floor_yields_the_floor() -> None:
+    assert LookaheadFilter(LookaheadFilterSettings()).step(15.0, 10.0, 5.0, 0.2) == 10.0
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "allowed"),
+    [
+        ({"hysteresis_m": 0.0}, True),
+        ({"hysteresis_m": 50.0}, True),
+        ({"hysteresis_m": 50.000001}, False),
+        ({"hysteresis_m": -1e-9}, False),
+        ({"max_growth_m_per_m": 100.0}, True),
+        ({"max_growth_m_per_m": 100.000001}, False),
+        ({"max_growth_m_per_m": 1e-9}, True),
+        ({"max_shrink_m_per_m": 100.0}, True),
+        ({"max_shrink_m_per_m": 100.000001}, False),
+        ({"max_shrink_m_per_m": 0.0}, False),
+        ({"max_shrink_m_per_m": None}, True),
+        ({"max_growth_m_per_m": None}, True),
+    ],
+)
+def test_settings_are_allowed_up_to_their_bounds(kwargs: dict, allowed: bool) -> None:
+    if allowed:
+        LookaheadFilterSettings(**kwargs)
+    else:
+        with pytest.raises(WorkbenchInputError, match=next(iter(kwargs))):
+            LookaheadFilterSettings(**kwargs)
