@@ -22,6 +22,8 @@ __all__ = ["LOG_COLUMNS", "MAX_LOG_SAMPLES", "MAX_PLANT_STEPS", "check_log_size"
 
 #: Rate (Hz) the plant is integrated at while a log is generated.
 PLANT_RATE_HZ = 1000.0
+#: Fewest rows (samples) of a log: what `log_file.VehicleLog` reads.
+MIN_LOG_SAMPLES = 2
 #: Most rows (samples) a generated log may hold: 7 columns of 8 bytes, 112 MB in memory (about 5.6 h at 100 Hz).
 MAX_LOG_SAMPLES = 2_000_000
 #: Most plant steps (log samples x plant steps per sample) a generated log may take: the steering profile is
@@ -30,11 +32,25 @@ MAX_LOG_SAMPLES = 2_000_000
 MAX_PLANT_STEPS = 10_000_000
 
 
-def _planned_steps(duration_s: float, sample_rate_hz: float, plant_rate_hz: float) -> tuple[int, int]:
+def _substeps(sample_rate_hz: float, plant_rate_hz: float) -> int:
+    """Plant steps per log sample: the plant rate over the sample rate, rounded, at least one."""
+    return max(1, round(plant_rate_hz / sample_rate_hz))
+
+
+def _planned_steps(duration_s: float, sample_rate_hz: float, plant_rate_hz: float) -> tuple[float, float]:
     """(log samples, plant steps) of a log of duration_s sampled at sample_rate_hz (`generate_open_loop_log`'s
-    grid: 0 to duration_s inclusive, plant_rate_hz / sample_rate_hz plant steps a sample, at least one)."""
-    samples = math.floor(duration_s * sample_rate_hz + 0.5) + 1
-    return samples, samples * max(1, round(plant_rate_hz / sample_rate_hz))
+    grid: 0 to duration_s inclusive, plant_rate_hz / sample_rate_hz plant steps a sample, at least one), as floats:
+    whole numbers, or inf for a duration too long to count in integers."""
+    product = duration_s * sample_rate_hz
+    samples = math.floor(product + 0.5) + 1.0 if math.isfinite(product) else math.inf
+    return samples, samples * _substeps(sample_rate_hz, plant_rate_hz)
+
+
+def _count(n: float) -> str:
+    """A count as a message shows it: whole with grouped thousands, in powers of ten from 1e15 on."""
+    if not math.isfinite(n):
+        return "over 1e+308"
+    return f"{n:,.0f}" if n < 1e15 else f"{n:.3g}"
 
 
 def check_log_size(
@@ -50,14 +66,21 @@ def check_log_size(
     require_positive(duration_name, duration_s)
     require_in_range(rate_name, sample_rate_hz, 1.0, 10_000.0, "Hz")
     samples, steps = _planned_steps(duration_s, sample_rate_hz, plant_rate_hz)
+    if samples < MIN_LOG_SAMPLES:
+        raise WorkbenchInputError(
+            f"{duration_name} {value_text(duration_s)} s at {rate_name} {value_text(sample_rate_hz)} Hz gives "
+            f"{samples:.0f} log sample; a log needs at least {MIN_LOG_SAMPLES}: {duration_name} at least "
+            f"{(MIN_LOG_SAMPLES - 1) / sample_rate_hz:g} s"
+        )
     if samples <= MAX_LOG_SAMPLES and steps <= MAX_PLANT_STEPS:
         return
-    per_sample = steps // samples
+    per_sample = _substeps(sample_rate_hz, plant_rate_hz)
     longest_s = min((MAX_LOG_SAMPLES - 1) / sample_rate_hz, (MAX_PLANT_STEPS // per_sample - 1) / sample_rate_hz)
     memory_gb = (samples * len(LOG_COLUMNS) + steps) * 8 / 1e9
     raise WorkbenchInputError(
         f"{duration_name} {value_text(duration_s)} s at {rate_name} {value_text(sample_rate_hz)} Hz plans "
-        f"{samples:,} log samples and {steps:,} plant steps at {plant_rate_hz:g} Hz (about {memory_gb:,.3g} GB); "
+        f"{_count(samples)} log samples and {_count(steps)} plant steps at {plant_rate_hz:g} Hz ("
+        f"{f'about {memory_gb:,.3g} GB' if math.isfinite(memory_gb) else 'beyond any memory'}); "
         f"at most {MAX_LOG_SAMPLES:,} samples and {MAX_PLANT_STEPS:,} plant steps, {longest_s:,.6g} s at this rate: "
         f"give a shorter {duration_name} or a lower {rate_name}"
     )
@@ -78,7 +101,7 @@ def generate_open_loop_log(
     require_in_range("speed_kmh", speed_kmh, 1e-3, 400.0, "km/h (must be > 0)")
     require_in_range("plant_rate_hz", plant_rate_hz, 1.0, 100_000.0, "Hz")
     check_log_size(maneuver.duration_s, sample_rate_hz, plant_rate_hz)
-    substeps = max(1, round(plant_rate_hz / sample_rate_hz))
+    substeps = _substeps(sample_rate_hz, plant_rate_hz)
     dt = 1.0 / sample_rate_hz
     speed_ref = speed_kmh / 3.6
     t = np.arange(0.0, maneuver.duration_s + 0.5 * dt, dt)
