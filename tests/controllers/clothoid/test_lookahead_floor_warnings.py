@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from controllers.clothoid import ClothoidConfig
-from controllers.clothoid.controller import FLOOR_SPEED_BAND_KMH, MAX_FLOOR_LOOKAHEAD_M
+from controllers.clothoid.controller import MAX_FLOOR_LOOKAHEAD_M
 from controllers.clothoid.filter_schedule import FilterSchedule
 from controllers.clothoid.lead_filter import LeadFilterParams
 from tuning.filter_file import write_filter_file
@@ -91,10 +91,10 @@ def test_the_simulation_says_it_before_the_run_and_the_run_holds_the_floor() -> 
     warnings = [w for w in simulation.warnings("dlc: clothoid") if "lookahead floor" in w]
     assert len(warnings) == 1 and warnings[0].startswith("dlc: clothoid: the clothoid controller's lookahead floor")
     trace = simulation.run().to_pandas()
-    bands = np.maximum(1, np.round(trace["speed_mps"] * 3.6 / FLOOR_SPEED_BAND_KMH))
-    floors = np.array([controller.lookahead_floor_m(b * FLOOR_SPEED_BAND_KMH / 3.6) for b in bands])
+    floors = trace["ctrl_lookahead_floor_m"].to_numpy()
     above = floors > 12.0
     assert above.mean() > 0.5  # most of the run is in bands whose floor is above the range
+    assert floors[above].min() == controller.lookahead_floor_m(30.0 / 3.6)
     np.testing.assert_allclose(trace["ctrl_lookahead_m"][above], floors[above], atol=1e-9)  # held at the floor
 
 
