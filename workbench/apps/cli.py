@@ -108,12 +108,6 @@ def _parser(command: str | None = None) -> argparse.ArgumentParser:
         "controllers`)",
     )
     run.add_argument("--vehicle", metavar="NAME", help=f"vehicle model (default: {DEFAULT_VEHICLE})")
-    run.add_argument(
-        "--allow-infeasible",
-        action="store_true",
-        help="run a path the vehicle cannot follow at the planned speed (too tight for its lock, curvature changing "
-        "faster than its steering, beyond its rollover threshold or grip), warning where; refused without it",
-    )
     _run_options(run, several=False)
 
     cmp = sub.add_parser("compare", help="run several controllers (and vehicles) on one scenario; write a report")
@@ -168,6 +162,7 @@ def _parser(command: str | None = None) -> argparse.ArgumentParser:
         action="store_true",
         help="start even when each run's time-out allows more than 2,000,000 controller steps or a trace over 1 GB",
     )
+    _allow_infeasible_option(rob)
     _conditions_options(rob)
     _backend_options(rob, command in (None, "robustness"))
 
@@ -313,10 +308,21 @@ def _run_options(parser: argparse.ArgumentParser, several: bool) -> None:
         help="run even when the time-out allows more than 2,000,000 controller steps or a trace over 1 GB (refused "
         "without it)",
     )
+    _allow_infeasible_option(parser)
     _conditions_options(parser)
     what = "trace and metrics" if not several else "traces, metrics and summary.csv, without figures or report.html"
     parser.add_argument("--no-plots", action="store_true", help=f"write the {what} only")
     _overwrite_option(parser)
+
+
+def _allow_infeasible_option(parser: argparse.ArgumentParser) -> None:
+    """--allow-infeasible, of run, compare and robustness (`feasibility.refuse_infeasible`)."""
+    parser.add_argument(
+        "--allow-infeasible",
+        action="store_true",
+        help="run a path a vehicle cannot follow at the planned speed (too tight for its lock, curvature changing "
+        "faster than its steering, beyond its rollover threshold or grip), warning where; refused without it",
+    )
 
 
 def _conditions_options(parser: argparse.ArgumentParser) -> None:
@@ -531,6 +537,7 @@ def _compare(args: argparse.Namespace) -> int:
         warn=warn_on_stderr,
         progress=sys.stderr.isatty(),
         allow_long_run=args.allow_long_run,
+        allow_infeasible=args.allow_infeasible,
     )
     with _writing(out):
         comparison.save(args.out, with_plots=not args.no_plots)
@@ -666,6 +673,7 @@ def _robustness(args: argparse.Namespace) -> int:
         args.track,
         Path.cwd(),
         allow_long_run=args.allow_long_run,
+        allow_infeasible=args.allow_infeasible,
     )
     limit = DEFAULT_MAX_RUNS if max_runs is None else max_runs
     if len(runs) > limit:
@@ -827,6 +835,7 @@ def _run_stages(
     from controllers import make_controller
     from tuning.own_tuning import tuned_controller
     from workbench.apps.controller_config import read_controller_config
+    from workbench.simulation.feasibility import refuse_infeasible
     from workbench.simulation.run_size import check_run_size, duration_text
     from workbench.simulation.scenarios import ScenarioOptions, make_scenario
     from workbench.simulation.simulator import Simulation
@@ -856,8 +865,8 @@ def _run_stages(
     label = f"{scenario.name}: {controller.name} on {vehicle.name}"
     if not args.allow_long_run:
         check_run_size(simulation.size, label, _SHORTEN_RUN.format(speed=args.speed), "--allow-long-run")
-    if simulation.infeasible_curvature and not args.allow_infeasible:  # `feasibility.py`: refused before the run
-        raise WorkbenchInputError("; ".join(simulation.path_warnings()) + "; --allow-infeasible runs it anyway")
+    if not args.allow_infeasible:  # refused before the run, as compare, robustness and the studies refuse it
+        refuse_infeasible(simulation.path_warnings())
     for warning in simulation.warnings(label):
         progress.warn(warning)
     progress.stage(

@@ -13,8 +13,9 @@ per vehicle), the trajectories with an inset magnifying the hardest stretch (`ha
 
 Every run is built (vehicle, scenario, controller options and files) before the first one is simulated, so a bad
 input is refused before any work, a run that may simulate more than the bounds of `run_size` is refused without
-`allow_long_run`, and what each run's `Simulation.warnings` says (stretches of the path the vehicle cannot turn, a
-planned top speed short of the speed asked for) is announced first. With `progress` one bar counts the runs
+`allow_long_run`, a path a vehicle cannot follow at the planned speed is refused without `allow_infeasible`, and
+what each run's `Simulation.warnings` says (a planned top speed short of the speed asked for, the places a vehicle
+cannot follow when allowed) is announced first. With `progress` one bar counts the runs
 (the current run named on it), and each run shows its metres as `workbench run` does.
 """
 
@@ -36,6 +37,7 @@ from tuning.own_tuning import tuned_controller
 from workbench.apps.controller_config import read_controller_config
 from workbench.base.console import warn_on_stderr
 from workbench.base.errors import WorkbenchInputError
+from workbench.simulation.feasibility import refuse_infeasible
 from workbench.simulation.limit_cycle import LimitCycle, detect_limit_cycle
 from workbench.simulation.metrics import METRIC_KEYS
 from workbench.simulation.plots import RunStyle, Stretch, run_styles
@@ -304,13 +306,18 @@ def compare(
     warn: Callable[[str], None] | None = warn_on_stderr,
     progress: bool = False,
     allow_long_run: bool = False,
+    allow_infeasible: bool = False,
 ) -> Comparison:
     """Simulate each run on `scenario` (a name, a waypoint file or a Scenario) with the same config. Every run is
-    built first (a bad input is refused before any simulation); what a vehicle cannot follow and a planned top
-    speed short of the config's (`Simulation.warnings`) are announced through `warn` before the first run (None:
+    built first (a bad input is refused before any simulation); a planned top speed short of the config's and
+    the controllers' own warnings (`Simulation.warnings`) are announced through `warn` before the first run (None:
     silent). progress: a bar on stderr counting the runs (naming the one being
     prepared or run), left on screen when done. A run that may simulate more than the bounds of `run_size` is
-    refused before any run starts, unless allow_long_run."""
+    refused before any run starts, unless allow_long_run. A path that one of the vehicles cannot follow at the
+    planned speed (`workbench.simulation.feasibility`) is refused before any run starts, naming each such vehicle,
+    the places and the limit (`feasibility.refuse_infeasible`, as `workbench run` refuses it), unless
+    allow_infeasible (`--allow-infeasible`): then it is announced through `warn` with the other warnings and run,
+    for a study of how the controllers fail there."""
     if not runs:
         raise WorkbenchInputError("a comparison needs at least one (controller, vehicle) run; got none")
     if len(set(runs)) != len(runs):
@@ -331,6 +338,8 @@ def compare(
             simulations.append(_simulation(spec, scenario, scenario_options, config))
             if not allow_long_run:
                 check_run_size(simulations[-1].size, spec.label, LONG_RUN_SHORTENED, "--allow-long-run")
+        if not allow_infeasible:
+            refuse_infeasible([m for sim in simulations for m in sim.path_warnings()])
         messages = [m for spec, sim in zip(runs, simulations, strict=True) for m in sim.warnings(spec.label)]
         if warn is not None:
             with tqdm.external_write_mode(file=sys.stderr):  # above the bar, not through it

@@ -12,7 +12,7 @@ from __future__ import annotations
 import dataclasses
 import html
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -22,6 +22,7 @@ from workbench.apps.studies.backends import Backend
 from workbench.apps.studies.spec import PlannedRun, StudySpec
 from workbench.apps.studies.store import RunStore, write_results
 from workbench.apps.studies.sweep import execute_runs
+from workbench.base.console import warn_on_stderr
 from workbench.base.errors import WorkbenchInputError, require_positive
 from workbench.simulation.scenarios import SCENARIOS
 from workbench.vehicles import load_vehicle
@@ -109,14 +110,17 @@ def plan_robustness(
     base_dir: Path | None = None,
     axes: Sequence[Axis] | None = None,
     allow_long_run: bool = False,
+    allow_infeasible: bool = False,
+    warn: Callable[[str], None] | None = warn_on_stderr,
 ) -> list[PlannedRun]:
     """Every run of the study: per controller, the base run and each axis's other values (axes: None for
     `robustness_axes(vehicle)`; the payload axis's runs keep the controller built for the nominal payload). Each
     axis's value is set on top of `conditions`. A study whose runs may simulate more than the
     bounds of `run_size` (a very low speed) is refused before any run, unless allow_long_run
-    (`--allow-long-run`)."""
-    if not allow_long_run:
-        _check_run_size(scenario, vehicle, speed_kmh, track_file, base_dir)
+    (`--allow-long-run`); so is a path the vehicle, at its own payload, cannot follow at the planned speed
+    (`feasibility.refuse_infeasible`, as `workbench run` refuses it), unless allow_infeasible
+    (`--allow-infeasible`): then where it cannot is said through `warn` (None: silent)."""
+    _check_path(scenario, vehicle, speed_kmh, track_file, base_dir, allow_long_run, allow_infeasible, warn)
     base = {"speed_kmh": speed_kmh, "conditions": conditions, "seed": seed}
     grids = [dict(base)]
     for axis in robustness_axes(vehicle) if axes is None else axes:
@@ -137,17 +141,29 @@ def plan_robustness(
             base_dir=base_dir or Path.cwd(),
             description="robustness",
             allow_long_runs=True,  # sized above, as the option asks
+            allow_infeasible=True,  # judged above, as the option asks
         )
         for run in spec.plan():
             runs.setdefault(run.run_id, run)
     return [dataclasses.replace(run, index=i) for i, run in enumerate(runs.values())]
 
 
-def _check_run_size(
-    scenario: str, vehicle: str, speed_kmh: float, track_file: Path | None, base_dir: Path | None
+def _check_path(
+    scenario: str,
+    vehicle: str,
+    speed_kmh: float,
+    track_file: Path | None,
+    base_dir: Path | None,
+    allow_long_run: bool,
+    allow_infeasible: bool,
+    warn: Callable[[str], None] | None,
 ) -> None:
-    """Refuse runs that may simulate more than the bounds of `run_size` (`check_run_size`): every run of the study
-    drives the scenario at the same speed, so one size is every run's."""
+    """Refuse runs that may simulate more than the bounds of `run_size` (`check_run_size`), unless
+    allow_long_run, and a path the vehicle cannot follow at the planned speed (`refuse_infeasible`), unless
+    allow_infeasible (then said through `warn`): every run of the study drives the scenario's path at the same
+    speed, so one planned path is every run's (the payload axis's lighter plants ask less of the vehicle than its
+    own payload)."""
+    from workbench.simulation.feasibility import path_feasibility_warnings, refuse_infeasible
     from workbench.simulation.run_config import SimulationConfig
     from workbench.simulation.run_size import RunSize, check_run_size
     from workbench.simulation.scenarios import ScenarioOptions, make_scenario
@@ -156,11 +172,17 @@ def _check_run_size(
     model = load_vehicle(vehicle)
     if scenario not in SCENARIOS:
         scenario = str((base_dir or Path.cwd()) / scenario)
-    path = make_scenario(scenario, ScenarioOptions(model.geometry.width_m, track_file)).path
     config = SimulationConfig(speed_kmh=speed_kmh)
-    size = RunSize.of(plan_path_speed(path, config), config, len(model.output_names))
-    shorten = f"a higher --speed (now {speed_kmh:g} km/h) shortens it"
-    check_run_size(size, f"each run on {path.name}", shorten, "--allow-long-run")
+    path = plan_path_speed(make_scenario(scenario, ScenarioOptions(model.geometry.width_m, track_file)).path, config)
+    if not allow_long_run:
+        size = RunSize.of(path, config, len(model.output_names))
+        shorten = f"a higher --speed (now {speed_kmh:g} km/h) shortens it"
+        check_run_size(size, f"each run on {path.name}", shorten, "--allow-long-run")
+    warnings = path_feasibility_warnings(path, model)
+    if not allow_infeasible:
+        refuse_infeasible(warnings)
+    for warning in warnings if warn is not None else ():
+        warn(warning)
 
 
 @dataclass(frozen=True)

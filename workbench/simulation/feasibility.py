@@ -1,8 +1,9 @@
 """Whether a vehicle can follow a path at the path's planned speed, checked before a run: where the path curves
 tighter than the vehicle steers, changes its curvature faster than the vehicle's steering can follow, or asks for
 more lateral acceleration than its rollover threshold or its tyres allow. A run through such a place ends with a
-large CTE (or a wheel lifted); the check says where and why first (`workbench run` refuses such a path unless
-told to run it anyway).
+large CTE (or a wheel lifted); the check says where and why first. Every command refuses such a path before any
+run, unless told to run it anyway, through one function with one text (`refuse_infeasible`): `workbench run`,
+`compare` and `robustness` (`--allow-infeasible`) and the study specs (`study.allow_infeasible = true`).
 
 Steering lock: the steady-state road-wheel angle a path of curvature kappa needs at speed v is
 atan(L kappa) + K v^2 kappa (Ackermann at the rear axle, L the wheelbase, plus the understeer gradient K of the
@@ -29,6 +30,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from collections.abc import Sequence
 from dataclasses import asdict, dataclass
 from typing import TYPE_CHECKING
 
@@ -62,6 +64,8 @@ STEERING_RATE_WINDOW_S = 1.5
 MERGE_GAP_M = 2.0
 #: A warning names at most this many places per reason, then says how many more.
 MAX_PLACES_NAMED = 3
+#: The command-line option that runs a path its vehicle cannot follow anyway (`refuse_infeasible`).
+ALLOW_INFEASIBLE_OPTION = "--allow-infeasible"
 _MPS_PER_KMH = 1.0 / 3.6
 
 
@@ -306,6 +310,25 @@ def _range_extremes(values: np.ndarray, first: np.ndarray, last: np.ndarray) -> 
 def check_path(path: ReferencePath, vehicle: VehicleModel) -> tuple[InfeasibleSpan, ...]:
     """`infeasible_spans` of the path (carrying its planned speed) for this vehicle model's limits."""
     return infeasible_spans(path, VehicleLimits.of(vehicle))
+
+
+def path_feasibility_warnings(path: ReferencePath, vehicle: VehicleModel) -> list[str]:
+    """`feasibility_warnings` of the path (carrying its planned speed) for this vehicle model: empty when the
+    vehicle can follow all of it."""
+    limits = VehicleLimits.of(vehicle)
+    return feasibility_warnings(path.name, limits, infeasible_spans(path, limits))
+
+
+def refuse_infeasible(warnings: Sequence[str], allow: str = ALLOW_INFEASIBLE_OPTION, about: str = "") -> None:
+    """Refuse a run on a path its vehicle cannot follow at the planned speed, before any run starts: a
+    WorkbenchInputError of one line, `about` (what is refused, e.g. a spec key, a file, a vehicle and a speed; ""
+    for nothing) then each distinct warning of `feasibility_warnings` (the path, the vehicle, the places with s in m
+    and the limit) joined by '; ', ending with '; `allow` runs it anyway'. Nothing when `warnings` is empty. The one
+    refusal of `workbench run`, `compare`, `robustness` and the study specs, so that each says the same."""
+    if not warnings:
+        return
+    prefix = f"{about}: " if about else ""
+    raise WorkbenchInputError(f"{prefix}{'; '.join(dict.fromkeys(warnings))}; {allow} runs it anyway")
 
 
 def _stretches(over: np.ndarray, path: ReferencePath) -> list[tuple[int, int]]:

@@ -20,7 +20,9 @@ file the spec names is read as the runs will read it (`_check_files`); a study p
 (`run_count`, from the axes' sizes, before anything is planned; an optimisation: trials x runs) is refused saying
 how many. Every planned value is then built into the objects its runs build (`value_check.py`): a value every run
 with it would refuse (speed_kmh = 0, laps = 0, initial_offset_m = 1000, a controller option out of its range) is
-refused naming the key and the value; a value refused only in combination with others stays that run's error.
+refused naming the key and the value; a value refused only in combination with others stays that run's error. A
+scenario a vehicle cannot follow at the study's fastest run is refused (`study_feasibility.py`) unless
+study.allow_infeasible.
 """
 
 from __future__ import annotations
@@ -42,6 +44,7 @@ from controllers import CONTROLLERS
 from workbench.apps.studies.condition_parameters import CONDITION_PARAMETERS, resolve_conditions
 from workbench.apps.studies.distributions import SEARCHABLE, Distribution, key_rng
 from workbench.apps.studies.run_build import EXTRA_RUN_PARAMETERS, LEAD_FILTER_SCALES
+from workbench.apps.studies.study_feasibility import check_feasibility
 from workbench.apps.studies.study_size import check_run_sizes
 from workbench.apps.studies.value_check import check_values
 from workbench.base.errors import WorkbenchInputError, value_text
@@ -90,6 +93,7 @@ STUDY_KEYS = (
     "description",
     "max_runs",
     "allow_long_runs",
+    "allow_infeasible",
 )
 OPTIMISE_KEYS = ("trials", "batch_size", "seed", "startup_trials", "aggregate", "objective", "search")
 SCENARIO_FILE_SUFFIXES = (".csv", ".txt")
@@ -331,7 +335,8 @@ class StudySpec:
     """A study: see the module docstring. base_dir: the folder relative paths are taken from (the spec file's).
     grid / random: run-parameter axes / distributions; controller_grid / controller_random: the same per
     controller; max_runs: the most runs the study may plan (an optimisation: trials x runs per trial);
-    allow_long_runs: let runs longer than the bounds of `run_size` start (`study_size.py`). Values are
+    allow_long_runs: let runs longer than the bounds of `run_size` start (`study_size.py`); allow_infeasible: let
+    runs start on a path a vehicle cannot follow at the planned speed (`study_feasibility.py`). Values are
     checked and typed on construction (paths made absolute, the files they name read)."""
 
     scenarios: Sequence[str]
@@ -350,11 +355,14 @@ class StudySpec:
     optimise: OptimiseSettings | None = None
     max_runs: int = DEFAULT_MAX_RUNS
     allow_long_runs: bool = False
+    allow_infeasible: bool = False
 
     def __post_init__(self) -> None:
         """Check and type the study, in this order: the names (controllers, scenarios, vehicles), the files and
         scalars of [study], the axes and draws, the samples, the optimisation, then its size and every file a run
-        will read, then every value planned, built into the objects its runs build (`value_check.py`)."""
+        will read, then every value planned, built into the objects its runs build (`value_check.py`), the
+        longest run's size (`study_size.py`) and whether each vehicle can follow each scenario's path
+        (`study_feasibility.py`)."""
         object.__setattr__(self, "base_dir", Path(self.base_dir).resolve())
         self._resolve_names()
         self._resolve_study_files()
@@ -369,6 +377,7 @@ class StudySpec:
         scenarios = self._check_files(models)
         check_values(self, models, scenarios)
         check_run_sizes(self, models, scenarios)
+        check_feasibility(self, models, scenarios)
 
     # ------------------------------------------------------------------------------------------- typing
     def _resolve_names(self) -> None:
@@ -412,10 +421,9 @@ class StudySpec:
                 object.__setattr__(self, name, check_input_file(path, f"study.{name}: file {str(value)!r}"))
 
     def _check_scalars(self) -> None:
-        if not isinstance(self.allow_long_runs, bool):
-            raise WorkbenchInputError(
-                f"study.allow_long_runs must be true or false; got {value_text(self.allow_long_runs)}"
-            )
+        for name in ("allow_long_runs", "allow_infeasible"):
+            if not isinstance(getattr(self, name), bool):
+                raise WorkbenchInputError(f"study.{name} must be true or false; got {value_text(getattr(self, name))}")
         if not isinstance(self.description, str):
             raise WorkbenchInputError(f"study.description must be text; got {self.description!r}")
         if isinstance(self.seed, bool) or not isinstance(self.seed, int) or self.seed < 0:
@@ -775,6 +783,7 @@ def _from_document(document: Mapping[str, Any], kind: str, base_dir: Path, max_r
         optimise=optimise,
         max_runs=max_runs if max_runs is not None else study.get("max_runs", DEFAULT_MAX_RUNS),
         allow_long_runs=study.get("allow_long_runs", False),
+        allow_infeasible=study.get("allow_infeasible", False),
     )
 
 

@@ -35,7 +35,7 @@ SHORTEN = "a higher speed_kmh, fewer laps or a max_time_s in [grid] shortens it"
 ALLOW = "study.allow_long_runs = true in [study]"
 
 
-def _planned_values(spec: Any) -> dict[str, tuple[str, list[Any]]]:
+def planned_values(spec: Any) -> dict[str, tuple[str, list[Any]]]:
     """Each run parameter the study plans: where it is in the spec and every value of it (grid and draws)."""
     values = {k: (f"grid.{k}", list(v)) for k, v in spec.grid.items()}
     values |= {k: (f"random.{k}", list(v)) for k, v in spec.drawn().items()}
@@ -59,7 +59,7 @@ def check_run_sizes(spec: Any, models: Mapping[str, Any], scenarios: Mapping[str
     """Refuse a study (`spec`, a typed StudySpec) whose longest run exceeds the bounds, unless
     spec.allow_long_runs, and laps on a study of open paths only. models: each vehicle's model; scenarios: each
     scenario built, by the spec's names."""
-    values = _planned_values(spec)
+    values = planned_values(spec)
     if "laps" in values and max(values["laps"][1]) > 1 and not any(s.path.closed for s in scenarios.values()):
         where, laps = values["laps"]
         raise WorkbenchInputError(
@@ -85,4 +85,4 @@ def check_run_sizes(spec: Any, models: Mapping[str, Any], scenarios: Mapping[str
             check_run_size(size, label, SHORTEN, ALLOW)
 
 
-__all__ = ["check_run_sizes", "longest_config"]
+__all__ = ["check_run_sizes", "longest_config", "planned_values"]
