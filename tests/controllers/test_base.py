@@ -6,6 +6,7 @@ import dataclasses
 import decimal
 import fractions
 import math
+import sys
 from typing import ClassVar
 
 import numpy as np
@@ -31,11 +32,13 @@ class _Scripted(Controller):
     config_type: ClassVar[type] = dict
 
     def _reset(self, path: ReferencePath, sample_time_s: float) -> None:
+        self.reset_with = (path, sample_time_s)
         self.seen: list[Measurement] = []
         self.next_command, self.signal = 0.1, 0.0
         self._signal = self._declare_diagnostics(("signal",))
 
     def _command(self, measurement: Measurement, path: ReferencePath) -> float:
+        assert path is PATH
         self.seen.append(measurement)
         self._signal[0] = self.signal
         return self.next_command
@@ -67,6 +70,10 @@ def test_a_plausible_measurement_reaches_the_controller_unchanged() -> None:
         ("t_s", 1.0),  # the same time again (zero dt)
         ("yaw_rad", 1e300),
         ("yaw_rad", -base.MAX_UNWRAPPED_YAW_RAD),
+        ("t_s", base.MAX_TIME_S),
+        ("yaw_rate_rad_s", base.MAX_YAW_RATE_RAD_S),
+        ("x_m", -base.MAX_POSITION_M),
+        ("y_m", base.MAX_POSITION_M),
     ],
 )
 def test_the_envelope_edges_are_plausible(field: str, value: float) -> None:
@@ -157,7 +164,7 @@ def test_the_flags_are_there_before_the_first_step() -> None:
 def test_a_bad_sample_time_is_refused_for_every_controller() -> None:
     from workbench.base.errors import WorkbenchInputError
 
-    with pytest.raises(WorkbenchInputError, match="sample_time_s"):
+    with pytest.raises(WorkbenchInputError, match=r"^sample_time_s must be a finite number > 0; got 0\.0$"):
         _Scripted(GEOMETRY).reset(PATH, 0.0)
 
 
@@ -251,3 +258,83 @@ def test_a_measurement_of_floats_reaches_the_controller_as_it_is() -> None:
     measured = Measurement(*np.array([1.0, 5.0, 0.5, 8.0, 0.0, 0.0, 0.0, 0.0]))
     controller.step(measured, PATH)
     assert controller.seen[-1] is measured
+
+
+SENSOR_RANGE = base.STEER_SENSOR_MARGIN * LOCK
+
+
+@pytest.mark.parametrize(
+    ("fields", "why"),
+    [
+        ({"x_m": math.nan, "yaw_rad": math.inf}, "x_m, yaw_rad not finite"),
+        ({"steer_wheel_rad": -30.0}, f"|steer_wheel_rad| = 30 is beyond the sensor's range {SENSOR_RANGE:g} rad"),
+        ({"vx_mps": 100.0, "vy_mps": 120.0}, "speed 156.205 m/s is above 150 m/s"),  # each alone is within it
+        ({"yaw_rate_rad_s": -11.0}, "|yaw_rate_rad_s| = 11 is above 10 rad/s"),
+        ({"x_m": 2e8}, "position (2e+08, 0.5) m is beyond +-1e+08 m"),
+        ({"y_m": -2e8}, "position (5, -2e+08) m is beyond +-1e+08 m"),
+        ({"t_s": 2e12}, "t_s = 2e+12 s is beyond +-1e+12 s"),
+        # each bound itself is plausible: the reason is the one field beyond its bound
+        ({"steer_wheel_rad": SENSOR_RANGE, "t_s": 2e12}, "t_s = 2e+12 s is beyond +-1e+12 s"),
+        ({"vx_mps": base.MAX_SPEED_MPS, "t_s": 2e12}, "t_s = 2e+12 s is beyond +-1e+12 s"),
+        ({"yaw_rate_rad_s": base.MAX_YAW_RATE_RAD_S, "t_s": 2e12}, "t_s = 2e+12 s is beyond +-1e+12 s"),
+        ({"x_m": base.MAX_POSITION_M, "y_m": base.MAX_POSITION_M, "t_s": 2e12}, "t_s = 2e+12 s is beyond +-1e+12 s"),
+    ],
+)
+def test_the_rejection_says_which_field_is_beyond_which_bound(fields: dict, why: str) -> None:
+    controller = _controller()
+    controller.step(GOOD, PATH)
+    controller.step(dataclasses.replace(GOOD, **fields), PATH)
+    assert controller.diagnostics["measurement_rejected"] == 1.0
+    assert controller.rejection == why
+
+
+def test_a_rejected_step_keeps_the_last_accepted_signals() -> None:
+    controller = _controller()
+    controller.signal = 7.0
+    controller.step(GOOD, PATH)
+    controller.signal = 3.0
+    controller.step(dataclasses.replace(GOOD, t_s=math.nan), PATH)
+    assert controller.diagnostics == {"signal": 7.0, "measurement_rejected": 1.0, "command_rejected": 0.0}
+
+
+def test_a_non_finite_command_says_so_and_a_reset_clears_the_reason() -> None:
+    controller = _controller()
+    assert controller.rejection == ""
+    controller.next_command = math.nan
+    controller.step(GOOD, PATH)
+    assert controller.rejection == "the controller's command or diagnostics were not finite"
+    controller.reset(PATH, 0.02)
+    assert controller.rejection == ""
+
+
+def test_the_yaw_is_wrapped_only_beyond_the_bound_and_nothing_else_changes() -> None:
+    controller = _controller()
+    controller.step(dataclasses.replace(GOOD, yaw_rad=base.MAX_UNWRAPPED_YAW_RAD), PATH)
+    assert controller.seen[-1].yaw_rad == base.MAX_UNWRAPPED_YAW_RAD  # at the bound: as measured
+    measured = Measurement(2.0, 6.0, 0.7, 8.5, 0.3, 2 * math.pi * 1e4 + 0.25, 0.4, 0.5)
+    controller.step(measured, PATH)
+    seen = controller.seen[-1]
+    assert seen.yaw_rad == pytest.approx(0.25, abs=1e-9)
+    assert dataclasses.replace(seen, yaw_rad=measured.yaw_rad) == measured
+
+
+def test_a_restart_on_a_reset_clock_keeps_the_path_and_sample_time() -> None:
+    controller = _Scripted(GEOMETRY)
+    controller.reset(PATH, 0.05)
+    controller.step(dataclasses.replace(GOOD, t_s=100.0), PATH)
+    for k in range(base.CLOCK_RESET_FRAMES):
+        controller.step(dataclasses.replace(GOOD, t_s=1.0 + k), PATH)
+    assert controller.reset_with == (PATH, 0.05)
+    assert controller.seen == [dataclasses.replace(GOOD, t_s=float(base.CLOCK_RESET_FRAMES))]
+
+
+def test_a_config_of_another_type_is_refused_naming_both() -> None:
+    with pytest.raises(TypeError, match=r"^scripted takes a dict; got list$"):
+        _Scripted(GEOMETRY, [])
+
+
+def test_the_summary_is_the_first_line_of_the_controllers_module_docstring() -> None:
+    from controllers.stanley import Stanley
+
+    assert Stanley.summary() == sys.modules[Stanley.__module__].__doc__.strip().splitlines()[0]
+    assert _Scripted.summary() == __doc__.strip().splitlines()[0]
