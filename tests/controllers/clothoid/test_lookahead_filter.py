@@ -137,3 +137,17 @@ def test_settings_are_allowed_up_to_their_bounds(kwargs: dict, allowed: bool) ->
     else:
         with pytest.raises(WorkbenchInputError, match=next(iter(kwargs))):
             LookaheadFilterSettings(**kwargs)
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "message"),
+    [
+        ({"hysteresis_m": 51.0}, "hysteresis_m must be a finite number in [0, 50] m; got 51.0"),
+        ({"max_growth_m_per_m": 0.0}, "max_growth_m_per_m must be a finite number in (0, 100] m per m"),
+        ({"max_shrink_m_per_m": 101.0}, "max_shrink_m_per_m must be a finite number in (0, 100] m per m"),
+    ],
+)
+def test_a_refused_setting_is_named_with_its_unit_and_range(kwargs: dict, message: str) -> None:
+    with pytest.raises(WorkbenchInputError) as refused:
+        LookaheadFilterSettings(**kwargs)
+    assert str(refused.value).startswith(message)

@@ -164,3 +164,12 @@ def test_a_limit_cycle_is_found_in_a_simulated_run() -> None:
     assert not quiet.limit_cycle and quiet.limit_cycle_hz is None
     assert weaving.limit_cycle and 0.5 < weaving.limit_cycle_hz < 1.2 and weaving.limit_cycle_amplitude_deg > 50.0
     assert weaving.steer_oscillation_deg > 2 * quiet.steer_oscillation_deg
+
+
+def test_offtracking_is_the_signed_sideways_distance_from_the_path() -> None:
+    """Beside a straight path along x: the offset is y, left positive; behind its start still sideways only."""
+    from workbench.simulation.metrics import offtracking
+
+    path = ClothoidChain().straight(100.0).to_path("straight")
+    assert offtracking(path, [10, 20, 30], [1, -2, 0]).tolist() == pytest.approx([1.0, -2.0, 0.0], abs=1e-9)
+    assert offtracking(path, np.array([-5.0]), np.array([0.5])) == pytest.approx([0.5], abs=1e-9)
