@@ -13,6 +13,7 @@ from hypothesis import strategies as st
 from workbench.apps.comparison import RunSpec, compare
 from workbench.base.clothoid_chain import ClothoidChain
 from workbench.base.errors import WorkbenchInputError
+from workbench.base.path import ReferencePath
 from workbench.simulation.metrics import METRIC_KEYS, Metrics, compute_metrics
 
 G = 9.80665
@@ -173,3 +174,49 @@ def test_offtracking_is_the_signed_sideways_distance_from_the_path() -> None:
     path = ClothoidChain().straight(100.0).to_path("straight")
     assert offtracking(path, [10, 20, 30], [1, -2, 0]).tolist() == pytest.approx([1.0, -2.0, 0.0], abs=1e-9)
     assert offtracking(path, np.array([-5.0]), np.array([0.5])) == pytest.approx([0.5], abs=1e-9)
+
+
+def test_the_run_is_named_as_given() -> None:
+    path = ClothoidChain().straight(100.0).to_path("straight")
+    m = compute_metrics(
+        _straight_trace(), path, scenario="dlc", controller="nmpc", vehicle="truck", completed=False, path_length_m=1.0
+    )
+    assert (m.scenario, m.controller, m.vehicle, m.completed) == ("dlc", "nmpc", "truck", False)
+
+
+@pytest.mark.parametrize("n", [1, 2])
+def test_one_or_two_samples(n: int) -> None:
+    """One sample: no distance, no rate; two: the distance and the one rate between them."""
+    m = _metrics({k: v[:n] for k, v in _straight_trace(dt=0.1, speed=5.0).items()})
+    assert m.distance_m == pytest.approx(0.5 * (n - 1), abs=1e-12)
+    if n == 1:
+        assert m.max_abs_steer_rate_deg_s is None and m.rms_steer_rate_deg_s is None
+    else:
+        assert m.max_abs_steer_rate_deg_s == pytest.approx(10.0, rel=1e-9)
+        assert m.rms_steer_rate_deg_s == pytest.approx(10.0, rel=1e-9)
+
+
+def test_touching_the_track_edge_is_not_leaving_it() -> None:
+    """A car 1.6 m wide on the centre line of a track 0.8 m either side: margin 0, on the track."""
+    from workbench.simulation.track_margin import VehicleOutline
+
+    plain = ClothoidChain().straight(100.0).to_path("straight")
+    n = plain.x_m.size
+    path = ReferencePath(
+        plain.x_m, plain.y_m, plain.heading_rad, plain.curvature_1pm, plain.spacing_m, plain.closed,
+        name="track", width_left_m=np.full(n, 0.8), width_right_m=np.full(n, 0.8),
+    )  # fmt: skip
+    trace = _straight_trace()
+    trace["y_m"] = np.zeros(trace["t_s"].size)
+    trace["yaw_rad"] = np.zeros(trace["t_s"].size)
+    trace["path_s_m"] = trace["x_m"].copy()
+    outline = VehicleOutline(width_m=1.6, front_m=3.4, rear_m=1.1)
+    m = compute_metrics(
+        trace, path, scenario="s", controller="c", vehicle="v", completed=True, path_length_m=100.0, outline=outline
+    )
+    assert m.min_track_margin_m == 0.0 and m.left_track is False
+    trace["y_m"] = np.full(trace["t_s"].size, 0.01)
+    m = compute_metrics(
+        trace, path, scenario="s", controller="c", vehicle="v", completed=True, path_length_m=100.0, outline=outline
+    )
+    assert m.min_track_margin_m == pytest.approx(-0.01, abs=1e-9) and m.left_track is True
