@@ -9,14 +9,15 @@ workers change how fast a study runs, never its rows (but for the wall-clock TIM
   that has imported the workbench once (`start_context`), so a worker starts in milliseconds. Each worker ignores
   SIGINT and SIGTERM: the study's process owns its workers. Closing the pool while runs are in progress (an
   interrupted study) cancels the queued runs and kills the workers (SIGKILL: a worker holds nothing worth saving,
-  the rows are written by the study's process), so the study stops in milliseconds rather than when its longest
-  run ends; a worker also leaves by itself within ORPHAN_CHECK_S when the study's process is gone.
+  the rows are written by the study's process), so the study stops within a fraction of a second rather than when
+  its longest run ends; a worker also leaves by itself within ORPHAN_CHECK_S when the study's process is gone.
 - `DaskBackend(scheduler, workers)`: `dask.distributed`; with no scheduler address a `LocalCluster` of `workers`
   single-threaded worker processes, else the cluster at that address, `tcp://HOST:PORT` (its workers must have this
   package installed and see the files the spec names); a scheduler that does not answer within
-  SCHEDULER_TIMEOUT_S is refused. Closing it cancels the runs in progress. Workers of either backend run BLAS/OpenMP
-  on one thread each
-  (`threadpoolctl`; a Dask worker plugin). A run whose worker dies each time it runs it (Dask's
+  SCHEDULER_TIMEOUT_S is refused. Closing it cancels the runs in progress and stops the LocalCluster, whose
+  workers keep SIGINT blocked (Ctrl-C reaches only the study's process) and log only critical failures
+  (CLUSTER_LOG_LEVEL). Workers of either backend are prepared alike (`worker_setup.prepare_worker_process`: BLAS
+  and OpenMP on one thread each; a Dask worker plugin). A run whose worker dies each time it runs it (Dask's
   `KilledWorker`) is recorded as an error row; any other failure of the machinery stops the study, keeping the
   rows already written.
 
@@ -40,10 +41,9 @@ from contextlib import contextmanager
 from types import TracebackType
 from typing import Any, Protocol, Self
 
-from threadpoolctl import threadpool_limits
-
 from workbench.apps.studies.runner import execute_run, failed_row
 from workbench.apps.studies.spec import PlannedRun
+from workbench.apps.studies.worker_setup import prepare_worker_process
 from workbench.base.errors import WorkbenchInputError, value_text
 from workbench.simulation.plot_worker import usable_cpus
 
@@ -61,6 +61,10 @@ ORPHAN_CHECK_S = 1.0
 KILLED_WORKER_JOIN_S = 2.0
 #: How long (s) connecting to a dask scheduler may take before it is refused as unreachable.
 SCHEDULER_TIMEOUT_S = 10.0
+#: What a LocalCluster's scheduler, nannies and workers log: critical failures only. Its other errors reach the
+#: study as its runs' errors (a run's exception, a worker that died: KilledWorker, the cluster unable to run a task);
+#: logged, they are tracebacks of the workers' connections when an interrupted study stops its busy workers.
+CLUSTER_LOG_LEVEL = logging.CRITICAL
 #: The most workers per usable CPU. A run is single-threaded and CPU-bound, so workers beyond the CPUs only share
 #: them (no run ends sooner) while each holds its own copy of the workbench in memory (~0.2-0.3 GB with numba's
 #: kernels loaded); a few per CPU still leaves room to measure that.
@@ -126,16 +130,14 @@ def _require_scheduler(scheduler: object) -> None:
 
 
 def _init_worker(parent_pid: int) -> None:
-    """A local worker runs its numerical libraries on one thread (a run is one CPU's work: OpenBLAS would otherwise
-    start a thread per CPU in every worker, and the workers would compete for the CPUs), ignores SIGINT and SIGTERM
-    (Ctrl-C reaches the whole process group; the study's process stops the pool) and leaves when the study's
-    process is gone (killed without cleaning up). A forked worker starts with the stop signals blocked
-    (`_stop_signals_blocked`), so that the study's own handlers, which it inherits, never run in it; they are
-    unblocked once ignored."""
+    """A local worker is prepared as every worker is (`prepare_worker_process`), ignores SIGINT and SIGTERM (Ctrl-C
+    reaches the whole process group; the study's process stops the pool) and leaves when the study's process is gone
+    (killed without cleaning up). A forked worker starts with the stop signals blocked (`_stop_signals_blocked`), so
+    that the study's own handlers, which it inherits, never run in it; they are unblocked once ignored."""
     for signum in _STOP_SIGNALS:
         signal.signal(signum, signal.SIG_IGN)
     signal.pthread_sigmask(signal.SIG_UNBLOCK, _STOP_SIGNALS)
-    threadpool_limits(1)
+    prepare_worker_process()
 
     def watch() -> None:
         while True:
@@ -167,10 +169,11 @@ def start_context() -> multiprocessing.context.BaseContext:
 
 
 @contextmanager
-def _stop_signals_blocked() -> Iterator[None]:
-    """Block SIGINT and SIGTERM in this thread while local workers may be forked (they inherit the mask and unblock
-    the signals in `_init_worker`, after ignoring them); a signal that arrives meanwhile is delivered on leaving."""
-    previous = signal.pthread_sigmask(signal.SIG_BLOCK, _STOP_SIGNALS)
+def _stop_signals_blocked(signals: frozenset[signal.Signals] = _STOP_SIGNALS) -> Iterator[None]:
+    """Block `signals` (SIGINT and SIGTERM) in this thread while worker processes may be started: they and the
+    threads started meanwhile inherit the mask (local workers unblock the signals in `_init_worker`, after ignoring
+    them); a signal that arrives meanwhile is delivered to this thread on leaving."""
+    previous = signal.pthread_sigmask(signal.SIG_BLOCK, signals)
     try:
         yield
     finally:
@@ -307,13 +310,16 @@ class DaskBackend(_StartedInWith):
                     f"cannot reach the dask scheduler {self.scheduler!r} within {SCHEDULER_TIMEOUT_S:g} s: {exc}"
                 ) from None
         else:
-            self._cluster = LocalCluster(
-                n_workers=self.workers,
-                threads_per_worker=1,
-                processes=True,
-                dashboard_address=None,
-                silence_logs=logging.ERROR,
-            )
+            # Ctrl-C reaches the whole process group: the cluster's worker processes (and the thread that starts
+            # them) keep SIGINT blocked, so only this process receives it, and stops them through their nannies.
+            with _stop_signals_blocked(frozenset({signal.SIGINT})):
+                self._cluster = LocalCluster(
+                    n_workers=self.workers,
+                    threads_per_worker=1,
+                    processes=True,
+                    dashboard_address=None,
+                    silence_logs=CLUSTER_LOG_LEVEL,
+                )
             self._client = Client(self._cluster)
         from workbench.apps.studies.dask_worker import SingleThreadedLibraries
 
@@ -373,4 +379,13 @@ def make_backend(name: str = "local", scheduler: str | None = None, workers: int
     return DaskBackend(scheduler, workers)
 
 
-__all__ = ["BACKENDS", "Backend", "BackendError", "DaskBackend", "LocalBackend", "default_workers", "make_backend"]
+__all__ = [
+    "BACKENDS",
+    "Backend",
+    "BackendError",
+    "DaskBackend",
+    "LocalBackend",
+    "default_workers",
+    "make_backend",
+    "max_workers",
+]

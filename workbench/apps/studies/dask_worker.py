@@ -1,20 +1,22 @@
-"""What a Dask worker runs once before a study's runs: numerical libraries limited to one thread (`threadpoolctl`),
-as in the local pool's workers, so each run uses one CPU and gives the same numbers however the cluster is laid
-out. Imported only by the Dask backend (it needs `distributed`)."""
+"""What a Dask worker runs once before a study's runs: what a local pool's worker does
+(`worker_setup.prepare_worker_process`: numerical libraries limited to one thread, so each run uses one CPU and
+gives the same numbers however the cluster is laid out; tqdm on a thread lock). Imported only by the Dask backend
+(it needs `distributed`)."""
 
 from __future__ import annotations
 
 from distributed.diagnostics.plugin import WorkerPlugin
-from threadpoolctl import threadpool_limits
+
+from workbench.apps.studies.worker_setup import prepare_worker_process
 
 
 class SingleThreadedLibraries(WorkerPlugin):
-    """Limit BLAS/OpenMP thread pools to one thread on every worker, present and future."""
+    """Prepare every worker, present and future, as a local pool's worker is."""
 
     name = "workbench-single-threaded-libraries"
 
     def setup(self, worker: object) -> None:
-        threadpool_limits(1)
+        prepare_worker_process()
 
 
 __all__ = ["SingleThreadedLibraries"]

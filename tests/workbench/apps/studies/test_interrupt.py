@@ -182,4 +182,5 @@ def test_a_dask_sweep_stops_its_local_cluster_and_says_so(tmp_path: Path) -> Non
     )
     _assert_stopped(stderr, descendants, out)
     assert "stopped the dask LocalCluster, 2 single-threaded worker processes (runs in progress abandoned)" in stderr
+    assert len(stderr.strip().splitlines()) == 1, stderr  # that line only: no log of the workers' connections
     assert _row_ids(out) == set(fast)
