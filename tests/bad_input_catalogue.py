@@ -40,16 +40,27 @@ def _circle_csv(radius_m: float, n: int = 60) -> str:
         f"{radius_m * math.cos(2 * math.pi * i / n):.4f},{radius_m * math.sin(2 * math.pi * i / n):.4f}"
         for i in range(n)
     ]
-    return "x_m,y_m\n" + "\n".join(rows + [rows[0]]) + "\n"
+    return "x_m,y_m\n" + "\n".join([*rows, rows[0]]) + "\n"
 
 
 GOOD_WAYPOINTS = "x_m,y_m\n" + "".join(f"{x},{0.02 * x:.3f}\n" for x in range(0, 61, 5))
 GOOD_TRACK = "# x_m,y_m,w_tr_right_m,w_tr_left_m\n" + "".join(
     f"{60 * math.cos(2 * math.pi * i / 80):.3f},{40 * math.sin(2 * math.pi * i / 80):.3f},5.0,5.0\n" for i in range(80)
 )
-GOOD_LOG = "t_s,steer_wheel_deg,speed_mps,x_m,y_m\n" + "".join(
-    f"{0.02 * i:.2f},{30 * math.sin(0.02 * i):.4f},8.33,{8.33 * 0.02 * i:.4f},0.0\n" for i in range(500)
-)
+
+
+def _turning_log(duration_s: float = 20.0, step_s: float = 0.02, speed_mps: float = 8.33) -> str:
+    """A kinematic car (wheelbase 2.579 m, ratio 15) weaving at 0.5 rad/s: a log `fit-lag` can fit."""
+    rows, x, y, yaw = [], 0.0, 0.0, 0.0
+    for i in range(round(duration_s / step_s)):
+        steer_deg = 30.0 * math.sin(0.5 * i * step_s)
+        rows.append(f"{i * step_s:.2f},{steer_deg:.4f},{speed_mps},{x:.4f},{y:.4f}\n")
+        yaw += speed_mps * math.tan(math.radians(steer_deg) / 15.0) / 2.579 * step_s
+        x, y = x + speed_mps * math.cos(yaw) * step_s, y + speed_mps * math.sin(yaw) * step_s
+    return "t_s,steer_wheel_deg,speed_mps,x_m,y_m\n" + "".join(rows)
+
+
+GOOD_LOG = _turning_log()
 GOOD_LAG = {"format": "steering-lag/1", "omega_n_rad_s": 4.44, "zeta": 0.8, "delay_s": 0.0, "steady_state_gain": 0.94}
 GOOD_LEAD = {"format": "lead-filter/1", "omega_z_rad_s": 4.44, "psi": 0.8, "omega_p_rad_s": 13.3}
 GOOD_LIMITS = "speed_kmh,max_curvature_1pm,max_curvature_rate_1pm_s\n10,0.2,0.1\n50,0.05,0.05\n100,0.02,0.02\n"
@@ -65,8 +76,11 @@ GOOD_OPTIMISE = GOOD_SPEC + """
 [optimise]
 trials = 2
 
-[optimise.pure-pursuit]
-lookahead_gain_s = [0.3, 1.5]
+[optimise.objective]
+rms_cte_m = 1.0
+
+[optimise.search]
+lookahead_gain_s = { uniform = [0.3, 1.5] }
 """
 GOOD_CONTROLLER_CONFIG = "[pure-pursuit]\nlookahead_gain_s = 0.8\n\n[stanley]\ngain_per_s = 4.0\n"
 
@@ -157,7 +171,7 @@ def files() -> dict[str, str | bytes | None]:
         "lead-schedule.json": json.dumps({**GOOD_LEAD, "schedule": [
             {"speed_kmh": 50, "omega_z_rad_s": 4.4, "psi": 0.8, "omega_p_rad_s": 13.0},
             {"speed_kmh": 30, "omega_z_rad_s": 4.4, "psi": 0.8, "omega_p_rad_s": 13.0},
-        ]}),  # fmt: skip
+        ]}),
         "lead-pole-below-zero.json": json.dumps({**GOOD_LEAD, "omega_p_rad_s": 1.0}),
         # limits files
         "limits-nan.csv": GOOD_LIMITS.replace("0.05,0.05", "nan,0.05"),
@@ -270,11 +284,15 @@ def _spec_mutations() -> Iterator[tuple[str, str]]:
     yield "max-runs-zero", base.replace("[study]\n", "[study]\nmax_runs = 0\n")
     yield "huge", base.replace("speed_kmh = [20, 30]", "speed_kmh = [" + ", ".join(str(20 + i * 1e-3) for i in range(
         3000)) + "]").replace("[study]\n", "[study]\nmax_runs = 100\n")  # fmt: skip
-    yield "optimise-no-trials", base + "\n[optimise]\n[optimise.pure-pursuit]\nlookahead_gain_s = [0.3, 1.5]\n"
-    yield "optimise-zero-trials", base + "\n[optimise]\ntrials = 0\n[optimise.pure-pursuit]\nlookahead_gain_s = [0.3, 1.5]\n"
-    yield "optimise-bad-range", base + "\n[optimise]\ntrials = 2\n[optimise.pure-pursuit]\nlookahead_gain_s = [1.5, 0.3]\n"
-    yield "optimise-unknown-option", base + "\n[optimise]\ntrials = 2\n[optimise.pure-pursuit]\ngain = [0.3, 1.5]\n"
+    searched = "\n[optimise.objective]\nrms_cte_m = 1.0\n"
+    searched += "[optimise.search]\nlookahead_gain_s = { uniform = [0.3, 1.5] }\n"
+    yield "optimise-no-trials", base + "\n[optimise]" + searched
+    yield "optimise-zero-trials", base + "\n[optimise]\ntrials = 0" + searched
+    yield "optimise-bad-range", base + "\n[optimise]\ntrials = 2" + searched.replace("[0.3, 1.5]", "[1.5, 0.3]")
+    yield "optimise-unknown-option", base + "\n[optimise]\ntrials = 2" + searched.replace("lookahead_gain_s", "gain")
+    yield "optimise-unknown-draw", base + "\n[optimise]\ntrials = 2" + searched.replace("uniform", "gaussian")
     yield "optimise-bad-objective", base + '\n[optimise]\ntrials = 2\nobjective = "fastest"\n'
+    yield "optimise-unknown-metric", base + "\n[optimise]\ntrials = 2\n[optimise.objective]\nspeed = 1.0\n"
 
 
 def _is_number(text: str) -> bool:
@@ -295,26 +313,26 @@ BROKEN_FILES = ("no-such-file.any", "folder", "empty.any", "binary.any", "latin1
 WB_BASE = {
     "run": ("run", "good.csv", "--controller", "pure-pursuit", "--out", "out", "--no-plots"),
     "compare": ("compare", "good.csv", "--controllers", "pure-pursuit,stanley", "--vehicle", "kinematic-bicycle",
-                "--out", "out", "--no-plots"),  # fmt: skip
+                "--out", "out", "--no-plots"),
     "fig17": ("fig17", "--out", "out"),
     "paper": ("paper", "--out", "out"),
     "robustness": ("robustness", "good.csv", "--controllers", "pure-pursuit", "--vehicle", "kinematic-bicycle", "--out",
-                   "out"),  # fmt: skip
+                   "out"),
     "sweep": ("sweep", "spec.toml", "--out", "out", "--no-plots"),
     "optimise": ("optimise", "optimise.toml", "--out", "out"),
 }
 TUNING_BASE = {
     "generate-data": ("generate-data", "--vehicle", "kinematic-bicycle", "--maneuver", "step", "--speed", "30", "--out",
-                      "new-log.csv"),  # fmt: skip
+                      "new-log.csv"),
     "fit-lag": ("fit-lag", "log.csv", "--vehicle", "kinematic-bicycle", "--out", "new-lag.json"),
     "design-lead": ("design-lead", "--lag", "lag.json", "--out", "new-lead.json"),
     "rollover-limits": ("rollover-limits", "--vehicle", "tractor-semitrailer", "--speeds", "30,60", "--out",
-                        "new-limits.csv"),  # fmt: skip
+                        "new-limits.csv"),
     "steering-limits": ("steering-limits", "--vehicle", "kinematic-bicycle", "--speeds", "30,60", "--out",
-                        "new-limits.csv"),  # fmt: skip
-    "schedule": ("schedule", "--vehicle", "kinematic-bicycle", "--speeds", "30", "--out", "new-lead.json"),
+                        "new-limits.csv"),
+    "schedule": ("schedule", "--vehicle", "dynamic-bicycle", "--speeds", "30", "--out", "new-lead.json"),
     "margins": ("margins", "--lag", "lag.json", "--lead", "lead.json", "--vehicle", "kinematic-bicycle", "--speeds",
-                "30", "--out", "margins.csv"),  # fmt: skip
+                "30", "--out", "margins.csv"),
 }
 
 #: Number options: (programs' commands having it, option, the bad values that do not apply to it, i.e. are valid).
@@ -369,6 +387,9 @@ MEANINGFUL = {
     "tuning-schedule---max-cascade-peak-db=0": "a cascade without any resonance peak",
     "tuning-schedule---max-cascade-peak-db=1e-300": "as 0 dB",
     "tuning-generate-data---amplitude-deg=-1": "a step to the right",
+    "tuning-generate-data---amplitude-deg=1e-300": "the plant driven straight: a log's noise floor",
+    "tuning-generate-data---lat-accel-g=1e-300": "as an amplitude of (nearly) zero",
+    "tuning-generate-data---max-rate-deg-s=1e-300": "the steering held: the plant driven straight",
     "tuning-margins---gain-margin-db=0": "stability alone, no gain margin asked",
     "tuning-margins---gain-margin-db=1e-300": "as 0 dB",
     "tuning-margins---phase-margin-deg=0": "stability alone, no phase margin asked",
@@ -376,6 +397,9 @@ MEANINGFUL = {
     "tuning-margins---prediction-time-s=1e-300": "no prediction, as 0 s",
     "tuning-schedule---prediction-time-s=1e-300": "no prediction, as 0 s",
     "tuning-rollover-limits---payload-kg=1e-300": "an empty trailer",
+    "tuning-fit-lag---max-speed-variation=0": "a log held at exactly one speed (this one is)",
+    "tuning-fit-lag---max-speed-variation=1e-300": "as 0",
+    "tuning-fit-lag---smooth-s=1e-300": "no smoothing, as 0 s",
     "tuning-generate-data---max-rate-deg-s=1e308": "no steering-rate limit",
     "workbench-robustness---max-cte=1e308": "every run that completes passes",
     "workbench-robustness---max-cte=1e-300": "no run passes: a strict judge",
@@ -417,6 +441,11 @@ def cases() -> list[Case]:
     add = made.append
     names = files()
     bases = {"workbench": WB_BASE, "tuning": TUNING_BASE}
+
+    # every baseline is itself accepted, so that each refusal below is the mutation's
+    for program, commands in bases.items():
+        for command, base in commands.items():
+            add(Case(f"{program}-{command}-baseline", program, base, ACCEPTED))
 
     # bad numbers on every number option
     for program, commands, option, valid in NUMBER_OPTIONS:

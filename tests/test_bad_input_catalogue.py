@@ -1,17 +1,25 @@
 """Every case of the bad-input catalogue (tests/bad_input_catalogue.py) over both command lines: a bad input is
 refused cleanly (exit code 2, an `error:` line naming it, no traceback), a meaningful one accepted. Each case runs
 in-process in a folder holding the catalogue's files; the work an accepted input reaches (a simulation, a study's
-backend, a tuning's fit) is stopped at its door, so that no case runs for long."""
+backend, a tuning command's slow part) is stopped at its door, so that no case runs for long, and so that a
+refusal that comes only once the work has started counts as a failure: bad input is refused before any work."""
 
 from __future__ import annotations
 
+import importlib
 from pathlib import Path
 
 import pytest
-
 from bad_input_catalogue import ACCEPTED, REFUSED, Case, cases, files
 
 CASES = cases()
+#: Where the slow work of a tuning command starts, after its inputs are checked (the commands look these up in
+#: their modules when they run): identifying a schedule's lags, a margins study, a rollover series.
+THE_WORK = (
+    ("tuning.schedule", "identification_logs"),
+    ("tuning.margins", "run_margins"),
+    ("tuning.rollover", "rollover_limits"),
+)
 
 
 class ReachedTheWork(BaseException):
@@ -41,12 +49,16 @@ def _run(case: Case, folder: Path, monkeypatch: pytest.MonkeyPatch) -> int | Non
     """The case's exit code, or None when it reached the work."""
     import tuning.cli
     import workbench.apps.cli
-    import workbench.apps.studies
+    from workbench.apps.studies.backends import DaskBackend, LocalBackend
     from workbench.simulation.simulator import Simulation
 
     monkeypatch.chdir(folder)
     monkeypatch.setattr(Simulation, "run", _stop)
-    monkeypatch.setattr(workbench.apps.studies, "make_backend", _stop)
+    for backend in (LocalBackend, DaskBackend):  # made (its options checked), never started
+        monkeypatch.setattr(backend, "start", _stop)
+        monkeypatch.setattr(backend, "map_runs", _stop)
+    for module, function in THE_WORK:
+        monkeypatch.setattr(importlib.import_module(module), function, _stop)
     main = workbench.apps.cli.main if case.program == "workbench" else tuning.cli.main
     try:
         return main(list(case.argv))
@@ -66,7 +78,8 @@ def test_the_case(case: Case, catalogue_files: Path, tmp_path: Path, monkeypatch
     out, err = capsys.readouterr()
     assert "Traceback" not in err + out, f"{case.id}: a traceback\n{err[-2000:]}"
     if case.expect == REFUSED:
-        assert code == 2, f"{case.id}: exit code {code!r}, expected a refusal (2)\nstdout: {out[-600:]}\nstderr: {err[-600:]}"
+        shown = f"stdout: {out[-600:]}\nstderr: {err[-600:]}"
+        assert code == 2, f"{case.id}: exit code {code!r}, expected a refusal (2)\n{shown}"
         errors = [line for line in err.splitlines() if " error: " in line or line.startswith(f"{case.program}: error")]
         assert len(errors) == 1, f"{case.id}: expected one error line, got {errors}\n{err[-1000:]}"
     else:

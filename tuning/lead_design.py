@@ -243,6 +243,19 @@ def _phase_deg(tf: control.TransferFunction, omega: float) -> float:
     return float(np.degrees(np.unwrap(np.angle(response))[-1]))
 
 
+#: The allowed bound on the peak of |G_lead| (linear) and on the cascade's peak (dB).
+MAX_LEAD_GAIN_RANGE = (1.0, 1000.0)
+MAX_CASCADE_PEAK_DB_RANGE = (0.0, 20.0)
+
+
+def check_design_bounds(max_lead_gain: float, max_cascade_peak_db: float | None = None) -> None:
+    """Refuse a design bound outside its range (MAX_LEAD_GAIN_RANGE, MAX_CASCADE_PEAK_DB_RANGE), naming it: every
+    design checks its bounds here, and a schedule before it identifies anything."""
+    require_in_range("max_lead_gain", max_lead_gain, *MAX_LEAD_GAIN_RANGE)
+    if max_cascade_peak_db is not None:
+        require_in_range("max_cascade_peak_db", max_cascade_peak_db, *MAX_CASCADE_PEAK_DB_RANGE, "dB")
+
+
 def design_lead(
     lag: SteeringLag,
     max_lead_gain: float = DEFAULT_MAX_LEAD_GAIN,
@@ -252,8 +265,7 @@ def design_lead(
     """Design Eq. 6 for `lag` by the criterion of the module docstring. max_lead_gain: bound on the peak of
     |G_lead| (linear, >= 1); max_cascade_peak_db: bound on the cascade's peak (dB, >= 0); phase_frequency_rad_s:
     where the phases are reported (rad/s; default: the plant's -3 dB bandwidth)."""
-    require_in_range("max_lead_gain", max_lead_gain, 1.0, 1000.0)
-    require_in_range("max_cascade_peak_db", max_cascade_peak_db, 0.0, 20.0, "dB")
+    check_design_bounds(max_lead_gain, max_cascade_peak_db)
     if phase_frequency_rad_s is not None:
         require_in_range("phase_frequency_rad_s", phase_frequency_rad_s, 1e-3, 1e4, "rad/s")
     problem = _Problem(lag, max_lead_gain, max_cascade_peak_db)
@@ -422,7 +434,7 @@ def _design_lead_for_margins(
     phase_margin_deg: float,
     gain_margin_db: float,
 ) -> MarginsDesign:
-    require_in_range("max_lead_gain", max_lead_gain, 1.0, 1000.0)
+    check_design_bounds(max_lead_gain)
     require_in_range("speed_mps", speed_mps, 0.1, 100.0, "m/s")
     floor_args = (speed_mps, min_lookahead_m, max_lookahead_m, lookahead_step_m, path_curvatures_1pm,
                   phase_margin_deg, gain_margin_db)  # fmt: skip

@@ -42,6 +42,7 @@ from tuning.lead_design import (
     DEFAULT_MAX_LEAD_GAIN,
     LeadDesign,
     MarginsDesign,
+    check_design_bounds,
     design_lead,
     design_lead_for_margins,
 )
@@ -53,6 +54,8 @@ from workbench.vehicles.base import VehicleModel
 from workbench.vehicles.steering_lag import SteeringLag
 
 DEFAULT_LAT_ACCEL_G = 0.1
+#: The identification maneuvers' kinematic lateral acceleration may be set within this range (g).
+LAT_ACCEL_RANGE_G = (0.001, 1.0)
 SCHEDULE_MANEUVERS = ("dlc", "step-series", "chirp")
 #: The identification maneuvers ask at most this fraction of the vehicle's steering-wheel rate limit (their steps
 #: become ramps, the chirp's amplitude falls at high frequency), so that the actuator stays linear.
@@ -274,7 +277,7 @@ def identification_logs(
     """Open-loop logs at speed_kmh, each profile's amplitude giving lat_accel_g of kinematic lateral acceleration,
     its steering-wheel rate at most IDENTIFICATION_RATE_FRACTION of the vehicle's rate limit."""
     require_in_range("speed_kmh", speed_kmh, *SPEED_RANGE_KMH, "km/h")
-    require_in_range("lat_accel_g", lat_accel_g, 0.001, 1.0, "g")
+    require_in_range("lat_accel_g", lat_accel_g, *LAT_ACCEL_RANGE_G, "g")
     amplitude = steer_amplitude_deg(vehicle, speed_kmh, lat_accel_g)
     max_rate = IDENTIFICATION_RATE_FRACTION * math.degrees(vehicle.geometry.max_steer_wheel_rate_rad_s)
     logs = []
@@ -336,6 +339,8 @@ def identify_schedule(
         raise WorkbenchInputError(f"design must be one of {', '.join(DESIGNS)}; got {design!r}")
     require_in_range("controller_rate_hz", controller_rate_hz, 1.0, 1000.0, "Hz")
     require_in_range("prediction_time_s", prediction_time_s, 0.0, 2.0, "s")
+    require_in_range("lat_accel_g", lat_accel_g, *LAT_ACCEL_RANGE_G, "g")  # before any speed is identified
+    check_design_bounds(max_lead_gain, max_cascade_peak_db)
     options = fit_options or LagFitOptions()
     measured_options = dataclasses.replace(options, curvature_from="yaw-rate")
     settings = LoopSettings(sample_time_s=1.0 / controller_rate_hz, prediction_time_s=prediction_time_s)

@@ -81,5 +81,5 @@ def test_a_study_grids_conditions_and_their_fields(tmp_path: Path) -> None:
     with pytest.raises(WorkbenchInputError, match=r"missing\.toml"):
         load_spec(spec)
     spec.write_text(spec.read_text().replace('"missing.toml"', '"ideal2"'))
-    with pytest.raises(WorkbenchInputError, match="neither a preset"):
+    with pytest.raises(WorkbenchInputError, match=r"unknown conditions 'ideal2': choose a preset \(ideal, "):
         load_spec(spec)

@@ -5,12 +5,12 @@ each scalar field of its tables, named `<table>_<field>` (`actuation_dead_time_s
 from __future__ import annotations
 
 import dataclasses
+import os
 import typing
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
-from workbench.base.errors import WorkbenchInputError
 from workbench.base.typed_tables import unwrap
 from workbench.simulation.conditions import CONDITIONS, Conditions, load_conditions
 
@@ -44,11 +44,9 @@ def resolve_conditions(value: str, base_dir: Path) -> str:
         return value
     path = Path(value)
     path = path if path.is_absolute() else base_dir / path
-    if path.suffix.lower() != ".toml":
-        raise WorkbenchInputError(
-            f"conditions {value!r} is neither a preset ({', '.join(CONDITIONS)}) nor a .toml conditions file"
-        )
-    load_conditions(str(path))
+    if not os.path.lexists(path):
+        load_conditions(value)  # refuses an unknown preset or a missing file, named as given
+    load_conditions(str(path))  # as `workbench run --conditions` reads it
     return str(path.resolve())
 
 
