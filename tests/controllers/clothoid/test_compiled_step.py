@@ -1,6 +1,6 @@
 """The compiled step (`step_kernel.py`) against the Python step it replaced: the recorded runs of
 tests/controllers/clothoid/replay (`replay_cases.py`, recorded with the Python step of commit b614e88) replayed through
-today's controller, measurement by measurement, give the same commands and diagnostics to 1e-12."""
+today's controller, measurement by measurement, give the same commands and diagnostics to rounding (`TOLERANCE`)."""
 
 from __future__ import annotations
 
@@ -10,8 +10,11 @@ from replay_cases import CASES, ZANDVOORT_CSV
 
 from controllers.base import Measurement
 
-#: Agreement asked of the replay: absolute, and relative to each diagnostic's own scale.
-TOLERANCE = 1e-12
+#: Agreement asked of the replay: absolute, and relative to each diagnostic's own scale. The lookahead floors come
+#: from LAPACK solves whose last bits depend on the kernel OpenBLAS picks for the processor: forcing its Haswell
+#: kernel (OPENBLAS_CORETYPE=Haswell, as some machines here set) on an AMD EPYC moves the commands by up to 8e-12 rad
+#: from the recording. 1e-10 allows that rounding and is still eight orders below any steering a change would make.
+TOLERANCE = 1e-10
 
 
 @pytest.mark.parametrize("case", CASES, ids=[c.name for c in CASES])
