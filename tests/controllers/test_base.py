@@ -321,6 +321,8 @@ def test_the_yaw_is_wrapped_only_beyond_the_bound_and_nothing_else_changes() -> 
 def test_a_restart_on_a_reset_clock_keeps_the_path_and_sample_time() -> None:
     controller = _Scripted(GEOMETRY)
     controller.reset(PATH, 0.05)
+    assert controller.reset_with == (PATH, 0.05)
+    controller.reset_with = None
     controller.step(dataclasses.replace(GOOD, t_s=100.0), PATH)
     for k in range(base.CLOCK_RESET_FRAMES):
         controller.step(dataclasses.replace(GOOD, t_s=1.0 + k), PATH)
