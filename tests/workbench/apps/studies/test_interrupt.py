@@ -184,3 +184,43 @@ def test_a_dask_sweep_stops_its_local_cluster_and_says_so(tmp_path: Path) -> Non
     assert "stopped the dask LocalCluster, 2 single-threaded worker processes (runs in progress abandoned)" in stderr
     assert len(stderr.strip().splitlines()) == 1, stderr  # that line only: no log of the workers' connections
     assert _row_ids(out) == set(fast)
+
+
+def test_local_workers_ignore_the_stop_signals_and_closing_the_busy_pool_ends_them(tmp_path: Path) -> None:
+    """A worker ignores SIGINT and SIGTERM (Ctrl-C reaches the whole process group: the study's process stops the
+    pool); closing the pool mid-run kills and reaps its workers at once."""
+    import multiprocessing
+    import threading
+
+    from workbench.apps.studies import LocalBackend
+    from workbench.apps.studies.backends import BackendError
+
+    slow = load_spec(write_spec(tmp_path, SLOW_SPEC)).plan()[2:3]
+    others = {child.pid for child in multiprocessing.active_children()}
+    backend = LocalBackend(workers=1)
+    outcome: list[object] = []
+
+    def study() -> None:  # as a study's loop over the rows, here beside the test
+        try:
+            outcome.extend(backend.map_runs(slow))
+        except BackendError as exc:  # its pool closed under it
+            outcome.append(exc)
+
+    with backend:
+        loop = threading.Thread(target=study)
+        loop.start()
+        deadline = time.monotonic() + READY_TIMEOUT_S
+        while not (workers := [c for c in multiprocessing.active_children() if c.pid not in others]):
+            assert time.monotonic() < deadline, "no worker started"
+            time.sleep(0.05)
+        (worker,) = workers
+        time.sleep(1.0)  # past its initialiser, into the run
+        for signum in (signal.SIGINT, signal.SIGTERM):
+            psutil.Process(worker.pid).send_signal(signum)
+        time.sleep(1.0)
+        assert worker.is_alive(), "a stop signal ended the worker"
+        start = time.monotonic()
+    assert not worker.is_alive() and time.monotonic() - start < STOP_BOUND_S / 2
+    assert worker.exitcode == -signal.SIGKILL
+    loop.join(STOP_BOUND_S)
+    assert not loop.is_alive() and len(outcome) == 1 and isinstance(outcome[0], BackendError), outcome
