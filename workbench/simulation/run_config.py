@@ -7,7 +7,6 @@ from dataclasses import dataclass
 from workbench.base.errors import WorkbenchInputError, require_in_range, require_positive, value_text
 from workbench.simulation.conditions import CONDITIONS, Conditions
 
-
 #: The longest time-out a run may be given (s; about 32 years): beyond it a number of steps no longer fits a
 #: machine integer, and `run_size` refuses far shorter runs anyway.
 MAX_TIME_S = 1e9
