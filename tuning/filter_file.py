@@ -17,7 +17,6 @@ from __future__ import annotations
 
 import json
 import math
-import re
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
@@ -26,6 +25,7 @@ from controllers.clothoid.filter_schedule import PARAM_KEYS, SPEED_RANGE_KMH, Fi
 from controllers.clothoid.lead_filter import LeadFilterParams
 from workbench.base.errors import WorkbenchInputError, require_in_range
 from workbench.base.input_files import read_json, read_toml
+from workbench.base.toml_text import toml_key, toml_value
 from workbench.base.typed_tables import check_keys
 
 FORMAT_TAG = "lead-filter/1"
@@ -127,30 +127,14 @@ def _check_value(name: str, value: object) -> None:
         raise WorkbenchInputError(f"{name} must be text, a boolean, a number, a list or a table; got {value!r}")
 
 
-def _toml_value(value: object) -> str:
-    if isinstance(value, str):  # a JSON string is a TOML basic string, but for DEL, which TOML wants escaped
-        return json.dumps(value, ensure_ascii=False).replace("\x7f", "\\u007f")
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    if isinstance(value, int | float):
-        return repr(value)
-    if isinstance(value, Mapping):
-        return "{" + ", ".join(f"{_toml_key(k)} = {_toml_value(v)}" for k, v in value.items()) + "}"
-    return "[" + ", ".join(_toml_value(v) for v in value) + "]"  # type: ignore[attr-defined]
-
-
-def _toml_key(key: str) -> str:
-    return key if re.fullmatch(r"[A-Za-z0-9_-]+", key) else _toml_value(key)
-
-
 def _to_toml(doc: Mapping[str, Any]) -> str:
     """The few TOML shapes this format needs: top-level values, then [plant] and [[schedule]] tables."""
     tables = ("plant", "schedule")
-    lines = [f"{_toml_key(k)} = {_toml_value(v)}" for k, v in doc.items() if k not in tables]
+    lines = [f"{toml_key(k)} = {toml_value(v)}" for k, v in doc.items() if k not in tables]
     if "plant" in doc:
-        lines += ["", "[plant]", *(f"{k} = {_toml_value(v)}" for k, v in doc["plant"].items())]
+        lines += ["", "[plant]", *(f"{k} = {toml_value(v)}" for k, v in doc["plant"].items())]
     for entry in doc.get("schedule", ()):
-        lines += ["", "[[schedule]]", *(f"{k} = {_toml_value(v)}" for k, v in entry.items())]
+        lines += ["", "[[schedule]]", *(f"{k} = {toml_value(v)}" for k, v in entry.items())]
     return "\n".join(lines) + "\n"
 
 

@@ -859,7 +859,7 @@ def _run_stages(
     scenario = make_scenario(
         args.scenario, ScenarioOptions(vehicle_width_m=vehicle.geometry.width_m, track_file=args.track)
     )
-    if args.scenario == "zandvoort" and scenario.name != "zandvoort":  # another file given: named by the file
+    if args.scenario == TRACK_SCENARIO and scenario.name != TRACK_SCENARIO:  # another file given: named by it
         progress.warn(scenario.description)
     simulation = Simulation(scenario, vehicle, controller, config)
     label = f"{scenario.name}: {controller.name} on {vehicle.name}"

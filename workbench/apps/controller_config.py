@@ -25,7 +25,6 @@ from __future__ import annotations
 
 import dataclasses
 import difflib
-import json
 import textwrap
 from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass
@@ -34,6 +33,7 @@ from typing import TYPE_CHECKING, Any
 
 from workbench.base.errors import WorkbenchInputError, value_text
 from workbench.base.input_files import read_toml
+from workbench.base.toml_text import toml_value
 from workbench.base.typed_tables import field_types, typed_value
 
 if TYPE_CHECKING:
@@ -233,19 +233,8 @@ def config_template(controller_name: str, config_type: type) -> str:
         if f.name in by_field:
             lines.append(f'# {by_field[f.name]} = "..."')
         else:
-            lines.append(f"{f.name} = {_toml_text(value)}")
+            lines.append(f"{f.name} = {toml_value(value)}")
     return "\n".join(lines) + "\n"
-
-
-def _toml_text(value: Any) -> str:
-    """`value` as a TOML value (None as "none", which TOML has no other way to write)."""
-    if value is None:
-        return '"none"'
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    if isinstance(value, str | Path):
-        return json.dumps(str(value), ensure_ascii=False)
-    return value_text(value)
 
 
 def _option_comment(f: dataclasses.Field[Any], default: Any, file_option: str | None) -> list[str]:
@@ -260,7 +249,7 @@ def _option_comment(f: dataclasses.Field[Any], default: Any, file_option: str | 
         default_text = f'"none" ({none_means})' if default is None else "given"
         allowed, name = 'a file path, or "none"', file_option
     else:
-        default_text, allowed, name = _toml_text(default), rule.allowed(), f.name
+        default_text, allowed, name = toml_value(default), rule.allowed(), f.name
 
     def wrapped(text: str, first: str) -> list[str]:
         return textwrap.wrap(

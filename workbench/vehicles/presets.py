@@ -22,7 +22,6 @@ from __future__ import annotations
 
 import dataclasses
 import importlib
-import json
 import os
 import sys
 from importlib import resources
@@ -32,6 +31,7 @@ from typing import Any
 from workbench.base.entry_points import installed_entry_points
 from workbench.base.errors import WorkbenchInputError, value_text
 from workbench.base.input_files import parse_toml, read_text
+from workbench.base.toml_text import toml_value
 from workbench.base.typed_tables import check_keys, dataclass_from_table
 from workbench.vehicles.base import VehicleModel
 from workbench.vehicles.commonroad_mb import CommonRoadMB, CommonRoadMBParams
@@ -105,18 +105,10 @@ def preset_text(name: str) -> str:
         raise WorkbenchInputError(f"unknown vehicle preset {name!r}; choose one of {', '.join(list_presets())}")
     if name in INSTALLED_MODEL_TYPES:
         defaults = INSTALLED_MODEL_TYPES[name][1]()
-        lines = ["[model]", f'type = "{name}"', f"description = {json.dumps(list_presets()[name])}", "", "[parameters]"]
-        lines += [f"{f.name} = {_toml_value(getattr(defaults, f.name))}" for f in dataclasses.fields(defaults)]
+        lines = ["[model]", f'type = "{name}"', f"description = {toml_value(list_presets()[name])}", "", "[parameters]"]
+        lines += [f"{f.name} = {toml_value(getattr(defaults, f.name))}" for f in dataclasses.fields(defaults)]
         return "\n".join(lines) + "\n"
     return _preset_dir().joinpath(f"{name}.toml").read_text(encoding="utf-8")
-
-
-def _toml_value(value: object) -> str:
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    if isinstance(value, str):
-        return json.dumps(value)
-    return repr(value)
 
 
 def carries_payload(model_type: str) -> bool:

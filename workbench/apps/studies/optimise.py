@@ -38,6 +38,7 @@ from workbench.apps.studies.spec import LEAD_FILTER_SCALES, StudySpec
 from workbench.apps.studies.store import RunStore, write_results
 from workbench.apps.studies.sweep import execute_runs
 from workbench.base.errors import WorkbenchInputError, value_text
+from workbench.base.toml_text import toml_value
 from workbench.vehicles.presets import load_vehicle
 
 if TYPE_CHECKING:
@@ -80,16 +81,6 @@ def trial_value(rows: list[dict[str, Any]], weights: dict[str, float], aggregate
     return float(np.mean(values) if aggregate == "mean" else np.max(values)), ""
 
 
-def _toml_value(value: Any) -> str:
-    if value is None:
-        return '"none"'
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    if isinstance(value, int | float):
-        return repr(value)
-    return json.dumps(str(value), ensure_ascii=False)
-
-
 def _write_object(folder: Path, value: Any) -> str | None:
     """Write an object a file option was read into beside the config (its file's name), or None when it has no
     file form (a vehicle's single-track equivalent)."""
@@ -129,13 +120,13 @@ def write_controller_config(path: Path, controller: str, config: Any, header: st
             if value is not None and name is None:
                 lines.append(f"# {file_keys[f.name]}: {type(value).__name__} has no file form; give its file again")
             else:
-                lines.append(f"{file_keys[f.name]} = {_toml_value(name)}")
+                lines.append(f"{file_keys[f.name]} = {toml_value(name)}")
             continue
         if isinstance(value, Path):
             value = value.resolve()
             value = value.relative_to(path.parent.resolve()) if value.is_relative_to(path.parent.resolve()) else value
             value = value.as_posix()
-        lines.append(f"{f.name} = {_toml_value(value)}")
+        lines.append(f"{f.name} = {toml_value(value)}")
     path.write_text("\n".join(lines) + "\n", encoding="utf-8")
     return path
 
