@@ -17,6 +17,7 @@ from numba import njit
 
 from controllers.base import Controller, Measurement
 from controllers.config_checks import Number, check_options, option
+from controllers.search_space import Tunable
 from workbench.base.errors import WorkbenchInputError, value_text
 from workbench.base.path import PathTracker, ReferencePath
 from workbench.base.path_search import first_beyond, track, value_at
@@ -57,6 +58,14 @@ class PurePursuitConfig:
 class PurePursuit(Controller):
     name: ClassVar[str] = "pure-pursuit"
     config_type: ClassVar[type] = PurePursuitConfig
+    search_space: ClassVar[tuple[Tunable, ...]] = (
+        Tunable("lookahead_gain_s", "log", 0.2, 3.0, reason="longer lookahead per unit speed is calmer and more "
+                "stable at speed, and cuts the corners more"),
+        Tunable("min_lookahead_m", "linear", 1.0, 10.0, reason="a shorter lookahead at low speed tracks tighter and "
+                "oscillates sooner"),
+        Tunable("max_lookahead_m", "linear", 15.0, 60.0, reason="caps the lookahead at high speed: shorter cuts less "
+                "on fast bends, longer keeps high speed stable"),
+    )  # fmt: skip
 
     def _reset(self, path: ReferencePath, sample_time_s: float) -> None:
         self._tracker: PathTracker = path.tracker(0.0)

@@ -23,6 +23,17 @@ pull of the front axle back onto the path. The slip angles are the vehicle's sin
 delta_ff = atan(k e_f / (k_soft + v)) with e_f = -(sqrt(R^2 + L^2) - R). The path's curvature is taken at the
 front axle's foot point (one wheelbase of preview). Adding atan(L kappa) instead would count the kinematic steer
 twice: the heading term already holds it.
+
+The two damping terms of the law's reference form (Hoffmann et al. 2007, "Autonomous automobile trajectory tracking
+for off-road driving"), both off by default (0), in which case the command is the law above, bit for bit:
+
+    delta = u - k_yaw (r - v kappa) + k_steer (delta_prev - delta)
+
+with u the law above, r the measured yaw rate, v kappa the trajectory's yaw rate (the path's curvature at the
+front axle's foot point times the speed), and delta_prev the last command returned (road-wheel angle; 0 after a
+reset). The yaw-rate term damps the yaw motion the path does not ask for; the steering-damping term opposes a
+change of the command, delta = (u - k_yaw (r - v kappa) + k_steer delta_prev) / (1 + k_steer): a first-order
+filter on the command whose pole, k_steer / (1 + k_steer) per step, smooths a busy command at the cost of lag.
 """
 
 from __future__ import annotations
@@ -33,6 +44,7 @@ from typing import Any, ClassVar
 
 from controllers.base import Controller, Measurement
 from controllers.config_checks import Flag, Number, check_options, option
+from controllers.search_space import Tunable
 from workbench.base.path import PathTracker, ReferencePath, wrap_angle
 from workbench.vehicles.geometry import VehicleGeometry
 
@@ -58,6 +70,18 @@ class StanleyConfig:
         "law)",
         Flag(),
     )
+    yaw_rate_damping_s: float = option(
+        0.0,
+        "k_yaw, the yaw-rate damping: -k_yaw (r - v kappa) is added to the road-wheel angle (module docstring); larger "
+        "damps yaw oscillation, too large lags the turn-in",
+        Number(0.0, 10.0, "s", note="0: off"),
+    )
+    steering_damping: float = option(
+        0.0,
+        "k_steer, the steering damping: k_steer (delta_prev - delta) is added to the road-wheel angle (module "
+        "docstring), a filter on the command; larger is smoother and slower",
+        Number(0.0, 100.0, note="0: off"),
+    )
 
     def __post_init__(self) -> None:
         check_options(self)
@@ -66,6 +90,16 @@ class StanleyConfig:
 class Stanley(Controller):
     name: ClassVar[str] = "stanley"
     config_type: ClassVar[type] = StanleyConfig
+    search_space: ClassVar[tuple[Tunable, ...]] = (
+        Tunable("gain_per_s", "log", 0.3, 10.0, reason="higher pulls the front axle onto the path faster; too high "
+                "oscillates, most at speed and on a lagging steering"),
+        Tunable("softening_mps", "log", 0.1, 10.0, reason="larger calms the cross-track term at low speed, at the "
+                "cost of a weaker pull back onto the path"),
+        Tunable("yaw_rate_damping_s", "linear", 0.0, 0.5, reason="damps yaw motion the path does not ask for; too "
+                "much lags the turn-in and fights the steering's own lag"),
+        Tunable("steering_damping", "linear", 0.0, 4.0, reason="smooths a busy command (less steering rate) at the "
+                "cost of lag in every correction"),
+    )  # fmt: skip
 
     def __init__(self, geometry: VehicleGeometry, config: Any | None = None, vehicle: object | None = None) -> None:
         """As `Controller`; `vehicle` (a `VehicleModel`) gives the curvature feed-forward its tyres' slip (none
@@ -102,6 +136,11 @@ class Stanley(Controller):
         cross_track_term = math.atan2(-cfg.gain_per_s * foot.cte_m, cfg.softening_mps + m.speed_mps)
         feedforward = self.feedforward_rad(foot.curvature_1pm, m.speed_mps) if cfg.curvature_feedforward else 0.0
         road_wheel = heading_term + cross_track_term + feedforward
+        if cfg.yaw_rate_damping_s:
+            road_wheel -= cfg.yaw_rate_damping_s * (m.yaw_rate_rad_s - m.speed_mps * foot.curvature_1pm)
+        if cfg.steering_damping:
+            previous = self.held_command / self.geometry.steering_ratio  # the last command's road-wheel angle
+            road_wheel = (road_wheel + cfg.steering_damping * previous) / (1.0 + cfg.steering_damping)
         self._diag[:] = (foot.cte_m, heading_term, cross_track_term, feedforward)
         limit = self.geometry.max_road_wheel_angle_rad
         return self.saturate(min(max(road_wheel, -limit), limit) * self.geometry.steering_ratio)

@@ -1,7 +1,8 @@
 """Stanley (`controllers/stanley.py`) against its law, worked out by hand: the cross-track term's gain and softening,
 the heading term, the steering limit, and the curvature feed-forward, whose steady command on a circle is the one
 that holds the rear axle (the workbench's reference point) on it, on each of the four vehicle models; and on the
-figure8 the feed-forward makes tracking better, not worse."""
+figure8 the feed-forward makes tracking better, not worse; the reference form's yaw-rate and steering damping terms
+act as their equations say, and at 0 (their defaults) leave a run bit for bit the plain law's."""
 
 from __future__ import annotations
 
@@ -15,7 +16,8 @@ from hypothesis import strategies as st
 
 from controllers.base import Controller
 from controllers.stanley import Stanley, StanleyConfig
-from workbench.base.path import ReferencePath
+from workbench.base.errors import WorkbenchInputError
+from workbench.base.path import ReferencePath, wrap_angle
 from workbench.simulation.control_interface import Measurement
 from workbench.simulation.scenarios import Scenario, ScenarioOptions, make_scenario
 from workbench.simulation.simulator import Simulation, SimulationConfig
@@ -247,3 +249,91 @@ def test_on_the_figure8_the_feedforward_makes_tracking_better(name: str) -> None
         assert result.status.value == "completed", result.message
         worst[feedforward] = result.metrics.max_abs_cte_m
     assert worst[True] <= 0.7 * worst[False], worst
+
+
+# ------------------------------------------------------------------------------ the reference form's damping terms
+class _PlainLaw(Stanley):
+    """The law without the damping terms, written out as the module docstring's first equation: the reference a
+    Stanley with both damping terms at 0 must match bit for bit."""
+
+    def _command(self, measurement: Measurement, path: ReferencePath) -> float:
+        cfg, m, wheelbase = self.config, measurement, self.geometry.wheelbase_m
+        foot = self._tracker.update(m.x_m + wheelbase * math.cos(m.yaw_rad), m.y_m + wheelbase * math.sin(m.yaw_rad))
+        heading_term = wrap_angle(foot.heading_rad - m.yaw_rad)
+        cross_track_term = math.atan2(-cfg.gain_per_s * foot.cte_m, cfg.softening_mps + m.speed_mps)
+        feedforward = self.feedforward_rad(foot.curvature_1pm, m.speed_mps) if cfg.curvature_feedforward else 0.0
+        self._diag[:] = (foot.cte_m, heading_term, cross_track_term, feedforward)
+        limit = self.geometry.max_road_wheel_angle_rad
+        road_wheel = heading_term + cross_track_term + feedforward
+        return self.saturate(min(max(road_wheel, -limit), limit) * self.geometry.steering_ratio)
+
+
+@pytest.mark.parametrize("feedforward", [False, True])
+def test_with_the_damping_terms_off_a_run_is_bit_for_bit_the_plain_law(feedforward: bool) -> None:
+    """Both damping terms at 0 (their defaults): every logged signal of a run on the fig17 S-bend (but the step's
+    wall-clock time) equals the plain law's, exactly."""
+    vehicle = make_vehicle("dynamic-bicycle")
+    scenario = make_scenario("fig17", ScenarioOptions(vehicle_width_m=vehicle.geometry.width_m))
+    config = StanleyConfig(curvature_feedforward=feedforward, yaw_rate_damping_s=0.0, steering_damping=0.0)
+    assert StanleyConfig(curvature_feedforward=feedforward) == config  # off by default
+    traces = []
+    for cls in (Stanley, _PlainLaw):
+        result = Simulation(scenario, vehicle, cls(vehicle.geometry, config, vehicle=vehicle), SimulationConfig()).run()
+        assert result.status.value == "completed", result.message
+        traces.append(result.to_pandas())
+    assert list(traces[0].columns) == list(traces[1].columns)
+    for column in (c for c in traces[0].columns if c != "step_time_s"):  # all but the wall-clock time of a step
+        assert np.array_equal(traces[0][column].to_numpy(), traces[1][column].to_numpy(), equal_nan=True), column
+
+
+@pytest.mark.parametrize(("yaw_rate", "speed", "damping"), [(0.2, 10.0, 0.3), (-0.1, 5.0, 0.05), (0.05, 20.0, 1.0)])
+def test_the_yaw_rate_term_is_minus_k_yaw_times_the_yaw_rate_the_path_does_not_ask_for(
+    yaw_rate: float, speed: float, damping: float
+) -> None:
+    """Beside a straight line (trajectory yaw rate 0), aligned, 0.3 m left of it, yawing at r: delta = atan(-k e /
+    (k_soft + v)) - k_yaw r. On a circle of radius R, rear axle on it and yawing at v / R (the trajectory's yaw
+    rate), the term vanishes: the command is that without damping."""
+    cfg = StanleyConfig(yaw_rate_damping_s=damping)
+    controller = Stanley(GEOMETRY, cfg)
+    controller.reset(STRAIGHT, 0.02)
+    command = controller.step(Measurement(0.0, 0.0, 0.3, speed, 0.0, 0.0, yaw_rate, 0.0), STRAIGHT)
+    expected = math.atan(-cfg.gain_per_s * 0.3 / (cfg.softening_mps + speed)) - damping * yaw_rate
+    assert command / GEOMETRY.steering_ratio == pytest.approx(expected, abs=1e-12)
+    radius = 40.0
+    circle = _circle(radius)
+    on_circle = Measurement(0.0, 0.0, 0.0, speed, 0.0, 0.0, speed / radius, 0.0)
+    damped, plain = Stanley(GEOMETRY, cfg), Stanley(GEOMETRY, StanleyConfig())
+    for controller in (damped, plain):
+        controller.reset(circle, 0.02)
+    # the path's curvature at the front axle's foot point is 1 / R to the chords' error (~1e-5 of it)
+    assert damped.step(on_circle, circle) == pytest.approx(plain.step(on_circle, circle), abs=damping * speed * 1e-6)
+
+
+@pytest.mark.parametrize("damping", [0.5, 3.0])
+def test_the_steering_damping_opposes_a_change_of_the_command(damping: float) -> None:
+    """delta = u + k_steer (delta_prev - delta), delta_prev the last command (0 after a reset): the first step
+    gives u / (1 + k), the next (u' + k delta_1) / (1 + k), with u, u' the undamped law's commands (hand-computed
+    beside a straight line, aligned)."""
+    cfg = StanleyConfig(steering_damping=damping)
+    controller = Stanley(GEOMETRY, cfg)
+    controller.reset(STRAIGHT, 0.02)
+
+    def law(offset: float, speed: float) -> float:
+        return math.atan(-cfg.gain_per_s * offset / (cfg.softening_mps + speed))
+
+    ratio = GEOMETRY.steering_ratio
+    first = controller.step(Measurement(0.0, 0.0, 0.5, 8.0, 0.0, 0.0, 0.0, 0.0), STRAIGHT) / ratio
+    assert first == pytest.approx(law(0.5, 8.0) / (1.0 + damping), abs=1e-12)
+    second = controller.step(Measurement(0.02, 0.16, -0.2, 8.0, 0.0, 0.0, 0.0, 0.0), STRAIGHT) / ratio
+    assert second == pytest.approx((law(-0.2, 8.0) + damping * first) / (1.0 + damping), abs=1e-12)
+    controller.reset(STRAIGHT, 0.02)  # a reset forgets the last command
+    again = controller.step(Measurement(0.0, 0.0, 0.5, 8.0, 0.0, 0.0, 0.0, 0.0), STRAIGHT) / ratio
+    assert again == pytest.approx(first, abs=1e-15)
+
+
+@pytest.mark.parametrize(
+    ("option", "value"), [("yaw_rate_damping_s", -0.1), ("steering_damping", -1.0), ("steering_damping", math.nan)]
+)
+def test_a_damping_term_outside_its_range_is_refused_naming_it(option: str, value: float) -> None:
+    with pytest.raises(WorkbenchInputError, match=rf"{option} must be a finite number in \[0, "):
+        StanleyConfig(**{option: value})

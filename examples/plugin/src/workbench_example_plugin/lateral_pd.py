@@ -15,6 +15,7 @@ from typing import ClassVar
 
 from controllers.base import Controller, Measurement
 from controllers.config_checks import Number, check_options, option
+from controllers.search_space import Tunable
 from workbench.base.path import ReferencePath, wrap_angle
 
 
@@ -35,6 +36,14 @@ class LateralPDConfig:
 class LateralPD(Controller):
     name: ClassVar[str] = "lateral-pd"
     config_type: ClassVar[type] = LateralPDConfig
+    #: What a tournament may tune (`workbench controllers --show lateral-pd --search-space`): the two gains, each
+    #: range holding its default, with what it trades.
+    search_space: ClassVar[tuple[Tunable, ...]] = (
+        Tunable("cte_gain_1pm2", "log", 0.01, 1.0, reason="a stiffer pull onto the path (shorter natural wavelength) "
+                "tracks tighter and steers harder"),
+        Tunable("heading_gain_1pm", "linear", 0.1, 2.0, reason="more damping of the approach to the path; too much "
+                "slows the correction of an offset"),
+    )  # fmt: skip
 
     def _reset(self, path: ReferencePath, sample_time_s: float) -> None:
         self._tracker = path.tracker()
