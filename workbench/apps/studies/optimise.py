@@ -81,32 +81,35 @@ def trial_value(rows: list[dict[str, Any]], weights: dict[str, float], aggregate
     return float(np.mean(values) if aggregate == "mean" else np.max(values)), ""
 
 
-def _write_object(folder: Path, value: Any) -> str | None:
-    """Write an object a file option was read into beside the config (its file's name), or None when it has no
-    file form (a vehicle's single-track equivalent)."""
+def _write_object(folder: Path, value: Any, stem: str = "best") -> str | None:
+    """Write an object a file option was read into beside the config, named `<stem>_lead_filter.json`,
+    `<stem>_limits.csv` or `<stem>_lag.json` (its file's name), or None when it has no file form (a vehicle's
+    single-track equivalent)."""
     from controllers.clothoid.curvature_limits import CurvatureLimits
     from controllers.clothoid.filter_schedule import FilterSchedule
     from tuning.filter_file import write_filter_file
     from workbench.vehicles.steering_lag import SteeringLag, write_lag_file
 
     if isinstance(value, FilterSchedule):
-        write_filter_file(
-            folder / BEST_FILTER, value.params[0] if len(value.params) == 1 else value, source=value.source
-        )
-        return BEST_FILTER
+        name = BEST_FILTER.replace("best", stem, 1)
+        write_filter_file(folder / name, value.params[0] if len(value.params) == 1 else value, source=value.source)
+        return name
     if isinstance(value, CurvatureLimits):
-        write_limits_file(value, folder / BEST_LIMITS)
-        return BEST_LIMITS
+        name = BEST_LIMITS.replace("best", stem, 1)
+        write_limits_file(value, folder / name)
+        return name
     if isinstance(value, SteeringLag):
-        write_lag_file(value, folder / BEST_LAG)
-        return BEST_LAG
+        name = BEST_LAG.replace("best", stem, 1)
+        write_lag_file(value, folder / name)
+        return name
     return None
 
 
-def write_controller_config(path: Path, controller: str, config: Any, header: str) -> Path:
+def write_controller_config(path: Path, controller: str, config: Any, header: str, stem: str = "best") -> Path:
     """Write every field of a controller config as a controller-config TOML file (one [controller] table; None
     as "none"; paths inside the file's folder relative to it, others absolute); an object a file option was read
-    into (`FILE_OPTIONS`) is written to a file beside it and named by that option; return the path."""
+    into (`FILE_OPTIONS`) is written to a file beside it, its name starting with `stem` (`_write_object`), and
+    named by that option; return the path."""
     from workbench.apps.controller_config import FILE_OPTIONS
 
     file_keys = {option.field: name for name, option in FILE_OPTIONS.items()}
@@ -116,7 +119,7 @@ def write_controller_config(path: Path, controller: str, config: Any, header: st
             continue
         value = getattr(config, f.name)
         if f.name in file_keys:
-            name = None if value is None else _write_object(path.parent, value)
+            name = None if value is None else _write_object(path.parent, value, stem)
             if value is not None and name is None:
                 lines.append(f"# {file_keys[f.name]}: {type(value).__name__} has no file form; give its file again")
             else:

@@ -45,9 +45,10 @@ ERROR_STATUS = "error"
 #: The metrics.json fields a row carries (the names are the run's own columns).
 ROW_METRICS = tuple(k for k in METRIC_KEYS if k not in ("scenario", "controller", "vehicle"))
 #: The columns of a row after the run's parameters, in order.
-RESULT_COLUMNS = (*ROW_METRICS, "status", "message", "traceback", "run_time_s")
+RESULT_COLUMNS = (*ROW_METRICS, "status", "message", "traceback", "run_time_s", "cpu_time_s")
 #: Wall-clock fields: they differ from run to run; everything else in a row is reproducible bit for bit.
-TIMING_COLUMNS = ("step_time_median_us", "step_time_p99_us", "run_time_s")
+#: cpu_time_s, the CPU time (s) of the worker process while it ran the run, is measured like them.
+TIMING_COLUMNS = ("step_time_median_us", "step_time_p99_us", "run_time_s", "cpu_time_s")
 
 
 def build_controller_config(run: PlannedRun, vehicle: VehicleModel | None = None) -> Any:
@@ -81,8 +82,9 @@ def simulate(run: PlannedRun, progress: bool = False) -> SimulationResult:
 
 def execute_run(run: PlannedRun) -> dict[str, Any]:
     """The run's row: its parameters, the metrics.json fields, status, message, traceback (errors only) and
-    run_time_s (wall time). Exceptions become an "error" row; KeyboardInterrupt and SystemExit propagate."""
-    start = time.perf_counter()
+    run_time_s (wall time) and cpu_time_s (this process's CPU time while it ran). Exceptions become an "error" row;
+    KeyboardInterrupt and SystemExit propagate."""
+    start, cpu_start = time.perf_counter(), time.process_time()
     row = run.parameters()
     try:
         result = simulate(run)
@@ -97,6 +99,7 @@ def execute_run(run: PlannedRun) -> dict[str, Any]:
             "traceback": "".join(traceback.format_exception(exc)),
         }
     row["run_time_s"] = time.perf_counter() - start
+    row["cpu_time_s"] = time.process_time() - cpu_start
     return row
 
 
@@ -105,7 +108,8 @@ def failed_row(run: PlannedRun, message: str) -> dict[str, Any]:
     return (
         run.parameters()
         | dict.fromkeys(ROW_METRICS)
-        | {"completed": False, "status": ERROR_STATUS, "message": message, "traceback": None, "run_time_s": None}
+        | {"completed": False, "status": ERROR_STATUS, "message": message, "traceback": None}
+        | dict.fromkeys(("run_time_s", "cpu_time_s"))
     )
 
 

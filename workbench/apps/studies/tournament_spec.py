@@ -1,0 +1,551 @@
+"""A tournament spec (TOML): which controllers compete on which vehicles, the training set they are tuned on, the
+test set they are judged on, the trial budget each gets alike, the objectives, and the rules that name each
+controller's chosen configuration and rank the controllers.
+
+Tables: [tournament] (controllers, vehicles, trials, batch_size, seed, objectives, selection, ranking,
+failure_score, front_points, inform_delays, max_runs, track_file, description), [train] and [test] (scenarios,
+speeds_kmh, conditions, seeds: a set's cases are their product with the vehicles), [search.NAME] (a controller's
+search space: its own, `controllers.search_space.controller_search_space`, with the table's entries over it, key by
+key) and [fixed.NAME] (options fixed for every run of a controller). README.md ("Tournament") shows an annotated
+example.
+
+A case is one scenario, vehicle, speed, conditions and seed; its id (`case_id`) is the same text across
+controllers and configurations. A case in both sets is refused: the test set is held out. Internally the spec is
+one `StudySpec` per controller and set (`studies`), so that every check of a study applies to each (names, files,
+values every run would refuse, run sizes, feasibility of each path for each vehicle at the set's fastest speed);
+the training study carries the trial budget and the search space as its [optimise] settings, which checks them
+against the controller's options. The MPCs (every controller with a `max_solve_time_s` option) get a solve budget
+they never reach, MPC_SOLVE_BUDGET_S, unless [fixed.NAME] gives one, so that their runs reproduce bit for bit.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from types import MappingProxyType
+from typing import Any
+
+from controllers import CONTROLLERS
+from workbench.apps.studies.distributions import Distribution
+from workbench.apps.studies.run_build import LEAD_FILTER_SCALES
+from workbench.apps.studies.spec import (
+    DEFAULT_MAX_RUNS,
+    OBJECTIVE_METRICS,
+    OptimiseSettings,
+    PlannedRun,
+    StudySpec,
+    controller_parameters,
+)
+from workbench.base.errors import WorkbenchInputError, value_text
+from workbench.base.input_files import read_toml
+from workbench.base.typed_tables import typed_value
+
+TABLES = ("tournament", "train", "test", "search", "fixed")
+TOURNAMENT_KEYS = (
+    "controllers",
+    "vehicles",
+    "trials",
+    "batch_size",
+    "seed",
+    "objectives",
+    "selection",
+    "ranking",
+    "failure_score",
+    "front_points",
+    "inform_delays",
+    "max_runs",
+    "track_file",
+    "description",
+)
+SET_KEYS = ("scenarios", "speeds_kmh", "conditions", "seeds")
+SETS = ("train", "test")
+#: The objectives a front is drawn over unless the spec names others: tracking (RMS and max |CTE|, m) against
+#: steering effort (RMS steering-wheel rate, deg/s), each the mean over the training cases.
+DEFAULT_OBJECTIVES = ("rms_cte_m", "max_abs_cte_m", "rms_steer_rate_deg_s")
+#: The weighted sum that names the chosen point of a front unless the spec states another: max |CTE| (m) plus
+#: 0.002 m per deg/s of RMS steering-wheel rate (100 deg/s of steering rate weigh as 0.2 m of |CTE|).
+DEFAULT_SELECTION = MappingProxyType({"max_abs_cte_m": 1.0, "rms_steer_rate_deg_s": 0.002})
+#: The ranking scalar of a test run unless the spec states another: the same weighted sum.
+DEFAULT_RANKING = DEFAULT_SELECTION
+#: The ranking scalar of a failed run unless the spec states another: 30, the |CTE| (m) at which a run has left
+#: the path (`SimulationConfig.max_abs_cte_m`), worse than any run that stays on it.
+DEFAULT_FAILURE_SCORE = 30.0
+#: The most front points carried to the test set per controller, and the default.
+MAX_FRONT_POINTS = 5
+#: Trials asked and run together unless the spec says: part of the spec, so any backend gives the same trials.
+DEFAULT_BATCH_SIZE = 4
+#: The MPCs' solver budget (s) in a tournament: the most their option allows, never reached by a solve of the
+#: horizons they search, so that no solve is cut short and a run reproduces bit for bit on any machine.
+MPC_SOLVE_BUDGET_S = 10.0
+#: The option that sets an MPC's solver budget.
+SOLVE_BUDGET_OPTION = "max_solve_time_s"
+
+
+def case_id(row: Mapping[str, Any]) -> str:
+    """A case's id from a run's row or parameters: "scenario|vehicle|speed_kmh|conditions|seed" (speed as %g)."""
+    return f"{row['scenario']}|{row['vehicle']}|{row['speed_kmh']:g}|{row['conditions']}|{row['seed']}"
+
+
+def weights_text(weights: Mapping[str, float]) -> str:
+    """A weighted sum in words, e.g. "1 x max_abs_cte_m + 0.002 x rms_steer_rate_deg_s"."""
+    return " + ".join(f"{w:g} x {k}" for k, w in weights.items())
+
+
+@dataclass(frozen=True)
+class CaseSet:
+    """A set of cases (train or test): its scenarios (names, "circuit:SEED", or waypoint/track files relative to
+    the spec), speeds (km/h), conditions (presets or files) and seeds of the conditions' noise."""
+
+    name: str
+    scenarios: tuple[str, ...]
+    speeds_kmh: tuple[float, ...]
+    conditions: tuple[str, ...] = ("ideal",)
+    seeds: tuple[int, ...] = (0,)
+
+    @classmethod
+    def from_table(cls, name: str, table: object) -> CaseSet:
+        if not isinstance(table, Mapping):
+            raise WorkbenchInputError(f"[{name}] must be a table with {', '.join(SET_KEYS)}; got {value_text(table)}")
+        unknown = [k for k in table if k not in SET_KEYS]
+        if unknown:
+            raise WorkbenchInputError(
+                f"unknown key(s) {name}.{f', {name}.'.join(unknown)}; allowed: {', '.join(SET_KEYS)}"
+            )
+        missing = [k for k in SET_KEYS[:2] if k not in table]
+        if missing:
+            raise WorkbenchInputError(f"[{name}] needs {', '.join(missing)}")
+        values: dict[str, tuple[Any, ...]] = {}
+        for key, kind in (("scenarios", str), ("speeds_kmh", float), ("conditions", str), ("seeds", int)):
+            if key not in table:
+                continue
+            raw = table[key]
+            items = list(raw) if isinstance(raw, list | tuple) else [raw]
+            if not items:
+                raise WorkbenchInputError(f"{name}.{key} is empty; give at least one")
+            typed = tuple(typed_value(f"{name}.{key}[{i}]", v, kind) for i, v in enumerate(items))
+            if len(set(typed)) != len(typed):
+                raise WorkbenchInputError(f"{name}.{key} lists a value twice: {items}")
+            values[key] = typed
+        for speed in values["speeds_kmh"]:
+            if not speed > 0:
+                raise WorkbenchInputError(f"{name}.speeds_kmh must be > 0 km/h; got {value_text(speed)}")
+        for seed in values.get("seeds", ()):
+            if seed < 0:
+                raise WorkbenchInputError(f"{name}.seeds must be whole numbers >= 0; got {seed}")
+        return cls(name, **values)
+
+
+def _weights(where: str, table: object, allowed: Sequence[str], default: Mapping[str, float]) -> dict[str, float]:
+    """A table of metric weights: metrics among `allowed`, finite weights >= 0, not all 0."""
+    if table is None:
+        return dict(default)
+    if not isinstance(table, Mapping) or not table:
+        raise WorkbenchInputError(
+            f"tournament.{where} must be a table of metric weights, e.g. {{max_abs_cte_m = 1.0, "
+            f"rms_steer_rate_deg_s = 0.002}}; got {value_text(table)}"
+        )
+    weights = {}
+    for key, weight in table.items():
+        if key not in allowed:
+            raise WorkbenchInputError(f"unknown metric tournament.{where}.{key}; allowed: {', '.join(allowed)}")
+        value = typed_value(f"tournament.{where}.{key}", weight, float)
+        if value < 0:
+            raise WorkbenchInputError(f"tournament.{where}.{key} must be a weight >= 0; got {value_text(weight)}")
+        weights[key] = value
+    if not any(weights.values()):
+        raise WorkbenchInputError(f"tournament.{where} needs a weight other than 0; got {weights}")
+    return weights
+
+
+def _whole(where: str, value: object, low: int, high: int | None = None) -> int:
+    if isinstance(value, bool) or not isinstance(value, int) or value < low or (high is not None and value > high):
+        allowed = f"from {low} to {high}" if high is not None else f">= {low}"
+        raise WorkbenchInputError(f"{where} must be a whole number {allowed}; got {value_text(value)}")
+    return value
+
+
+def _default_value(controller: str, key: str) -> Any:
+    """The shipped default of a controller parameter: its config field's default (1.0 for a lead-filter scale)."""
+    if key in LEAD_FILTER_SCALES:
+        return 1.0
+    config_type = CONTROLLERS[controller].config_type
+    for f in dataclasses.fields(config_type):
+        if f.name == key:
+            if f.default is not dataclasses.MISSING:
+                return f.default
+            if f.default_factory is not dataclasses.MISSING:
+                return f.default_factory()
+    return None
+
+
+def _contains(dist: Distribution, value: Any) -> bool:
+    """Whether a searchable distribution can give `value`."""
+    if dist.kind == "choice":
+        return any(type(value) is type(c) and value == c for c in dist.values)
+    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
+        return False
+    if dist.kind == "integers" and value != int(value):
+        return False
+    return dist.values[0] <= value <= dist.values[1]
+
+
+@dataclass(frozen=True)
+class TournamentSpec:
+    """A tournament (module docstring). search: per controller, parameter -> distribution (its own space with the
+    spec's [search.NAME] over it, the fixed options left out); fixed: per controller, option -> value for every
+    run (the MPCs' solve budget included); defaults: per controller, the shipped default of each searched
+    parameter (trial 0); studies: (controller, set) -> StudySpec; source: the spec file, if read from one.
+    selection and ranking: metric -> weight (None: DEFAULT_SELECTION, DEFAULT_RANKING)."""
+
+    controllers: tuple[str, ...]
+    vehicles: tuple[str, ...]
+    train: CaseSet
+    test: CaseSet
+    trials: int
+    batch_size: int = DEFAULT_BATCH_SIZE
+    seed: int = 0
+    objectives: tuple[str, ...] = DEFAULT_OBJECTIVES
+    selection: Mapping[str, float] | None = None
+    ranking: Mapping[str, float] | None = None
+    failure_score: float = DEFAULT_FAILURE_SCORE
+    front_points: int = MAX_FRONT_POINTS
+    inform_delays: bool = True
+    search_tables: Mapping[str, Mapping[str, Any]] = field(default_factory=dict)
+    fixed_tables: Mapping[str, Mapping[str, Any]] = field(default_factory=dict)
+    max_runs: int = DEFAULT_MAX_RUNS
+    track_file: str | None = None
+    description: str = ""
+    base_dir: Path = field(default_factory=Path.cwd)
+    source: Path | None = None
+    search: Mapping[str, Mapping[str, Distribution]] = field(init=False)
+    fixed: Mapping[str, Mapping[str, Any]] = field(init=False)
+    defaults: Mapping[str, Mapping[str, Any]] = field(init=False)
+    studies: Mapping[tuple[str, str], StudySpec] = field(init=False)
+
+    def __post_init__(self) -> None:
+        """Check the scalars and rules, the controllers and their tables, then build the studies (every check of
+        a study), then refuse a case in both sets and a tournament of more runs than max_runs."""
+        object.__setattr__(self, "base_dir", Path(self.base_dir).resolve())
+        self._check_scalars()
+        self._check_controllers()
+        search, fixed, defaults = {}, {}, {}
+        for controller in self.controllers:
+            fixed[controller] = self._fixed(controller)
+            search[controller], defaults[controller] = self._search(controller, fixed[controller])
+        object.__setattr__(self, "fixed", MappingProxyType(fixed))
+        object.__setattr__(self, "search", MappingProxyType(search))
+        object.__setattr__(self, "defaults", MappingProxyType(defaults))
+        studies: dict[tuple[str, str], StudySpec] = {}
+        for controller in self.controllers:
+            for case_set in (self.train, self.test):
+                studies[(controller, case_set.name)] = self._study(controller, case_set)
+            if controller == self.controllers[0]:
+                self._check_held_out(studies[(controller, "train")], studies[(controller, "test")])
+        object.__setattr__(self, "studies", MappingProxyType(studies))
+        self._check_size()
+
+    # ------------------------------------------------------------------------------------------- checks
+    def _check_scalars(self) -> None:
+        for name in ("train", "test"):
+            value = getattr(self, name)
+            if not isinstance(value, CaseSet) or value.name != name:
+                raise WorkbenchInputError(f"{name} must be the CaseSet named {name!r}; got {value!r}")
+        _whole("tournament.trials", self.trials, 1)
+        _whole("tournament.batch_size", self.batch_size, 1)
+        _whole("tournament.seed", self.seed, 0)
+        _whole("tournament.front_points", self.front_points, 0, MAX_FRONT_POINTS)
+        _whole("tournament.max_runs", self.max_runs, 1)
+        if not isinstance(self.inform_delays, bool):
+            value = value_text(self.inform_delays)
+            raise WorkbenchInputError(f"tournament.inform_delays must be true or false; got {value}")
+        if not isinstance(self.description, str):
+            raise WorkbenchInputError(f"tournament.description must be text; got {value_text(self.description)}")
+        objectives = self.objectives
+        if isinstance(objectives, str) or not isinstance(objectives, Sequence) or not objectives:
+            raise WorkbenchInputError(
+                f"tournament.objectives must be a list of metrics; got {value_text(objectives)}; allowed: "
+                f"{', '.join(OBJECTIVE_METRICS)}"
+            )
+        for metric in objectives:
+            if metric not in OBJECTIVE_METRICS:
+                raise WorkbenchInputError(
+                    f"unknown metric {metric!r} in tournament.objectives; allowed: {', '.join(OBJECTIVE_METRICS)}"
+                )
+        if len(set(objectives)) != len(objectives):
+            raise WorkbenchInputError(f"tournament.objectives names a metric twice: {list(objectives)}")
+        object.__setattr__(self, "objectives", tuple(objectives))
+        selection = _weights("selection", self.selection, self.objectives, DEFAULT_SELECTION)
+        object.__setattr__(self, "selection", MappingProxyType(selection))
+        object.__setattr__(
+            self, "ranking", MappingProxyType(_weights("ranking", self.ranking, OBJECTIVE_METRICS, DEFAULT_RANKING))
+        )
+        object.__setattr__(self, "failure_score", typed_value("tournament.failure_score", self.failure_score, float))
+
+    def _check_controllers(self) -> None:
+        controllers = self.controllers
+        if isinstance(controllers, str):
+            controllers = (controllers,)
+        if not isinstance(controllers, Sequence) or not controllers or not all(isinstance(c, str) for c in controllers):
+            raise WorkbenchInputError(f"tournament.controllers must be a list of names; got {value_text(controllers)}")
+        for name in controllers:
+            if name not in CONTROLLERS:
+                raise WorkbenchInputError(
+                    f"tournament.controllers: unknown controller {name!r}; choose one of {', '.join(CONTROLLERS)}"
+                )
+        if len(set(controllers)) != len(controllers):
+            raise WorkbenchInputError(f"tournament.controllers names one twice: {list(controllers)}")
+        object.__setattr__(self, "controllers", tuple(controllers))
+        vehicles = (self.vehicles,) if isinstance(self.vehicles, str) else self.vehicles
+        if not isinstance(vehicles, Sequence) or not vehicles or not all(isinstance(v, str) for v in vehicles):
+            raise WorkbenchInputError(f"tournament.vehicles must be a list of names; got {value_text(vehicles)}")
+        object.__setattr__(self, "vehicles", tuple(vehicles))
+        for table_name, tables in (("search", self.search_tables), ("fixed", self.fixed_tables)):
+            if not isinstance(tables, Mapping):
+                raise WorkbenchInputError(f"[{table_name}] must hold a table per controller; got {value_text(tables)}")
+            for name, table in tables.items():
+                if name not in self.controllers:
+                    raise WorkbenchInputError(
+                        f"[{table_name}.{name}] names a controller the tournament does not run; its controllers: "
+                        f"{', '.join(self.controllers)}"
+                    )
+                if not isinstance(table, Mapping):
+                    raise WorkbenchInputError(f"[{table_name}.{name}] must be a table; got {value_text(table)}")
+
+    def _fixed(self, controller: str) -> dict[str, Any]:
+        """The options fixed for every run of `controller`: its [fixed.NAME] table, and the MPCs' solve budget."""
+        allowed = controller_parameters(controller)
+        fixed = dict(self.fixed_tables.get(controller, {}))
+        for key in fixed:
+            if key not in allowed:
+                raise WorkbenchInputError(f"unknown option fixed.{controller}.{key}; allowed: {', '.join(allowed)}")
+        if SOLVE_BUDGET_OPTION in allowed and SOLVE_BUDGET_OPTION not in fixed:
+            fixed[SOLVE_BUDGET_OPTION] = MPC_SOLVE_BUDGET_S
+        return fixed
+
+    def _search(self, controller: str, fixed: Mapping[str, Any]) -> tuple[dict[str, Distribution], dict[str, Any]]:
+        """The controller's search space (its own, the spec's [search.NAME] over it, the fixed options left out)
+        and the shipped default of each of its parameters, which must be a point of it (trial 0)."""
+        from controllers.search_space import controller_search_space
+
+        table = dict(self.search_tables.get(controller, {}))
+        space: dict[str, Any] = {t.name: t.distribution_table() for t in controller_search_space(controller)}
+        space = {k: v for k, v in space.items() if k not in fixed}
+        both = sorted(set(table) & set(fixed))
+        if both:
+            raise WorkbenchInputError(
+                f"{', '.join(both)} is both fixed in [fixed.{controller}] and searched in [search.{controller}]; "
+                "keep one"
+            )
+        space |= table
+        if not space:
+            raise WorkbenchInputError(
+                f"controller {controller!r} declares no search space and the spec gives none: add a "
+                f"[search.{controller}] table of its options and distributions, e.g. `option = {{uniform = [low, "
+                f"high]}}` (its options: `workbench controllers --show {controller}`)"
+            )
+        distributions, defaults = {}, {}
+        for key, value in space.items():
+            dist = value if isinstance(value, Distribution) else Distribution.parse(f"search.{controller}.{key}", value)
+            default = _default_value(controller, key)
+            if not _contains(dist, default):
+                raise WorkbenchInputError(
+                    f"search.{controller}.{key}: {dist.kind} {list(dist.values)} does not contain the shipped default "
+                    f"{value_text(default)}, which is every controller's trial 0 (so that tuned is never worse than "
+                    "default on the training objective); widen it, or fix the option in [fixed." + controller + "]"
+                )
+            distributions[key], defaults[key] = dist, default
+        return distributions, defaults
+
+    def _study(self, controller: str, case_set: CaseSet) -> StudySpec:
+        """The StudySpec of one controller on one set: its cases as the grid, its fixed options, and (training)
+        the trial budget and search space as the [optimise] settings."""
+        optimise = None
+        if case_set.name == "train":
+            optimise = OptimiseSettings(
+                trials=self.trials,
+                objective={self.objectives[0]: 1.0},
+                search=dict(self.search[controller]),
+                batch_size=self.batch_size,
+                seed=self.seed,
+            )
+        grid = {
+            "speed_kmh": list(case_set.speeds_kmh),
+            "conditions": list(case_set.conditions),
+            "seed": list(case_set.seeds),
+            "inform_delays": [self.inform_delays],
+        }
+        try:
+            return StudySpec(
+                scenarios=case_set.scenarios,
+                controllers=(controller,),
+                vehicles=self.vehicles,
+                grid=grid,
+                controller_grid={controller: {k: [v] for k, v in self.fixed[controller].items()}},
+                seed=self.seed,
+                track_file=self.track_file,
+                description=self.description,
+                base_dir=self.base_dir,
+                optimise=optimise,
+                max_runs=self.max_runs,
+            )
+        except WorkbenchInputError as exc:
+            raise WorkbenchInputError(_in_tournament_terms(str(exc), case_set.name, controller)) from None
+
+    def _check_held_out(self, train: StudySpec, test: StudySpec) -> None:
+        both = sorted({case_id(r.parameters()) for r in train.plan()} & {case_id(r.parameters()) for r in test.plan()})
+        if both:
+            raise WorkbenchInputError(
+                f"case {both[0]!r} (scenario|vehicle|speed|conditions|seed) is in both the train and the test set"
+                + (f", and {len(both) - 1} more" if len(both) > 1 else "")
+                + ": the test set must be held out; change its scenarios, speeds, conditions or seeds"
+            )
+
+    def _check_size(self) -> None:
+        total = self.total_runs()
+        if total > self.max_runs:
+            raise WorkbenchInputError(
+                f"the tournament plans up to {total:,} runs ({len(self.controllers)} controller(s) x ({self.trials} "
+                f"trials x {self.cases('train')} training cases + {2 + self.front_points} judged configurations x "
+                f"{self.cases('test')} test cases)), more than the limit of {self.max_runs:,}: fewer trials, cases "
+                "or front points, or raise the limit with tournament.max_runs or --max-runs N"
+            )
+
+    # ------------------------------------------------------------------------------------------- planning
+    def cases(self, set_name: str) -> int:
+        """How many cases a set has (scenarios x vehicles x speeds x conditions x seeds)."""
+        case_set = self.train if set_name == "train" else self.test
+        return (
+            len(case_set.scenarios)
+            * len(self.vehicles)
+            * len(case_set.speeds_kmh)
+            * len(case_set.conditions)
+            * len(case_set.seeds)
+        )
+
+    def total_runs(self) -> int:
+        """The most runs the tournament executes: per controller, its trials on the training cases and its default,
+        tuned and carried front configurations on the test cases."""
+        per_controller = self.trials * self.cases("train") + (2 + self.front_points) * self.cases("test")
+        return len(self.controllers) * per_controller
+
+    def plan(self, controller: str, set_name: str, options: Mapping[str, Any] | None = None) -> list[PlannedRun]:
+        """The runs of `controller` on a set's cases with `options` (searched parameters) over its fixed ones."""
+        if set_name not in SETS:
+            raise WorkbenchInputError(f"set must be one of {', '.join(SETS)}; got {set_name!r}")
+        return self.studies[(controller, set_name)].plan(dict(options or {}))
+
+    def selection_text(self) -> str:
+        """The selection rule in words."""
+        return (
+            f"the point of the controller's training front (objectives {', '.join(self.objectives)}, each the mean "
+            f"over the training cases) with the least {weights_text(self.selection)}; ties: the earlier trial"
+        )
+
+    def ranking_text(self) -> str:
+        """The ranking scalar of a test run in words."""
+        return (
+            f"{weights_text(self.ranking)} per test run; a failed run (did not complete, left the track, limit "
+            f"cycle) scores {self.failure_score:g}"
+        )
+
+    def solve_budget_text(self) -> str:
+        """The MPCs' solve budget in words."""
+        mpcs = [c for c in self.controllers if SOLVE_BUDGET_OPTION in self.fixed[c]]
+        if not mpcs:
+            return "no controller in the tournament has a solve budget"
+        budgets = ", ".join(f"{c} {self.fixed[c][SOLVE_BUDGET_OPTION]:g} s" for c in mpcs)
+        return f"{SOLVE_BUDGET_OPTION}: {budgets} (never reached, so no solve is cut short and runs reproduce)"
+
+
+_TERMS = (
+    ("study.scenarios", "{set}.scenarios"),
+    ("study.vehicles", "tournament.vehicles"),
+    ("study.track_file", "tournament.track_file"),
+    ("study.max_runs or --max-runs N", "tournament.max_runs or --max-runs N"),
+    ("study.allow_infeasible", "a feasible path"),
+    ("grid.speed_kmh", "{set}.speeds_kmh"),
+    ("grid.conditions", "{set}.conditions"),
+    ("grid.seed", "{set}.seeds"),
+    ("grid.{controller}.", "fixed.{controller}."),
+    ("[grid.{controller}]", "[fixed.{controller}]"),
+    ("optimise.search.", "search.{controller}."),
+    ("[optimise.search]", "[search.{controller}]"),
+)
+
+
+def _in_tournament_terms(message: str, set_name: str, controller: str) -> str:
+    """A study's error message in the tournament spec's terms (its keys named as the tournament names them)."""
+    for study_term, term in _TERMS:
+        message = message.replace(
+            study_term.format(controller=controller), term.format(set=set_name, controller=controller)
+        )
+    return f"{controller} on the {set_name} set: {message}"
+
+
+def load_tournament(path: str | Path, max_runs: int | None = None) -> TournamentSpec:
+    """Read a tournament spec from a TOML file; max_runs (`--max-runs`) over the spec's tournament.max_runs.
+    WorkbenchInputError naming the file, the key and what is allowed for anything it cannot use."""
+    path = Path(path)
+    document = read_toml(path, f"tournament spec {str(path)!r}")
+    try:
+        return tournament_from_document(document, path.resolve().parent, max_runs, source=path)
+    except WorkbenchInputError as exc:
+        raise WorkbenchInputError(f"spec {path}: {exc}") from None
+
+
+def tournament_from_document(
+    document: Mapping[str, Any], base_dir: Path, max_runs: int | None = None, source: Path | None = None
+) -> TournamentSpec:
+    """A TournamentSpec from a parsed TOML document (paths relative to base_dir)."""
+    unknown = [k for k in document if k not in TABLES]
+    if unknown:
+        hint = " ([study], [grid] and [optimise] belong to sweep and optimise specs)" if "study" in unknown else ""
+        raise WorkbenchInputError(f"unknown table(s) {', '.join(unknown)}; allowed: {', '.join(TABLES)}{hint}")
+    head = document.get("tournament")
+    if not isinstance(head, Mapping):
+        raise WorkbenchInputError("the spec needs a [tournament] table with controllers, vehicles and trials")
+    unknown = [k for k in head if k not in TOURNAMENT_KEYS]
+    if unknown:
+        raise WorkbenchInputError(
+            f"unknown key(s) tournament.{', tournament.'.join(unknown)}; allowed: {', '.join(TOURNAMENT_KEYS)}"
+        )
+    missing = [k for k in ("controllers", "vehicles", "trials") if k not in head]
+    missing += [f"[{name}]" for name in SETS if name not in document]
+    if missing:
+        raise WorkbenchInputError(f"the spec needs {', '.join(missing)}")
+    options = {k: head[k] for k in TOURNAMENT_KEYS if k in head and k not in ("controllers", "vehicles", "trials")}
+    if "objectives" in options and isinstance(options["objectives"], list):
+        options["objectives"] = tuple(options["objectives"])
+    if max_runs is not None:
+        options["max_runs"] = max_runs
+    return TournamentSpec(
+        controllers=head["controllers"],
+        vehicles=head["vehicles"],
+        train=CaseSet.from_table("train", document["train"]),
+        test=CaseSet.from_table("test", document["test"]),
+        trials=head["trials"],
+        search_tables=document.get("search", {}),
+        fixed_tables=document.get("fixed", {}),
+        base_dir=base_dir,
+        source=source,
+        **options,
+    )
+
+
+__all__ = [
+    "DEFAULT_FAILURE_SCORE",
+    "DEFAULT_OBJECTIVES",
+    "DEFAULT_RANKING",
+    "DEFAULT_SELECTION",
+    "MAX_FRONT_POINTS",
+    "MPC_SOLVE_BUDGET_S",
+    "CaseSet",
+    "TournamentSpec",
+    "case_id",
+    "load_tournament",
+    "tournament_from_document",
+    "weights_text",
+]
