@@ -44,6 +44,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from controllers.search_space import Tunable
 from workbench.base.errors import is_number, require_positive, value_text
 from workbench.base.path import ReferencePath, wrap_angle
 from workbench.simulation.control_interface import COMMAND_REJECTED, MEASUREMENT_REJECTED, Measurement
@@ -86,6 +87,9 @@ class Controller(ABC):
 
     name: ClassVar[str]
     config_type: ClassVar[type]
+    #: The options worth tuning, with bounds, scale and reason (`controllers.search_space`); empty: none declared,
+    #: and a tournament spec gives the controller its space as a [search.NAME] table.
+    search_space: ClassVar[tuple[Tunable, ...]] = ()
 
     def __init__(self, geometry: VehicleGeometry, config: Any | None = None, vehicle: object | None = None) -> None:
         """`geometry`: the steered vehicle's; `config`: an instance of `config_type` (its defaults when None);

@@ -51,6 +51,7 @@ from controllers.clothoid.lookahead_filter import RATE_LIMIT
 from controllers.clothoid.path_feedforward import FeedforwardTiming
 from controllers.clothoid.vehicle_tuning import VehicleTuning
 from controllers.config_checks import Choice, Flag, Instance, Number, check_options, option
+from controllers.search_space import Tunable
 from workbench.base.errors import WorkbenchInputError, value_text
 from workbench.base.path import PathTracker, ReferencePath
 from workbench.vehicles.base import VehicleGeometry
@@ -346,6 +347,23 @@ class ClothoidController(Controller):
 
     name: ClassVar[str] = "clothoid"
     config_type: ClassVar[type] = ClothoidConfig
+    #: Not the margin floors (min_phase_margin_deg, min_gain_margin_db): they are the design's safety, not knobs.
+    search_space: ClassVar[tuple[Tunable, ...]] = (
+        Tunable("frechet_threshold_m", "log", 0.005, 0.5, reason="smaller admits only clothoids that hug the path: "
+                "shorter lookaheads, tighter tracking, busier steering"),
+        Tunable("prediction_time_s", "linear", 0.0, 0.6, reason="predicting the start pose further ahead anticipates "
+                "the steering's lag; too far steers for a pose not yet reached"),
+        Tunable("min_preview_time_s", "linear", 0.0, 1.0, reason="a lookahead of at least this time x speed is calmer "
+                "at speed and cuts tight bends more"),
+        Tunable("lead_filter_zero_scale", "log", 0.8, 1.25, reason="moves the lead filter's zeros: > 1 assumes a "
+                "faster steering lag (less lead), < 1 a slower one"),
+        Tunable("lead_filter_pole_scale", "log", 0.9, 2.0, reason="moves the lead filter's poles: > 1 more phase lead "
+                "and high-frequency gain, which amplifies noise"),
+        Tunable("min_lookahead_m", "linear", 2.0, 10.0, reason="the shortest lookahead the search may choose: shorter "
+                "tracks tighter where the floor allows, longer is calmer"),
+        Tunable("max_lookahead_m", "linear", 12.0, 30.0, reason="the longest lookahead the search may choose: longer "
+                "is smoother on straights and cuts bends more"),
+    )  # fmt: skip
 
     def __init__(
         self, geometry: VehicleGeometry, config: ClothoidConfig | None = None, vehicle: object | None = None

@@ -56,6 +56,7 @@ from controllers.mpc.prediction_model import (
 from controllers.mpc.preview import PathPreview
 from controllers.mpc.solver import MPCSolver
 from controllers.mpc.status import SolveStatus
+from controllers.search_space import Tunable
 from workbench.base.errors import WorkbenchInputError, value_text
 from workbench.base.path import PathTracker, Projection, ReferencePath, wrap_angle
 from workbench.vehicles.geometry import VehicleGeometry
@@ -274,6 +275,26 @@ class MPCConfig:
             terminal_heading=self.terminal_weight_heading,
             lat_accel_slack=self.weight_lat_accel_slack,
         )
+
+
+#: The search space of both MPCs (`NMPCController`, `LMPCController`): the cost weights and the horizon. The
+#: weights act through their ratios, over decades: a log scale each.
+MPC_SEARCH_SPACE = (
+    Tunable("weight_cte", "log", 10.0, 5000.0, reason="a heavier cross-track weight tracks tighter for more "
+            "steering effort and less damping"),
+    Tunable("weight_heading", "log", 0.5, 500.0, reason="a heavier heading weight damps the approach to the path, "
+            "and slows the correction of an offset"),
+    Tunable("weight_steer_rate", "log", 0.1, 100.0, reason="a heavier steering-rate weight is smoother and slower: "
+            "less steering effort, more cross-track error"),
+    Tunable("terminal_weight_cte", "log", 100.0, 50000.0, reason="the horizon end's cross-track weight: heavier "
+            "settles on the path sooner, a short horizon stabler"),
+    Tunable("terminal_weight_heading", "log", 5.0, 2000.0, reason="the horizon end's heading weight: heavier "
+            "arrives aligned with the path, at the cost of effort"),
+    Tunable("horizon_steps", "integer", 10, 50, reason="a longer horizon sees bends earlier and is stabler, for "
+            "solve time growing with the steps"),
+    Tunable("step_s", "linear", 0.03, 0.1, reason="a longer prediction step sees further for the same solve time, "
+            "with a coarser model of fast motion"),
+)  # fmt: skip
 
 
 def resolve_prediction_params(geometry: VehicleGeometry, config: MPCConfig, vehicle: object | None) -> PredictionParams:

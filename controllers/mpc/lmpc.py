@@ -28,10 +28,11 @@ import numpy as np
 
 from controllers.config_checks import Number, Whole, option
 from controllers.mpc.codegen import FastFunction, compile_function
-from controllers.mpc.common import MPCConfig, MPCController
+from controllers.mpc.common import MPC_SEARCH_SPACE, MPCConfig, MPCController
 from controllers.mpc.ocp import TrackingOCP
 from controllers.mpc.sparse_qp import OsqpSettings
 from controllers.mpc.status import SolveResult
+from controllers.search_space import Tunable
 from workbench.vehicles.geometry import VehicleGeometry
 
 
@@ -127,6 +128,7 @@ class LMPCController(MPCController):
 
     name: ClassVar[str] = "lmpc"
     config_type: ClassVar[type] = LMPCConfig
+    search_space: ClassVar[tuple[Tunable, ...]] = MPC_SEARCH_SPACE
 
     def __init__(self, geometry: VehicleGeometry, config: Any | None = None, vehicle: object | None = None) -> None:
         super().__init__(geometry, config, vehicle)

@@ -22,10 +22,11 @@ from dataclasses import dataclass
 from typing import Any, ClassVar
 
 from controllers.config_checks import Choice, Flag, Number, Whole, option
-from controllers.mpc.common import MPCConfig, MPCController
+from controllers.mpc.common import MPC_SEARCH_SPACE, MPCConfig, MPCController
 from controllers.mpc.nlp_solver import IpoptSolver
 from controllers.mpc.rti import RtiSolver
 from controllers.mpc.sparse_qp import OsqpSettings
+from controllers.search_space import Tunable
 from workbench.vehicles.geometry import VehicleGeometry
 
 SOLVERS = ("rti", "ipopt")
@@ -64,6 +65,7 @@ class NMPCController(MPCController):
 
     name: ClassVar[str] = "nmpc"
     config_type: ClassVar[type] = NMPCConfig
+    search_space: ClassVar[tuple[Tunable, ...]] = MPC_SEARCH_SPACE
 
     def __init__(self, geometry: VehicleGeometry, config: Any | None = None, vehicle: object | None = None) -> None:
         super().__init__(geometry, config, vehicle)

@@ -97,6 +97,12 @@ def _parser(command: str | None = None) -> argparse.ArgumentParser:
     cond.add_argument("--show", metavar="NAME", help="print a preset as TOML (copy, edit, pass with --conditions)")
     ctl = sub.add_parser("controllers", help="list the controllers")
     ctl.add_argument("--show", metavar="NAME", help="print a controller's options as TOML (for --controller-config)")
+    ctl.add_argument(
+        "--search-space",
+        action="store_true",
+        help="with --show NAME: print instead the options the controller offers to tuning, as the [search.NAME] "
+        "table a tournament spec copies",
+    )
 
     run = sub.add_parser("run", help="simulate one controller on one vehicle along one scenario")
     run.add_argument("scenario", help="a scenario name (see `workbench scenarios`) or a waypoint CSV file")
@@ -917,8 +923,15 @@ def _controllers(args: argparse.Namespace) -> None:
     if args.show:
         if args.show not in CONTROLLERS:
             raise WorkbenchInputError(f"unknown controller {args.show!r}; choose one of {', '.join(CONTROLLERS)}")
-        print(config_template(args.show, CONTROLLERS[args.show].config_type), end="")
+        if args.search_space:
+            from controllers.search_space import search_space_toml
+
+            print(search_space_toml(args.show), end="")
+        else:
+            print(config_template(args.show, CONTROLLERS[args.show].config_type), end="")
         return
+    if args.search_space:
+        raise WorkbenchInputError("--search-space needs --show NAME: the controller whose search space to print")
     for name in CONTROLLERS:
         try:
             summary = CONTROLLERS[name].summary()
