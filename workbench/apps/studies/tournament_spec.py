@@ -226,8 +226,8 @@ class TournamentSpec:
     studies: Mapping[tuple[str, str], StudySpec] = field(init=False)
 
     def __post_init__(self) -> None:
-        """Check the scalars and rules, the controllers and their tables, then build the studies (every check of
-        a study), then refuse a case in both sets and a tournament of more runs than max_runs."""
+        """Check the scalars and rules, the controllers and their tables, the tournament's size (at most
+        max_runs), then build the studies (every check of a study) and refuse a case in both sets."""
         object.__setattr__(self, "base_dir", Path(self.base_dir).resolve())
         self._check_scalars()
         self._check_controllers()
@@ -238,6 +238,7 @@ class TournamentSpec:
         object.__setattr__(self, "fixed", MappingProxyType(fixed))
         object.__setattr__(self, "search", MappingProxyType(search))
         object.__setattr__(self, "defaults", MappingProxyType(defaults))
+        self._check_size()
         studies: dict[tuple[str, str], StudySpec] = {}
         for controller in self.controllers:
             for case_set in (self.train, self.test):
@@ -245,7 +246,6 @@ class TournamentSpec:
             if controller == self.controllers[0]:
                 self._check_held_out(studies[(controller, "train")], studies[(controller, "test")])
         object.__setattr__(self, "studies", MappingProxyType(studies))
-        self._check_size()
 
     # ------------------------------------------------------------------------------------------- checks
     def _check_scalars(self) -> None:
@@ -331,6 +331,12 @@ class TournamentSpec:
         from controllers.search_space import controller_search_space
 
         table = dict(self.search_tables.get(controller, {}))
+        allowed = controller_parameters(controller)
+        for key in table:
+            if key not in allowed:
+                raise WorkbenchInputError(
+                    f"unknown parameter search.{controller}.{key} for {controller}; allowed: {', '.join(allowed)}"
+                )
         space: dict[str, Any] = {t.name: t.distribution_table() for t in controller_search_space(controller)}
         space = {k: v for k, v in space.items() if k not in fixed}
         both = sorted(set(table) & set(fixed))
