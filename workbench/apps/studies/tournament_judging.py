@@ -32,16 +32,15 @@ from itertools import combinations
 import numpy as np
 import pandas as pd
 
+from workbench.apps.studies.spec import OBJECTIVE_METRICS
+from workbench.apps.studies.tournament_spec import DEFAULT_OBJECTIVES
 from workbench.base.errors import WorkbenchInputError, value_text
-from workbench.simulation.metrics import METRIC_KEYS
 
 #: The share of the resampled means an interval holds (a 95 % interval).
 CONFIDENCE = 0.95
 #: Bootstrap resamples when none are given, and the fewest allowed (fewer make the interval's ends noisy).
 DEFAULT_RESAMPLES = 2000
 MIN_RESAMPLES = 100
-#: The objective metrics judged when none are given: tracking (RMS and max |CTE|) and steering effort.
-DEFAULT_OBJECTIVES = ("rms_cte_m", "max_abs_cte_m", "rms_steer_rate_deg_s")
 #: The column of the per-case table and the metric name of the gap table that hold the ranking scalar.
 SCORE = "score"
 #: The configurations of a results row: a training trial, and the judged ones (plus FRONT_PREFIX + rank).
@@ -52,10 +51,6 @@ REQUIRED_COLUMNS = (
     "run_id", "scenario", "controller", "set", "config", "trial", "case", "failed", "cpu_time_s",
     "step_time_median_us", "step_time_p99_us",
 )  # fmt: skip
-#: Metrics a ranking or objective may name: the numeric fields of a run's metrics.
-NUMERIC_METRICS = tuple(
-    k for k in METRIC_KEYS if k not in ("scenario", "controller", "vehicle", "completed", "limit_cycle", "left_track")
-)
 
 
 @dataclass(frozen=True)
@@ -171,8 +166,8 @@ def _require_finite_number(name: str, value: object) -> None:
 
 def _require_metrics(name: str, metrics: Sequence[str]) -> None:
     for metric in metrics:
-        if metric not in NUMERIC_METRICS:
-            raise WorkbenchInputError(f"{name}: unknown metric {metric!r}; allowed: {', '.join(NUMERIC_METRICS)}")
+        if metric not in OBJECTIVE_METRICS:
+            raise WorkbenchInputError(f"{name}: unknown metric {metric!r}; allowed: {', '.join(OBJECTIVE_METRICS)}")
 
 
 def statistic_rng(seed: int, *key: str) -> np.random.Generator:
@@ -444,7 +439,6 @@ def judge(
 __all__ = [
     "CONFIDENCE",
     "DEFAULT",
-    "DEFAULT_OBJECTIVES",
     "DEFAULT_RESAMPLES",
     "FRONT_PREFIX",
     "MIN_RESAMPLES",

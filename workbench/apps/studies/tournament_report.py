@@ -53,7 +53,9 @@ SECTIONS: tuple[tuple[str, str], ...] = (
     ("rules", "The rules"),
     ("reading", "How to read this report"),
 )
-#: The steering effort every front is drawn against.
+#: The history columns the report reads, besides the train_ mean of each objective.
+HISTORY_COLUMNS = ("controller", "trial", "state", "params_json", "pareto", "chosen", "carried")
+#: The steering effort the fronts are drawn against when it is an objective.
 EFFORT = "rms_steer_rate_deg_s"
 #: Sizes (inches) of a two-panel figure (a front and its test points) and of the stacked traces.
 WIDE_FIGURE_IN = (12.0, 4.5)
@@ -70,49 +72,49 @@ def _new_axes(size: tuple[float, float] = plots.FIGURE_SIZE_IN, panels: int = 1,
     return list(np.ravel(figure.subplots(rows, panels, squeeze=False)))
 
 
-def front_error(judgement: Judgement) -> str:
-    """The tracking metric the fronts are drawn with: max |CTE| when the ranking weighs it, else RMS CTE when the
-    ranking weighs that, else max |CTE|."""
-    if "max_abs_cte_m" not in judgement.ranking and "rms_cte_m" in judgement.ranking:
-        return "rms_cte_m"
-    return "max_abs_cte_m"
+def front_metrics(objectives: Sequence[str], ranking: Mapping[str, float]) -> tuple[str, str]:
+    """(effort, error): the objectives the fronts are drawn with. Effort: the RMS steering rate when it is an
+    objective, else the last objective; error: of max |CTE| and RMS CTE the one the ranking weighs (max |CTE| first)
+    when it is an objective, else the other, else the first objective."""
+    effort = EFFORT if EFFORT in objectives else objectives[-1]
+    weighed = [m for m in ("max_abs_cte_m", "rms_cte_m") if m in ranking]
+    preferred = [*weighed, "max_abs_cte_m", "rms_cte_m"]
+    error = next((m for m in preferred if m in objectives and m != effort), objectives[0])
+    return effort, error
 
 
 def _label(metric: str) -> str:
     return LABELS.get(metric, metric)
 
 
-def training_front(history: pd.DataFrame, controller: str, ax: Axes, error: str = "max_abs_cte_m") -> Axes:
-    """The controller's trials on the training cases (mean `error` against mean RMS steering rate, the history's
-    train_ columns): every trial, its front as a line, the default (trial 0), the chosen trial and the front points
-    carried to the test set (numbered by their rank)."""
+def training_front(
+    history: pd.DataFrame, controller: str, ax: Axes, error: str = "max_abs_cte_m", effort: str = EFFORT
+) -> Axes:
+    """The controller's trials on the training cases (the history's train_ means of `error` against `effort`):
+    every trial, the points of its front (over every objective: with more than two, a front point may look beaten
+    in this projection), the default (trial 0), the chosen trial and the front points carried to the test set
+    (F1.., by their rank)."""
     own = history[history["controller"] == controller]
-    x, y = own[f"train_{EFFORT}"].astype(float), own[f"train_{error}"].astype(float)
+    xs, ys = f"train_{effort}", f"train_{error}"
+    x, y = own[xs].astype(float), own[ys].astype(float)
     complete = (own["state"] == "complete").to_numpy()
     ax.scatter(x[complete], y[complete], s=14, color="0.55", alpha=0.6, linewidths=0, label="trials")
     failed = ~complete & np.isfinite(x.to_numpy()) & np.isfinite(y.to_numpy())
     if failed.any():
         ax.scatter(x[failed], y[failed], s=18, marker="x", color="tab:red", alpha=0.6, label="failed trials")
-    front = own[own["pareto"].astype(bool)].sort_values(f"train_{EFFORT}")
-    ax.plot(
-        front[f"train_{EFFORT}"], front[f"train_{error}"], "-", drawstyle="steps-post", color="tab:blue", label="front"
-    )
-    _mark(ax, own[own["trial"] == 0], f"train_{EFFORT}", f"train_{error}", "s", "default (trial 0)")
-    _mark(ax, own[own["chosen"].astype(bool)], f"train_{EFFORT}", f"train_{error}", "*", "chosen (tuned)")
+    front = own[own["pareto"].astype(bool)]
+    ax.scatter(front[xs], front[ys], s=22, color="tab:blue", zorder=2, label="front")
+    _mark(ax, own[own["trial"] == 0], xs, ys, "s", "default (trial 0)")
+    _mark(ax, own[own["chosen"].astype(bool)], xs, ys, "*", "chosen (tuned)")
     carried = own[own["carried"].notna()]
     if not carried.empty:
         ax.scatter(
-            carried[f"train_{EFFORT}"],
-            carried[f"train_{error}"],
-            s=60,
-            facecolors="none",
-            edgecolors="tab:green",
-            label="carried to the test set",
+            carried[xs], carried[ys], s=70, facecolors="none", edgecolors="tab:green", label="carried to the test set"
         )
         for row in carried.itertuples():
-            point = (getattr(row, f"train_{EFFORT}"), getattr(row, f"train_{error}"))
+            point = (getattr(row, xs), getattr(row, ys))
             ax.annotate(f"F{int(row.carried)}", point, xytext=(4, 4), textcoords="offset points", fontsize=7)
-    ax.set(xlabel=_label(EFFORT), ylabel=_label(error), title=f"{controller}: trials on the training cases (means)")
+    ax.set(xlabel=_label(effort), ylabel=_label(error), title=f"{controller}: trials on the training cases (means)")
     ax.grid(alpha=0.3)
     ax.legend(fontsize="small")
     return ax
@@ -120,27 +122,20 @@ def training_front(history: pd.DataFrame, controller: str, ax: Axes, error: str 
 
 def _mark(ax: Axes, rows: pd.DataFrame, x: str, y: str, marker: str, label: str) -> None:
     if not rows.empty:
-        ax.scatter(
-            rows[x],
-            rows[y],
-            s=110 if marker == "*" else 55,
-            marker=marker,
-            color="tab:orange",
-            edgecolors="k",
-            linewidths=0.6,
-            zorder=3,
-            label=label,
-        )
+        size = 110 if marker == "*" else 55
+        ax.scatter(rows[x], rows[y], s=size, marker=marker, color="tab:orange", edgecolors="k", zorder=3, label=label)
 
 
-def judged_points(scores: pd.DataFrame, controller: str, ax: Axes, error: str = "max_abs_cte_m") -> Axes:
-    """The controller's judged configurations on the test cases: mean `error` against mean RMS steering rate, with
-    their intervals as error bars: the default, the tuned configuration and the carried front points (F1..F5)."""
+def judged_points(
+    scores: pd.DataFrame, controller: str, ax: Axes, error: str = "max_abs_cte_m", effort: str = EFFORT
+) -> Axes:
+    """The controller's judged configurations on the test cases: mean `error` against mean `effort`, with their
+    intervals as error bars: the default, the tuned configuration and the carried front points (F1..)."""
     own = scores[scores["controller"] == controller]
     for row in own.itertuples():
         config = str(row.config)
-        x, y = getattr(row, EFFORT), getattr(row, error)
-        xerr = [[x - getattr(row, f"{EFFORT}_low")], [getattr(row, f"{EFFORT}_high") - x]]
+        x, y = getattr(row, effort), getattr(row, error)
+        xerr = [[x - getattr(row, f"{effort}_low")], [getattr(row, f"{effort}_high") - x]]
         yerr = [[y - getattr(row, f"{error}_low")], [getattr(row, f"{error}_high") - y]]
         if config == DEFAULT:
             style = {"marker": "s", "color": "tab:orange", "label": "default"}
@@ -155,7 +150,7 @@ def judged_points(scores: pd.DataFrame, controller: str, ax: Axes, error: str = 
             )
     if own["config"].astype(str).str.startswith(FRONT_PREFIX).any():
         ax.plot([], [], "o", color="tab:green", mfc="none", label="carried front points")
-    ax.set(xlabel=_label(EFFORT), ylabel=_label(error), title=f"{controller}: on the test cases (means, {_PERCENT})")
+    ax.set(xlabel=_label(effort), ylabel=_label(error), title=f"{controller}: on the test cases (means, {_PERCENT})")
     ax.grid(alpha=0.3)
     ax.legend(fontsize="small")
     return ax
@@ -317,21 +312,22 @@ def _leaderboard_section(summary: TournamentSummary, judgement: Judgement) -> li
 
 
 def _fronts_section(history: pd.DataFrame, judgement: Judgement) -> list[str]:
-    error = front_error(judgement)
+    effort, error = front_metrics(judgement.objectives, judgement.ranking)
     parts = [
         _heading("fronts"),
         _paragraph(
             f"Left: every trial of the controller on the training cases ({_label(error)} against "
-            f"{_label(EFFORT)}, each the mean over the training cases), its front, its default (trial 0), the chosen "
-            "trial and the front points carried to the test set (F1..F5). Right: the same configurations judged on "
-            f"the test cases (means, {_PERCENT} intervals as bars)."
+            f"{_label(effort)}, each the mean over the training cases), the points of its front (over the objectives "
+            f"{', '.join(judgement.objectives)}), its default (trial 0), the chosen trial and the front points carried "
+            "to the test set (F1.., by rank). Right: the same configurations judged on the test cases (means, "
+            f"{_PERCENT} intervals as bars)."
         ),
     ]
     chosen = []
     for controller in judgement.leaderboard["controller"]:
         left, right = _new_axes(WIDE_FIGURE_IN, panels=2)
-        training_front(history, controller, left, error)
-        judged_points(judgement.scores, controller, right, error)
+        training_front(history, controller, left, error, effort)
+        judged_points(judgement.scores, controller, right, error, effort)
         parts.append(png_figure(figure_png(left.figure), f"{controller}: front on training, points on test"))
         row = history[(history["controller"] == controller) & history["chosen"].astype(bool)]
         if not row.empty:
@@ -539,6 +535,10 @@ def write_report(
     untrained = sorted(judged - set(history["controller"]))
     if untrained:
         raise WorkbenchInputError(f"the history holds no trial of controller {untrained[0]!r}")
+    lacking = [f"train_{m}" for m in judgement.objectives if f"train_{m}" not in history.columns]
+    lacking += [c for c in HISTORY_COLUMNS if c not in history.columns]
+    if lacking:
+        raise WorkbenchInputError(f"the history lacks the column(s) {', '.join(lacking)}")
     extra = sorted(set(traces) - judged)
     if extra:
         raise WorkbenchInputError(f"a trace is given for {extra[0]!r}, which was not judged")
@@ -550,11 +550,12 @@ def write_report(
 
 __all__ = [
     "EFFORT",
+    "HISTORY_COLUMNS",
     "READING",
     "REPORT_FILE",
     "SECTIONS",
     "default_against_tuned",
-    "front_error",
+    "front_metrics",
     "judged_points",
     "render_report",
     "steering_rate_comparison",

@@ -13,7 +13,8 @@ import pytest
 from judging_frames import FAILURE_SCORE, RANKING, Run, history_frame, results_frame, summary
 
 from workbench.apps.studies.tournament_judging import judge
-from workbench.apps.studies.tournament_report import SECTIONS, training_front, write_report
+from workbench.apps.studies.tournament_report import SECTIONS, front_metrics, training_front, write_report
+from workbench.apps.studies.tournament_spec import DEFAULT_OBJECTIVES
 from workbench.base.errors import WorkbenchInputError
 
 matplotlib.use("Agg")
@@ -202,11 +203,29 @@ def test_the_training_front_marks_the_default_the_chosen_and_the_carried_points(
     for label in ("trials", "failed trials", "front", "default (trial 0)", "chosen (tuned)", "carried to the test set"):
         assert label in labels
     assert sorted(a.get_text() for a in ax.texts) == ["F1", "F2"]
-    front_line = next(line for line in ax.get_lines() if line.get_label() == "front")
-    assert list(front_line.get_xdata()) == [5.0, 8.0, 9.0, 14.0]  # trials 1, 0, 2, 3 by steering rate
+    front = next(c for c in ax.collections if c.get_label() == "front")
+    assert sorted(front.get_offsets()[:, 0]) == [5.0, 8.0, 9.0, 14.0]  # trials 1, 0, 2, 3; 4 failed
 
 
-def test_a_trace_of_a_controller_not_judged_is_refused(tournament, tmp_path: Path) -> None:
+@pytest.mark.parametrize(
+    ("objectives", "ranking", "expected"),
+    [
+        (DEFAULT_OBJECTIVES, RANKING, ("rms_steer_rate_deg_s", "max_abs_cte_m")),
+        (DEFAULT_OBJECTIVES, {"rms_cte_m": 1.0}, ("rms_steer_rate_deg_s", "rms_cte_m")),
+        (("rms_cte_m", "max_abs_steer_rate_deg_s"), RANKING, ("max_abs_steer_rate_deg_s", "rms_cte_m")),
+    ],
+)
+def test_the_fronts_are_drawn_with_the_objectives_the_ranking_weighs(objectives, ranking, expected) -> None:
+    assert front_metrics(objectives, ranking) == expected
+
+
+def test_a_trace_of_a_controller_not_judged_and_a_history_without_an_objective_are_refused(
+    tournament, tmp_path: Path
+) -> None:
     results, history, judgement = tournament
     with pytest.raises(WorkbenchInputError, match="a trace is given for 'nmpc', which was not judged"):
         write_report(tmp_path, summary(results), results, history, judgement, {"nmpc": None})
+    with pytest.raises(WorkbenchInputError, match=r"the history lacks the column.s. train_max_abs_cte_m, carried$"):
+        bare = history.drop(columns=["train_max_abs_cte_m", "carried"])
+        write_report(tmp_path, summary(results), results, bare, judgement, {})
+    assert not (tmp_path / "report.html").exists()
