@@ -595,6 +595,9 @@ def cases() -> list[Case]:
     add(Case("workbench-run-vehicle-and-mismatched-file", "workbench",
              (*WB_BASE["run"], "--vehicle", "tractor-semitrailer", "--vehicle-file", "vehicle.toml")))  # fmt: skip
     add(Case("workbench-controllers-show-unknown", "workbench", ("controllers", "--show", "stanly")))
+    add(Case("workbench-controllers-search-space-without-show", "workbench", ("controllers", "--search-space")))
+    add(Case("workbench-controllers-search-space-unknown", "workbench", ("controllers", "--show", "stanly",
+             "--search-space")))  # fmt: skip
     add(Case("workbench-vehicles-show-unknown", "workbench", ("vehicles", "--show", "hovercraft")))
     add(Case("workbench-conditions-show-unknown", "workbench", ("conditions", "--show", "foggy")))
     add(Case("workbench-no-command", "workbench", ()))
