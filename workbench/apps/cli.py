@@ -29,7 +29,7 @@ import sys
 from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, cast
 
 from controllers import CONTROLLERS
 from workbench.base.console import console_exit, warn_on_stderr
@@ -42,6 +42,7 @@ if TYPE_CHECKING:
     from workbench.apps.stage_progress import StageProgress
     from workbench.apps.studies import StudySpec
     from workbench.apps.studies.backends import Backend
+    from workbench.apps.studies.tournament_spec import TournamentSpec
     from workbench.base.output_dir import OutputDir
     from workbench.simulation.plot_worker import PlotWorker
     from workbench.simulation.result import SimulationResult
@@ -185,6 +186,14 @@ def _parser(command: str | None = None) -> argparse.ArgumentParser:
     opt.add_argument("spec", type=Path, metavar="SPEC.toml", help="the study spec with an [optimise] table")
     opt.add_argument("--out", type=Path, required=True, metavar="DIR", help="output directory (rerun to resume)")
     _backend_options(opt, command in (None, "optimise"))
+    tour = sub.add_parser(
+        "tournament",
+        help="tune every controller with the same trial budget on training cases, judge them on held-out test "
+        "cases; DIR/report.html",
+    )
+    tour.add_argument("spec", type=Path, metavar="SPEC.toml", help="the tournament spec (see README: Tournament)")
+    tour.add_argument("--out", type=Path, required=True, metavar="DIR", help="output directory (rerun to resume)")
+    _backend_options(tour, command in (None, "tournament"))
     return parser
 
 
@@ -637,7 +646,7 @@ def _max_runs(args: argparse.Namespace) -> int | None:
     return args.max_runs
 
 
-def _start_study(args: argparse.Namespace, kind: str) -> tuple[StudySpec, Backend]:
+def _start_study(args: argparse.Namespace, kind: str) -> tuple[StudySpec | TournamentSpec, Backend]:
     """Check the output folder (a study's resumable store: `check_study_dir`) and the spec (every file it names,
     the study's size), start nothing yet but the folder and the spec's copy in it."""
     from workbench.apps.studies import load_spec, make_backend
@@ -645,7 +654,12 @@ def _start_study(args: argparse.Namespace, kind: str) -> tuple[StudySpec, Backen
 
     check_study_dir(args.out)
     _check_inputs(args)
-    spec = load_spec(args.spec, kind, max_runs=_max_runs(args))
+    if kind == "tournament":
+        from workbench.apps.studies.tournament_spec import load_tournament
+
+        spec = load_tournament(args.spec, max_runs=_max_runs(args))
+    else:
+        spec = load_spec(args.spec, kind, max_runs=_max_runs(args))
     backend = make_backend(args.backend, args.scheduler, args.workers)
     copy = args.out / "spec.toml"
     try:
@@ -768,6 +782,39 @@ def _optimise(args: argparse.Namespace) -> int:
         params = ", ".join(f"{k} = {v!r}" for k, v in result.best_params.items())
         print(f"best: trial {result.best_trial}, objective {result.best_value:.6g}: {params}")
         print(f"wrote {result.config_file} (use with --controller-config), best.json, history.parquet, results.parquet")
+        return 0
+
+    return _interruptible(study, args.out, backend)
+
+
+#: The leaderboard's columns `workbench tournament` prints (the report has them all).
+_LEADERBOARD_COLUMNS = (
+    "rank", "controller", "trial", "score", "score_low", "score_high", "default_score", "failed_fraction",
+    "max_abs_cte_m", "rms_steer_rate_deg_s", "step_time_p99_us", "cpu_time_s", "not_distinguishable_from",
+)  # fmt: skip
+
+
+def _tournament(args: argparse.Namespace) -> int:
+    """`workbench tournament`: the stages on stderr, the leaderboard and what was written on stdout."""
+    from workbench.apps.studies.tournament import run_tournament
+
+    study_spec, backend = _start_study(args, "tournament")
+    spec = cast("TournamentSpec", study_spec)
+
+    def study() -> int:
+        print(
+            f"{len(spec.controllers)} controllers x {spec.trials} trials on {spec.cases('train')} training cases, "
+            f"judged on {spec.cases('test')} test cases, on the {backend.describe()}"
+        )
+        result = run_tournament(spec, args.out, backend, progress=sys.stderr.isatty())
+        board = result.judgement.leaderboard if result.judgement is not None else result.summary(spec)
+        board = board[[c for c in _LEADERBOARD_COLUMNS if c in board.columns] or list(board.columns)]
+        print(f"{len(result.results)} runs ({result.ran} run now); on the test set, {spec.ranking_text()}:")
+        print(board.to_string(index=False, float_format=lambda v: f"{v:.4g}", na_rep="-"))
+        untuned = [c for c, trial in result.chosen.items() if trial is None]
+        if untuned:
+            print(f"  no trial completed for {', '.join(untuned)}: tuned is the default")
+        print(f"wrote {result.report}, results.parquet, history.parquet, best/<controller>.toml in {args.out}")
         return 0
 
     return _interruptible(study, args.out, backend)
@@ -969,6 +1016,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             return _robustness(args)
         elif args.command == "optimise":
             return _optimise(args)
+        elif args.command == "tournament":
+            return _tournament(args)
         else:
             return _run(args)
     except WorkbenchInputError as exc:
