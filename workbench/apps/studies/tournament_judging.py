@@ -17,7 +17,8 @@ them) are averaged first, so that each case weighs alike.
   on the training cases, where its trial ran them (for the tuned configuration, the chosen trial).
 - The ranking: the controllers' tuned configurations by their mean scalar on the test set, lowest first. Two
   controllers are not distinguishable when the interval of their paired mean difference (the bootstrap over the
-  test cases both ran, `paired_difference`) contains 0.
+  test cases both ran, `paired_difference`) contains 0, or when they ran fewer than MIN_PAIRED_CASES cases in
+  common.
 """
 
 from __future__ import annotations
@@ -41,6 +42,10 @@ CONFIDENCE = 0.95
 #: Bootstrap resamples when none are given, and the fewest allowed (fewer make the interval's ends noisy).
 DEFAULT_RESAMPLES = 2000
 MIN_RESAMPLES = 100
+#: The fewest common test cases for two controllers to be told apart: with fewer, even a difference of the same sign
+#: on every case is no evidence at 5 % (a sign test: 2 x 0.5^5 = 6 % for five cases), and the percentile
+#: bootstrap of a handful of values draws its interval too narrow.
+MIN_PAIRED_CASES = 6
 #: The column of the per-case table and the metric name of the gap table that hold the ranking scalar.
 SCORE = "score"
 #: The configurations of a results row: a training trial, and the judged ones (plus FRONT_PREFIX + rank).
@@ -130,7 +135,8 @@ class Judgement:
     gap: one row per judged (controller, config) and metric (SCORE and each objective): train and test means, gap
     = test - train, and the cases each averages;
     pairwise: one row per pair of controllers, a ranked above b: cases (common test cases), difference (the mean
-    of a's scalar minus b's) with low/high, distinguishable (the interval excludes 0).
+    of a's scalar minus b's) with low/high, distinguishable (the interval excludes 0 and there are at least
+    MIN_PAIRED_CASES cases).
     ranking, failure_score, objectives, seed, resamples: what it was judged with."""
 
     leaderboard: pd.DataFrame
@@ -337,7 +343,7 @@ def _pairwise(per_case: pd.DataFrame, order: Sequence[str], seed: int, resamples
                 "difference": interval.mean,
                 "low": interval.low,
                 "high": interval.high,
-                "distinguishable": bool(len(common) > 0 and not interval.contains(0.0)),
+                "distinguishable": bool(len(common) >= MIN_PAIRED_CASES and not interval.contains(0.0)),
             }
         )
     return pd.DataFrame(
@@ -441,6 +447,7 @@ __all__ = [
     "DEFAULT",
     "DEFAULT_RESAMPLES",
     "FRONT_PREFIX",
+    "MIN_PAIRED_CASES",
     "MIN_RESAMPLES",
     "REQUIRED_COLUMNS",
     "SCORE",

@@ -26,6 +26,7 @@ from workbench.apps.studies.tournament_judging import (
     CONFIDENCE,
     DEFAULT,
     FRONT_PREFIX,
+    MIN_PAIRED_CASES,
     SCORE,
     TEST_SET,
     TUNED,
@@ -295,7 +296,7 @@ def _leaderboard_section(summary: TournamentSummary, judgement: Judgement) -> li
     ]
     text = (
         f"The controllers' tuned configurations by their mean ranking score on the {len(summary.test_cases)} test "
-        f"cases ({summary.ranking_rule}; a failed run scores {summary.failure_score:g}), best first. The metrics are "
+        f"cases ({summary.ranking_rule}), best first. The metrics are "
         "the tuned configuration's means over its test runs that did not fail; step times are measured in the same "
         "runs (the median of the runs' medians and of their 99th percentiles); CPU time is the training trials'."
     )
@@ -304,7 +305,8 @@ def _leaderboard_section(summary: TournamentSummary, judgement: Judgement) -> li
         parts += [
             _paragraph(
                 f"Paired comparisons: the mean difference of the ranking score over the test cases both ran, with its "
-                f"{_PERCENT} bootstrap interval; two controllers are distinguishable when the interval excludes 0."
+                f"{_PERCENT} bootstrap interval; two controllers are distinguishable when the interval excludes 0 "
+                f"and they ran at least {MIN_PAIRED_CASES} test cases in common."
             ),
             text_table(pd.DataFrame(pairs)),
         ]
@@ -479,8 +481,9 @@ READING = (
     "depends on which cases happened to be in the test set; few cases make it wide.",
     "Not distinguishable: two controllers are compared case by case (the paired difference over the test cases "
     f"both ran); when the {_PERCENT} interval of that mean difference contains 0, the test set cannot tell them apart, "
-    "whatever their ranks say. Pairing removes what the cases share (a hard track is hard for both), so two "
-    "controllers whose own intervals overlap can still be distinguishable.",
+    "whatever their ranks say; so it is with fewer than "
+    f"{MIN_PAIRED_CASES} common cases, too few for any verdict. Pairing removes what the cases share (a hard track is "
+    "hard for both), so two controllers whose own intervals overlap can still be distinguishable.",
     "The gap: the same metric on the training cases and on the test cases, each averaged per case first; test minus "
     "training. A large positive gap is tuning that fits the training cases and does not carry over.",
     "Fronts: on the training cases no configuration of the front is beaten on both tracking and steering effort; "

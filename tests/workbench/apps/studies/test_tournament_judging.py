@@ -13,6 +13,7 @@ from judging_frames import FAILURE_SCORE, RANKING, Run, case_id, results_frame, 
 from scipy import stats
 
 from workbench.apps.studies.tournament_judging import (
+    MIN_PAIRED_CASES,
     SCORE,
     Judgement,
     bootstrap_mean,
@@ -89,6 +90,16 @@ def test_the_leaderboard_ranks_by_the_tuned_score_and_names_who_cannot_be_told_a
     assert bool(pairs.loc[("clothoid", "nmpc"), "distinguishable"])
     assert not bool(pairs.loc[("nmpc", "stanley"), "distinguishable"])
     assert (pairs["cases"] == len(TEST)).all()
+
+
+def test_a_margin_on_too_few_common_cases_is_not_distinguishable() -> None:
+    results = _tournament({"clothoid": 0.0, "nmpc": 0.02})
+    few = {case_id(*case) for case in TEST[: MIN_PAIRED_CASES - 1]}
+    judgement = _judge(results[(results["set"] == "train") | results["case"].isin(few)])
+    pair = judgement.pairwise.iloc[0]
+    assert pair["cases"] == MIN_PAIRED_CASES - 1 and pair["high"] < 0.0  # one sign on every case, yet too few
+    assert not pair["distinguishable"]
+    assert list(judgement.leaderboard["not_distinguishable_from"]) == ["nmpc", "clothoid"]
 
 
 def test_scores_are_the_weighted_sum_averaged_per_case_with_the_failure_score() -> None:
