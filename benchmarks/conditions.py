@@ -1,9 +1,10 @@
 """Goals of issue 18 under real sensing and actuation: measured, printed and written as JSON.
 
-1. The loaded truck at 30 km/h under the `automotive` conditions: the clothoid controller (its pose prediction set
-   from the known delay, `known_delay_s`) and the NMPC with delay compensation (`input_delay_s`,
-   `measurement_latency_s`) and its pose filter (`pose_filter_cutoff_hz`) complete dlc, figure8 and zandvoort
-   with max |CTE| <= 0.15 m and no limit cycle.
+1. The loaded truck at 30 km/h under the `automotive` conditions, each controller told the conditions' nominal
+   delays (`Controller.informed_config` with `KnownDelays.from_conditions`, as `workbench run --inform-delays`
+   tells them): the clothoid controller (its pose prediction set from the known delay, `known_delay_s`) and the
+   NMPC with delay compensation (`input_delay_s`, `measurement_latency_s`) and its pose filter
+   (`pose_filter_cutoff_hz`) complete dlc, figure8 and zandvoort with max |CTE| <= 0.15 m and no limit cycle.
 2. The robustness study on the truck's dlc (clothoid, nmpc, stanley: 60 runs) finishes in under 3 minutes on 2
    workers, and the clothoid controller tolerates at least 150 ms of actuation dead time.
 
@@ -14,7 +15,6 @@
 from __future__ import annotations
 
 import argparse
-import dataclasses
 import json
 import math
 import os
@@ -29,6 +29,7 @@ from tuning.own_tuning import tuned_controller
 from workbench.apps.robustness import plan_robustness, run_robustness
 from workbench.apps.studies import make_backend
 from workbench.simulation.conditions import Conditions, load_conditions
+from workbench.simulation.known_delays import KnownDelays
 from workbench.simulation.scenarios import ScenarioOptions, make_scenario
 from workbench.simulation.simulator import Simulation, SimulationConfig
 from workbench.vehicles import make_vehicle
@@ -37,27 +38,15 @@ DEFAULT_TRACK = Path(__file__).resolve().parents[2] / "shared" / "tracks" / "Zan
 VEHICLE = "tractor-semitrailer"
 SCENARIOS = ("dlc", "figure8", "zandvoort")
 CTE_GOAL_M = 0.15
-#: The MPC's pose-filter crossover under noisy localisation (Hz; below its own 0.7 Hz offset correction).
-MPC_POSE_FILTER_CUTOFF_HZ = 0.3
 ROBUSTNESS_CONTROLLERS = ("clothoid", "nmpc", "stanley")
 ROBUSTNESS_RUNS_GOAL, ROBUSTNESS_TIME_GOAL_S, CLOTHOID_DELAY_GOAL_MS = 60, 180.0, 150.0
 
 
 def delay_aware(controller: str, conditions: Conditions) -> object:
-    """The controller's config knowing the conditions' delays: the pose latency and the actuation dead time."""
-    latency, dead_time = conditions.localisation.latency_s, conditions.actuation.dead_time_s
-    config = CONTROLLERS[controller].config_type()
-    if controller == "clothoid":
-        return dataclasses.replace(config, known_delay_s=latency + dead_time)
-    # the MPC also filters the noisy pose (a complementary filter on the measured velocity and yaw rate, aligned
-    # with the yaw rate's own latency), as a vehicle's state estimator would
-    return dataclasses.replace(
-        config,
-        input_delay_s=dead_time,
-        measurement_latency_s=latency,
-        pose_filter_cutoff_hz=MPC_POSE_FILTER_CUTOFF_HZ,
-        yaw_rate_latency_s=conditions.inertial.latency_s,
-    )
+    """The controller's default config told the conditions' nominal delays (`Controller.informed_config`): the
+    clothoid controller's known_delay_s, the MPC's delay compensation and, the pose being noisy, its pose filter."""
+    cls = CONTROLLERS[controller]
+    return cls.informed_config(cls.config_type(), KnownDelays.from_conditions(conditions))
 
 
 def run_one(job: tuple[str, str, str]) -> dict:

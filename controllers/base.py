@@ -40,7 +40,7 @@ import math
 import sys
 from abc import ABC, abstractmethod
 from collections.abc import Mapping, Sequence
-from typing import Any, ClassVar
+from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
 
@@ -49,6 +49,9 @@ from workbench.base.errors import is_number, require_positive, value_text
 from workbench.base.path import ReferencePath, wrap_angle
 from workbench.simulation.control_interface import COMMAND_REJECTED, MEASUREMENT_REJECTED, Measurement
 from workbench.vehicles.geometry import VehicleGeometry
+
+if TYPE_CHECKING:
+    from workbench.simulation.known_delays import KnownDelays
 
 # The plausible envelope of a measurement (`Controller.step` rejects a frame outside it). Each bound is far beyond
 # what any vehicle here can do, so that no plausible run is ever touched, and near enough that what lies beyond is
@@ -108,6 +111,26 @@ class Controller(ABC):
         """The first line of the controller's module docstring, for `workbench controllers`."""
         doc = sys.modules[cls.__module__].__doc__ or cls.__name__
         return doc.strip().splitlines()[0]
+
+    @classmethod
+    def informed_config(cls, config: Any, delays: KnownDelays) -> Any:
+        """`config` (a `config_type`) told the run's nominal delays and pose noise (`KnownDelays`): the options
+        by which this controller compensates them set from `delays`, every other option as it is.
+
+        Parameters
+        ----------
+        config : config_type
+            The controller's options, a file's and the vehicle's tuning included.
+        delays : KnownDelays
+            The conditions' nominal latencies, dead time and pose noise (`KnownDelays.from_conditions`).
+
+        Returns
+        -------
+        config_type
+            This default returns `config` unchanged: a controller without delay compensation (Stanley, pure
+            pursuit, a plugin that does not override it) has nothing to be told. A controller that compensates
+            delays overrides it (the clothoid controller, the MPCs)."""
+        return config
 
     # ------------------------------------------------------------------ the interface (not overridden)
     def reset(self, path: ReferencePath, sample_time_s: float) -> None:

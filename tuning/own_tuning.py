@@ -40,6 +40,7 @@ if TYPE_CHECKING:  # the clothoid controller and the tuning tools (python-contro
     from controllers.base import Controller
     from controllers.clothoid.vehicle_tuning import VehicleTuning
     from tuning.preset_tuning import PresetTuningOptions
+    from workbench.simulation.known_delays import KnownDelays
 
 
 def cache_key(vehicle: VehicleModel, options: PresetTuningOptions) -> str:
@@ -209,11 +210,17 @@ def with_vehicle_tuning(config: object, vehicle: VehicleModel) -> object:
     return config
 
 
-def tuned_controller(name: str, vehicle: VehicleModel, config: object | None = None) -> Controller:
+def tuned_controller(
+    name: str, vehicle: VehicleModel, config: object | None = None, delays: KnownDelays | None = None
+) -> Controller:
     """The controller registered under `name` for `vehicle`, its config (the default when None) given the
-    vehicle's own tuning where it takes one (the clothoid controller): how the applications build controllers."""
+    vehicle's own tuning where it takes one (the clothoid controller), then told `delays` when given
+    (`Controller.informed_config`; None: untold): how the applications build controllers."""
     from controllers import CONTROLLERS, make_controller
 
     if config is None and name in CONTROLLERS:
         config = CONTROLLERS[name].config_type()
-    return make_controller(name, vehicle.geometry, with_vehicle_tuning(config, vehicle), vehicle=vehicle)
+    config = with_vehicle_tuning(config, vehicle)
+    if delays is not None and name in CONTROLLERS:
+        config = CONTROLLERS[name].informed_config(config, delays)
+    return make_controller(name, vehicle.geometry, config, vehicle=vehicle)

@@ -34,7 +34,7 @@ and half those with the delay 50 ms off either way (`loop_analysis.DelayRobustne
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, ClassVar
 
 import numpy as np
@@ -58,6 +58,7 @@ from workbench.vehicles.base import VehicleGeometry
 
 if TYPE_CHECKING:  # the loop analysis (python-control, ~0.9 s to import) only where floors are computed
     from controllers.clothoid.loop_analysis import DelayRobustness, LoopSettings, PlantLags
+    from workbench.simulation.known_delays import KnownDelays
 
 LOOKAHEAD_MODES = ("adaptive", "fixed", "speed")
 INITIAL_CURVATURE = ("yaw-rate", "command", "steering")
@@ -364,6 +365,27 @@ class ClothoidController(Controller):
         Tunable("max_lookahead_m", "linear", 12.0, 30.0, reason="the longest lookahead the search may choose: longer "
                 "is smoother on straights and cuts bends more"),
     )  # fmt: skip
+
+    @classmethod
+    def informed_config(cls, config: ClothoidConfig, delays: KnownDelays) -> ClothoidConfig:
+        """`config` with known_delay_s = the loop's dead time, the pose latency plus the actuation dead time
+        (`KnownDelays.loop_delay_s`), which the pose prediction and the lookahead floor's loop analysis then
+        have; every other option as it is.
+
+        Parameters
+        ----------
+        config : ClothoidConfig
+            The controller's options.
+        delays : KnownDelays
+            The conditions' nominal delays; the yaw rate's own latency and the pose noise are not used (the pose
+            prediction starts from the pose; the lead filter and the lookahead floor are the noise's answer).
+
+        Returns
+        -------
+        ClothoidConfig
+            The informed options (refused, naming the option, when the delay is beyond known_delay_s's range or
+            the config's delay compensation cannot take it)."""
+        return replace(config, known_delay_s=delays.loop_delay_s)
 
     def __init__(
         self, geometry: VehicleGeometry, config: ClothoidConfig | None = None, vehicle: object | None = None

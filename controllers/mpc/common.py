@@ -33,8 +33,8 @@ compensation needs nothing more.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
-from typing import Any
+from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING, Any
 
 import casadi as ca
 import numpy as np
@@ -61,6 +61,9 @@ from workbench.base.errors import WorkbenchInputError, value_text
 from workbench.base.path import PathTracker, Projection, ReferencePath, wrap_angle
 from workbench.vehicles.geometry import VehicleGeometry
 from workbench.vehicles.steering_lag import SteeringLag
+
+if TYPE_CHECKING:
+    from workbench.simulation.known_delays import KnownDelays
 
 #: Below this speed (m/s) yaw rate / speed and the course angle are not used (the yaw and the previous plan are).
 MIN_MEASURED_SPEED_MPS = 0.5
@@ -89,6 +92,10 @@ MAX_WEIGHT = 1e9
 _KNOT_MERGE_S = 1e-9
 #: The largest crossover frequency of the pose filter (Hz): far above it the filter passes the measurement as it is.
 MAX_POSE_FILTER_HZ = 100.0
+#: The pose filter's crossover (Hz) an MPC told a noisy pose switches on (`MPCController.informed_config`): below
+#: the loop's own offset correction (an S-shaped steering pulse at 0.6-0.8 Hz on the loaded truck), so that pose
+#: noise in that band no longer drives the steering, while the motion the rates describe passes without lag.
+INFORMED_POSE_FILTER_CUTOFF_HZ = 0.3
 
 
 class PoseFilter:
@@ -345,6 +352,39 @@ def resolve_prediction_params(geometry: VehicleGeometry, config: MPCConfig, vehi
 
 class MPCController(Controller):
     """Base of the two MPCs: subclasses build `self.solver` (an `MPCSolver`) in `_build_solver`."""
+
+    @classmethod
+    def informed_config(cls, config: MPCConfig, delays: KnownDelays) -> MPCConfig:
+        """`config` told the conditions' nominal delays, as a vehicle's state estimator and delay compensation
+        would be configured; both MPCs (`NMPCConfig`, `LMPCConfig`) have every option set here (`MPCConfig`).
+
+        Parameters
+        ----------
+        config : MPCConfig
+            The controller's options.
+        delays : KnownDelays
+            The conditions' nominal delays and pose noise.
+
+        Returns
+        -------
+        MPCConfig
+            `config` with input_delay_s = the actuation dead time and measurement_latency_s = the pose latency
+            (the state predicted over both with the commands already sent); when the pose is noisy
+            (`KnownDelays.pose_is_noisy`) and the pose filter is off, pose_filter_cutoff_hz =
+            INFORMED_POSE_FILTER_CUTOFF_HZ (a cutoff already set is kept); with the pose filter on,
+            yaw_rate_latency_s = the yaw rate's own latency, by which the filter aligns the yaw rate with the
+            pose. A delay beyond an option's range is refused naming the option."""
+        cutoff = config.pose_filter_cutoff_hz
+        if delays.pose_is_noisy and cutoff == 0.0:
+            cutoff = INFORMED_POSE_FILTER_CUTOFF_HZ
+        yaw_rate_latency = delays.yaw_rate_latency_s if cutoff > 0.0 else config.yaw_rate_latency_s
+        return replace(
+            config,
+            input_delay_s=delays.dead_time_s,
+            measurement_latency_s=delays.pose_latency_s,
+            pose_filter_cutoff_hz=cutoff,
+            yaw_rate_latency_s=yaw_rate_latency,
+        )
 
     def __init__(self, geometry: VehicleGeometry, config: Any | None = None, vehicle: object | None = None) -> None:
         super().__init__(geometry, config)

@@ -42,13 +42,23 @@ MAX_MATRIX_ENTRY = 1e9
 #: Largest |value| of the vectors handed to OSQP (the dynamics rows' right sides, the linear cost, the soft bounds):
 #: well inside OSQP_INFINITY, beyond which a bound silently counts as absent.
 MAX_VECTOR_ENTRY = 1e20
+#: OSQP's adaptive_rho mode that adapts the ADMM step rho every ADAPTIVE_RHO_INTERVAL iterations
+#: (OSQP_ADAPTIVE_RHO_UPDATE_ITERATIONS). Its other automatic rule adapts when the iterations have taken a fraction
+#: of the setup's wall time (osqp 0.6's adaptive_rho_interval = 0; osqp 1.x's mode 2): a rule on the clock makes
+#: two identical solves differ on a loaded machine. On the iteration count, the same run gives the same result bit
+#: for bit, as long as no solve is cut short by its time limit (`max_solve_time_s`).
+ADAPTIVE_RHO_ITERATIONS = 1
+#: Iterations between two adaptations of rho: osqp 1.x's default interval, set here so that no version's default
+#: can move it, and so that every run is the same as with that default.
+ADAPTIVE_RHO_INTERVAL = 50
 
 
 @dataclass(frozen=True)
 class OsqpSettings:
     """eps_abs, eps_rel: OSQP's tolerances; max_iter: ADMM iteration limit; time_limit_s: wall-time limit (0: none);
     polish: refine the active set after ADMM (more accurate, a little slower); check_termination: iterations
-    between convergence checks; scaling: OSQP's Ruiz equilibration passes. Off by default: OSQP re-runs the
+    between convergence checks; scaling: OSQP's Ruiz equilibration passes (rho adapts on the iteration count,
+    ADAPTIVE_RHO_INTERVAL, never on the clock). Scaling is off by default: OSQP re-runs the
     equilibration on every matrix update, which took 3/4 of the update (130 of 170 us at N = 30, nx = 6), while
     these well-scaled MPC problems converged in as few or fewer ADMM iterations without it."""
 
@@ -68,6 +78,8 @@ class OsqpSettings:
             "verbose": False,
             "check_termination": self.check_termination,
             "scaling": self.scaling,
+            "adaptive_rho": ADAPTIVE_RHO_ITERATIONS,
+            "adaptive_rho_interval": ADAPTIVE_RHO_INTERVAL,
         }
         out.update(polishing=self.polish, warm_starting=True)  # OSQP >= 1.0 names
         if self.time_limit_s > 0.0:

@@ -349,14 +349,22 @@ def _conditions_options(parser: argparse.ArgumentParser) -> None:
         "(default: ideal, the plant's exact state at once)",
     )
     parser.add_argument("--seed", type=int, default=0, help="seed of the conditions' noise (default 0)")
+    parser.add_argument(
+        "--inform-delays",
+        action="store_true",
+        help="tell each controller the nominal latency, dead time and pose noise of --conditions (the clothoid "
+        "controller's known_delay_s, the MPCs' delay compensation and pose filter; Stanley and pure pursuit have "
+        "none; robustness: the base's, not the varied values); default: untold",
+    )
 
 
 def _simulation_config(args: argparse.Namespace, **fields: object) -> SimulationConfig:
-    """The SimulationConfig of a command's options: `fields` plus the conditions and seed."""
+    """The SimulationConfig of a command's options: `fields` plus the conditions, seed and --inform-delays."""
     from workbench.simulation.conditions import load_conditions
     from workbench.simulation.simulator import SimulationConfig
 
-    return SimulationConfig(**fields, conditions=load_conditions(args.conditions), seed=args.seed)
+    conditions = load_conditions(args.conditions)
+    return SimulationConfig(**fields, conditions=conditions, seed=args.seed, inform_delays=args.inform_delays)
 
 
 def _run_config(args: argparse.Namespace) -> SimulationConfig:
@@ -561,6 +569,7 @@ def _compare(args: argparse.Namespace) -> int:
                 args.out / "report.html",
                 f"{comparison.scenario.name}: {', '.join(controllers)}",
                 [ReportSection("Side by side", "", comparison)],
+                intro=comparison.conditions_text(),
             )
     _print_summary(comparison)
     if args.no_plots:
@@ -694,6 +703,7 @@ def _robustness(args: argparse.Namespace) -> int:
         Path.cwd(),
         allow_long_run=args.allow_long_run,
         allow_infeasible=args.allow_infeasible,
+        inform_delays=args.inform_delays,
     )
     limit = DEFAULT_MAX_RUNS if max_runs is None else max_runs
     if len(runs) > limit:
@@ -718,6 +728,7 @@ def _robustness(args: argparse.Namespace) -> int:
                 args.speed,
                 progress=sys.stderr.isatty(),
                 max_cte_m=args.max_cte,
+                inform_delays=args.inform_delays,
             )
         written = result.save(args.out)
         print(result.tolerance().to_string(index=False, float_format=lambda v: f"{v:.3g}", na_rep="-"))
@@ -857,6 +868,10 @@ def _run_with(args: argparse.Namespace, plot_worker: PlotWorker | None) -> int:
     print(f"{scenario.name}: {controller.name} on {vehicle.name} {speed} -> {result.status.value}")
     if top is not None:
         print(f"  the planned top speed is limited by {top.reason()}")
+    run_config = simulation.config
+    if not run_config.conditions.is_ideal:
+        told = "told their delays" if run_config.inform_delays else "not told their delays (--inform-delays tells it)"
+        print(f"  conditions {run_config.conditions.name}, seed {run_config.seed}: the controller {told}")
     print(f"  distance {fmt(m.distance_m, 'm')} of {fmt(m.path_length_m, 'm')}")
     print(f"  max |CTE| {fmt(m.max_abs_cte_m, 'm')}, RMS CTE {fmt(m.rms_cte_m, 'm')}")
     print(
@@ -889,6 +904,7 @@ def _run_stages(
     from tuning.own_tuning import tuned_controller
     from workbench.apps.controller_config import read_controller_config
     from workbench.simulation.feasibility import refuse_infeasible
+    from workbench.simulation.known_delays import KnownDelays
     from workbench.simulation.run_size import check_run_size, duration_text
     from workbench.simulation.scenarios import ScenarioOptions, make_scenario
     from workbench.simulation.simulator import Simulation
@@ -908,7 +924,8 @@ def _run_stages(
         vehicle.geometry,
         warn=progress.warn,
     )
-    controller = tuned_controller(args.controller, vehicle, options)
+    delays = KnownDelays.from_conditions(config.conditions) if config.inform_delays else None
+    controller = tuned_controller(args.controller, vehicle, options, delays)
     scenario = make_scenario(
         args.scenario, ScenarioOptions(vehicle_width_m=vehicle.geometry.width_m, track_file=args.track)
     )

@@ -38,6 +38,7 @@ from workbench.apps.controller_config import read_controller_config
 from workbench.base.console import warn_on_stderr
 from workbench.base.errors import WorkbenchInputError
 from workbench.simulation.feasibility import refuse_infeasible
+from workbench.simulation.known_delays import KnownDelays
 from workbench.simulation.limit_cycle import LimitCycle, detect_limit_cycle
 from workbench.simulation.metrics import METRIC_KEYS
 from workbench.simulation.plots import RunStyle, Stretch, run_styles
@@ -187,6 +188,21 @@ class Comparison:
             self._summary.append(table)
         return self._summary[0].copy()
 
+    def conditions_text(self) -> str:
+        """The runs' conditions in a sentence for a report, and whether the controllers were told their nominal
+        delays (`SimulationConfig.inform_delays`, `KnownDelays`); "" under ideal conditions."""
+        config = self.config
+        if config.conditions.is_ideal:
+            return ""
+        if config.inform_delays:
+            told = f"told their nominal delays ({KnownDelays.from_conditions(config.conditions).describe()})"
+        else:
+            told = "not told their delays"
+        return (
+            f"Conditions {config.conditions.name} (seed {config.seed}): {config.conditions.describe()}. The "
+            f"controllers were {told}."
+        )
+
     def limit_cycles(self) -> list[LimitCycle]:
         """Each run's steering limit cycle (`simulation/limit_cycle.py`; the summary's limit_cycle fields, plus when it
         starts and how long it lasts), in the runs' order."""
@@ -285,7 +301,8 @@ class Comparison:
 def _simulation(
     spec: RunSpec, scenario: str | Scenario, scenario_options: ScenarioOptions | None, config: SimulationConfig
 ) -> Simulation:
-    """The run `spec` wired: its vehicle, the scenario (sized for the vehicle when named), its tuned controller."""
+    """The run `spec` wired: its vehicle, the scenario (sized for the vehicle when named), its tuned controller
+    (told the conditions' delays when config.inform_delays)."""
     vehicle = spec.make_vehicle()
     if isinstance(scenario, Scenario):
         scen = scenario
@@ -294,7 +311,8 @@ def _simulation(
         scen = make_scenario(scenario, ScenarioOptions(vehicle.geometry.width_m, options.track_file))
     config_type = CONTROLLERS[spec.controller].config_type
     options = read_controller_config(spec.config_file, spec.controller, config_type, spec.overrides, vehicle.geometry)
-    return Simulation(scen, vehicle, tuned_controller(spec.controller, vehicle, options), config)
+    delays = KnownDelays.from_conditions(config.conditions) if config.inform_delays else None
+    return Simulation(scen, vehicle, tuned_controller(spec.controller, vehicle, options, delays), config)
 
 
 def compare(

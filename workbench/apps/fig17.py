@@ -270,8 +270,9 @@ class Fig17Result:
         intro = (
             "Replication of Figures 17 and 18 of Shaju, Southward & Ahmadian (2024): tracked trajectories, "
             "cross-track error against distance, speed against distance and steering against time, "
-            f"on the fig17 path at {self.fair.config.speed_kmh:g} km/h from a 1 m initial offset."
-        )
+            f"on the fig17 path at {self.fair.config.speed_kmh:g} km/h from a 1 m initial offset. "
+            + self.fair.conditions_text()
+        ).strip()
         written.append(
             write_report(out / "report.html", "Figure 17: clothoid controller against NMPC", sections, intro, tables)
         )

@@ -5,6 +5,11 @@ mismatch changes differs by controller, `PAYLOAD_MISMATCH`). Every run is a stud
 executed on the study backends (local processes or Dask) into a resumable store; the report is one self-contained
 HTML file with the degradation curves (max |CTE|, steering oscillation, completion) and a table of the values at
 which each controller stops completing or starts to limit-cycle.
+
+With inform_delays (`workbench robustness --inform-delays`) every controller is told the base conditions' nominal
+delays (`KnownDelays`, `Controller.informed_config`), the same in every run: a run with more dead time or latency
+than the base meets a controller that does not know it, which is what the study measures. The options told are
+given to each run as that controller's options (`told_options`), so the results record them.
 """
 
 from __future__ import annotations
@@ -15,15 +20,20 @@ import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import pandas as pd
 
+from controllers import CONTROLLERS
 from workbench.apps.studies.backends import Backend
+from workbench.apps.studies.condition_parameters import resolve_conditions
 from workbench.apps.studies.spec import PlannedRun, StudySpec
 from workbench.apps.studies.store import RunStore, write_results
 from workbench.apps.studies.sweep import execute_runs
 from workbench.base.console import warn_on_stderr
 from workbench.base.errors import WorkbenchInputError, require_positive
+from workbench.simulation.conditions import load_conditions
+from workbench.simulation.known_delays import KnownDelays
 from workbench.simulation.scenarios import SCENARIOS
 from workbench.vehicles import load_vehicle
 
@@ -99,6 +109,16 @@ def payload_mismatch(controller: str) -> str:
     return PAYLOAD_MISMATCH.get(controller, OTHER_CONTROLLER_MISMATCH)
 
 
+def told_options(controller: str, delays: KnownDelays) -> dict[str, Any]:
+    """The options `Controller.informed_config` sets for `delays` on the controller's default config, by name (the
+    values that differ from the default); empty for a controller that is told nothing (Stanley, pure pursuit)."""
+    cls = CONTROLLERS[controller]
+    default = cls.config_type()
+    told = cls.informed_config(default, delays)
+    names = (f.name for f in dataclasses.fields(told))
+    return {n: getattr(told, n) for n in names if getattr(told, n) != getattr(default, n)}
+
+
 def plan_robustness(
     scenario: str,
     controllers: Sequence[str],
@@ -112,6 +132,7 @@ def plan_robustness(
     allow_long_run: bool = False,
     allow_infeasible: bool = False,
     warn: Callable[[str], None] | None = warn_on_stderr,
+    inform_delays: bool = False,
 ) -> list[PlannedRun]:
     """Every run of the study: per controller, the base run and each axis's other values (axes: None for
     `robustness_axes(vehicle)`; the payload axis's runs keep the controller built for the nominal payload). Each
@@ -119,9 +140,15 @@ def plan_robustness(
     bounds of `run_size` (a very low speed) is refused before any run, unless allow_long_run
     (`--allow-long-run`); so is a path the vehicle, at its own payload, cannot follow at the planned speed
     (`feasibility.refuse_infeasible`, as `workbench run` refuses it), unless allow_infeasible
-    (`--allow-infeasible`): then where it cannot is said through `warn` (None: silent)."""
+    (`--allow-infeasible`): then where it cannot is said through `warn` (None: silent). inform_delays: every
+    run's controller is told the base conditions' nominal delays (`told_options`, the module docstring)."""
     _check_path(scenario, vehicle, speed_kmh, track_file, base_dir, allow_long_run, allow_infeasible, warn)
     base = {"speed_kmh": speed_kmh, "conditions": conditions, "seed": seed}
+    told: dict[str, dict[str, Any]] = {}
+    if inform_delays:
+        named = load_conditions(resolve_conditions(conditions, base_dir or Path.cwd()))
+        delays = KnownDelays.from_conditions(named)
+        told = {c: options for c in controllers if (options := told_options(c, delays))}
     grids = [dict(base)]
     for axis in robustness_axes(vehicle) if axes is None else axes:
         if axis.parameter == "road_friction_scale" and not load_vehicle(vehicle).has_tyres:
@@ -137,6 +164,7 @@ def plan_robustness(
             controllers=list(controllers),
             vehicles=[vehicle],
             grid=grid,
+            controller_grid=told,
             track_file=track_file,
             base_dir=base_dir or Path.cwd(),
             description="robustness",
@@ -197,6 +225,8 @@ class RobustnessResult:
     speed_kmh: float
     axes: tuple[Axis, ...] = AXES
     max_cte_m: float = PASS_MAX_CTE_M
+    #: Whether the controllers were told the base conditions' nominal delays (`told_options`).
+    inform_delays: bool = False
 
     def passed(self, row: pd.Series) -> bool:
         """Completed, no steering limit cycle, max |CTE| within max_cte_m."""
@@ -328,8 +358,12 @@ class RobustnessResult:
         intro = (
             f"Target speed {self.speed_kmh:g} km/h; each factor varied on its own around the base conditions "
             f"{self.conditions}. A run passes when it completes, its steering does not limit-cycle and its max |CTE| "
-            f"stays within {self.max_cte_m:g} m."
+            f"stays within {self.max_cte_m:g} m. "
         )
+        if self.inform_delays:
+            intro += "Every run's controller was told the base conditions' nominal delays, not the varied ones."
+        else:
+            intro += "The controllers were not told the conditions' delays (--inform-delays tells them the base's)."
         parts = ["<h2>Where each controller stops passing</h2>", text_table(self.tolerance(), missing="none")]
         mismatch = self.mismatch()
         if len(mismatch):
@@ -364,8 +398,10 @@ def run_robustness(
     speed_kmh: float = 30.0,
     progress: bool = False,
     max_cte_m: float = PASS_MAX_CTE_M,
+    inform_delays: bool = False,
 ) -> RobustnessResult:
-    """Run (or resume) the planned runs into out_dir (DIR/runs/, DIR/results.parquet) and return the result."""
+    """Run (or resume) the planned runs into out_dir (DIR/runs/, DIR/results.parquet) and return the result;
+    inform_delays: whether `plan_robustness` told the controllers the base conditions' delays (for the report)."""
     require_positive("max_cte_m", max_cte_m)
     if not runs:
         raise WorkbenchInputError("the robustness study plans no runs")
@@ -373,7 +409,9 @@ def run_robustness(
     write_results(out_dir, rows)
     frame = pd.DataFrame(rows)
     axes = robustness_axes(vehicle)
-    return RobustnessResult(frame, scenario, vehicle, tuple(controllers), conditions, speed_kmh, axes, max_cte_m)
+    return RobustnessResult(
+        frame, scenario, vehicle, tuple(controllers), conditions, speed_kmh, axes, max_cte_m, inform_delays
+    )
 
 
 __all__ = [
@@ -387,4 +425,5 @@ __all__ = [
     "plan_robustness",
     "robustness_axes",
     "run_robustness",
+    "told_options",
 ]

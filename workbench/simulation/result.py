@@ -104,10 +104,11 @@ class SimulationResult:
 
     def save(self, out_dir: str | Path, with_plots: bool = True, plot_worker: PlotWorker | None = None) -> list[Path]:
         """Write trace.parquet, metrics.json (the metrics, then infeasible_curvature: a list of
-        `InfeasibleSpan.to_dict`, or null when not checked, then status and message) and the PNG plots; return the
-        paths. The files a run writes that are already in out_dir (an earlier run's, the plots included when
-        with_plots is False) are removed first, so the folder never holds files of two runs. plot_worker: a
-        `plot_worker.PlotWorker` that draws the plots meanwhile (here, if it cannot)."""
+        `InfeasibleSpan.to_dict`, or null when not checked, then status and message; under conditions other than
+        ideal, their name, the seed and inform_delays) and the PNG plots; return the paths. The files a run writes
+        that are already in out_dir (an earlier run's, the plots included when with_plots is False) are removed
+        first, so the folder never holds files of two runs. plot_worker: a `plot_worker.PlotWorker` that draws the
+        plots meanwhile (here, if it cannot)."""
         from workbench.simulation import plots  # matplotlib itself only when the plots are drawn
 
         out = Path(out_dir)
@@ -125,7 +126,8 @@ class SimulationResult:
             "message": self.message,
         }
         if not self.config.conditions.is_ideal:  # an ideal run's file stays as it was before conditions existed
-            document |= {"conditions": self.config.conditions.name, "seed": self.config.seed}
+            c = self.config  # inform_delays: whether the controller was told the conditions' delays
+            document |= {"conditions": c.conditions.name, "seed": c.seed, "inform_delays": c.inform_delays}
         written[1].write_text(json.dumps(document, indent=2) + "\n")
         if with_plots:
             drawn = plot_worker.wait() if plot_worker is not None else None

@@ -24,7 +24,11 @@ class SimulationConfig:
     this far beyond either end of an open path (along the end's tangent); speed_feedforward: the speed controller
     feeds the planned speed's rate of change forward (speed x dv_ref/ds) besides its PI action (False: PI only);
     conditions: what lies between the plant and the controller (sensing, actuation, road; `conditions.py`; the
-    default, `ideal`, changes nothing); seed: the seed of the conditions' noise (the same seed, the same run).
+    default, `ideal`, changes nothing); seed: the seed of the conditions' noise (the same seed, the same run);
+    inform_delays: whether the run's controller is told the conditions' nominal delays and pose noise
+    (`known_delays.KnownDelays`, `Controller.informed_config`). Whoever builds the controller applies it (`workbench
+    run`, compare, fig17, the study runner); the simulator steps the controller it is given, and metrics.json
+    records the choice with the conditions.
     """
 
     speed_kmh: float = 30.0
@@ -40,6 +44,7 @@ class SimulationConfig:
     speed_feedforward: bool = True
     conditions: Conditions = CONDITIONS["ideal"]
     seed: int = 0
+    inform_delays: bool = False
 
     def __post_init__(self) -> None:
         require_in_range("speed_kmh", self.speed_kmh, 1e-3, 400.0, "km/h (must be > 0)")
@@ -70,6 +75,8 @@ class SimulationConfig:
             )
         if isinstance(self.seed, bool) or not isinstance(self.seed, int) or not 0 <= self.seed < 2**63:
             raise WorkbenchInputError(f"seed must be a whole number in [0, 2**63); got {value_text(self.seed)}")
+        if not isinstance(self.inform_delays, bool):
+            raise WorkbenchInputError(f"inform_delays must be True or False; got {value_text(self.inform_delays)}")
 
     @property
     def substeps(self) -> int:

@@ -3,12 +3,13 @@ status, message).
 
 The run is built as `workbench run` builds one: the vehicle (with its payload), the scenario sized for it (with
 the initial offset and heading error), the controller's options from the controller-config file and the run's
-options on top (`workbench.apps.controller_config.read_controller_config`, the `--set KEY=VALUE` path), the lead filter
-scaled when asked (`lead_filter_scaling.py`), then `Simulation(...).run()`. Nothing in it
-is random, so the same PlannedRun gives the same row, bit for bit, on any worker, except the wall-clock fields
-(TIMING_COLUMNS). One exception: the MPCs drop a solve that overruns its wall-clock budget (`max_solve_time_s`,
-default the controller period), so on a loaded machine their runs can differ; give them a budget they never reach
-(e.g. `max_solve_time_s = 10.0` in [grid.nmpc]) for reproducible MPC sweeps.
+options on top (`workbench.apps.controller_config.read_controller_config`, the `--set KEY=VALUE` path), told the
+conditions' nominal delays when the run parameter inform_delays is true (`known_delays.KnownDelays`, as `workbench
+run --inform-delays`), the lead filter scaled when asked (`lead_filter_scaling.py`), then `Simulation(...).run()`.
+Nothing in it is random, so the same PlannedRun gives the same row, bit for bit, on any worker, except the
+wall-clock fields (TIMING_COLUMNS). One exception: the MPCs drop a solve that overruns its wall-clock budget
+(`max_solve_time_s`, default the controller period), so on a loaded machine their runs can differ; give them a
+budget they never reach (e.g. `max_solve_time_s = 10.0` in [grid.nmpc]) for reproducible MPC sweeps.
 
 A run that raises (a value its vehicle, scenario or controller refuses, a controller that fails while being built)
 becomes a row with status "error", the exception as its message and the traceback; a run that ends early (left
@@ -21,7 +22,7 @@ import time
 import traceback
 from typing import Any
 
-from controllers import make_controller
+from controllers import CONTROLLERS, make_controller
 from tuning.own_tuning import with_vehicle_tuning
 from workbench.apps.studies.run_build import (
     option_text,
@@ -33,6 +34,7 @@ from workbench.apps.studies.run_build import (
     with_scaled_filter,
 )
 from workbench.apps.studies.spec import PlannedRun
+from workbench.simulation.known_delays import KnownDelays
 from workbench.simulation.metrics import METRIC_KEYS
 from workbench.simulation.result import SimulationResult
 from workbench.simulation.scenarios import ScenarioOptions, make_scenario
@@ -51,14 +53,19 @@ RESULT_COLUMNS = (*ROW_METRICS, "status", "message", "traceback", "run_time_s", 
 TIMING_COLUMNS = ("step_time_median_us", "step_time_p99_us", "run_time_s", "cpu_time_s")
 
 
-def build_controller_config(run: PlannedRun, vehicle: VehicleModel | None = None) -> Any:
+def build_controller_config(
+    run: PlannedRun, vehicle: VehicleModel | None = None, delays: KnownDelays | None = None
+) -> Any:
     """The run's controller config: the controller-config file's table, then the run's options (file options read
-    into their objects), then the vehicle's tuning (when a vehicle is given). With lead-filter scales other than
-    1, the config holds the scaled filter (of its own lead filter, else of the vehicle's tuning)."""
+    into their objects), then the vehicle's tuning (when a vehicle is given), then told `delays` when given
+    (`Controller.informed_config`; the run parameter inform_delays gives its conditions'). With lead-filter scales
+    other than 1, the config holds the scaled filter (of its own lead filter, else of the vehicle's tuning)."""
     geometry = vehicle.geometry if vehicle is not None else None
     config, scales = untuned_controller_config(run.controller, run.controller_config, dict(run.options), geometry)
     if vehicle is not None:
         config = with_vehicle_tuning(config, vehicle)
+    if delays is not None:
+        config = CONTROLLERS[run.controller].informed_config(config, delays)
     return with_scaled_filter(config, scales)
 
 
@@ -75,7 +82,8 @@ def simulate(run: PlannedRun, progress: bool = False) -> SimulationResult:
     scenario = started_scenario(
         scenario, extra["initial_offset_m"], extra["initial_heading_error_deg"], config.max_abs_cte_m
     )
-    options = build_controller_config(run, built_for)
+    delays = KnownDelays.from_conditions(config.conditions) if config.inform_delays else None
+    options = build_controller_config(run, built_for, delays)
     controller = make_controller(run.controller, vehicle.geometry, options, vehicle=built_for)
     return Simulation(scenario, vehicle, controller, config).run(progress=progress)
 
