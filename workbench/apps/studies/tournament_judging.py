@@ -27,7 +27,7 @@ import math
 import numbers
 import zlib
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from itertools import combinations
 
 import numpy as np
@@ -144,11 +144,11 @@ class Judgement:
     per_case: pd.DataFrame
     gap: pd.DataFrame
     pairwise: pd.DataFrame
-    ranking: Mapping[str, float] = field(default_factory=dict)
-    failure_score: float = math.nan
-    objectives: tuple[str, ...] = DEFAULT_OBJECTIVES
-    seed: int = 0
-    resamples: int = DEFAULT_RESAMPLES
+    ranking: Mapping[str, float]
+    failure_score: float
+    objectives: tuple[str, ...]
+    seed: int
+    resamples: int
 
     def to_pandas(self) -> dict[str, pd.DataFrame]:
         """The tables by name: leaderboard, scores, per_case, gap, pairwise."""
