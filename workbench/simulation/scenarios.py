@@ -1,8 +1,8 @@
 """Named test scenarios: a reference path, where the vehicle starts, and what to draw around it.
 
-`make_scenario(name)` builds one by name (`figure8`, `dlc`, `fig17`, `zandvoort`) or from a waypoint file path
-(CSV with x,y[,v] columns, a TUMFTM racetrack-database CSV with its track widths, or a GPS CSV with lat/lon
-columns).
+`make_scenario(name)` builds one by name (`figure8`, `dlc`, `fig17`, `zandvoort`, or `circuit:SEED`, a closed
+circuit drawn from a seed, `workbench.simulation.circuits`) or from a waypoint file path (CSV with x,y[,v] columns,
+a TUMFTM racetrack-database CSV with its track widths, or a GPS CSV with lat/lon columns).
 """
 
 from __future__ import annotations
@@ -13,14 +13,11 @@ import os
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING
 
 import numpy as np
 
-from workbench.base.errors import WorkbenchInputError, require_in_range
-
-if TYPE_CHECKING:
-    from workbench.base.path import ReferencePath
+from workbench.base.errors import WorkbenchInputError
+from workbench.simulation.scenario import Scenario, ScenarioOptions
 
 #: Environment variable naming the TUMFTM Zandvoort centre-line CSV when --track is not given.
 ZANDVOORT_ENV = "WORKBENCH_ZANDVOORT_CSV"
@@ -34,9 +31,6 @@ TRACKS_FOLDER = "tracks"
 CHECKOUT_ROOT: Path | None = (
     Path(__file__).resolve().parents[2] if (Path(__file__).resolve().parents[2] / "pyproject.toml").is_file() else None
 )
-#: Bounds of a run's initial error: lateral offset (m, either side) and heading error (rad, either way).
-MAX_INITIAL_OFFSET_M = 50.0
-MAX_INITIAL_HEADING_ERROR_RAD = math.pi / 2
 ZANDVOORT_SOURCE = (
     "the TUMFTM racetrack-database file tracks/Zandvoort.csv "
     "(https://github.com/TUMFTM/racetrack-database/blob/master/tracks/Zandvoort.csv, LGPL-3.0)"
@@ -45,73 +39,6 @@ ZANDVOORT_SOURCE = (
 #: ../shared/tracks/Zandvoort_track.csv): the one track file the `zandvoort` scenario is named after and the
 #: paper's Zandvoort figures and verdict are given for. Any other file given for it is run under its own name.
 ZANDVOORT_SHA256 = "f3f2a82c9f41bcee8d7161a6ad6c0b8e6d4b902dd772459918c9fe7f7451bc59"
-
-
-@dataclass(frozen=True)
-class ScenarioOptions:
-    """What a scenario factory may depend on.
-
-    vehicle_width_m: overall width b (m, 0.5-4.0) of the vehicle that will be driven on the scenario, which sizes
-    the ISO 3888-1 lanes of `dlc`; None for scenarios that do not depend on it. It has no default because a lane
-    sized for one vehicle and driven by another measures nothing the standard defines, and nothing in a run would
-    show the mismatch: `dlc` refuses to be built without it, from Python as from the command line (which passes
-    the width of the vehicle it runs). track_file: a track CSV for scenarios that read one (zandvoort).
-    """
-
-    vehicle_width_m: float | None = None
-    track_file: Path | None = None
-
-    def __post_init__(self) -> None:
-        if self.vehicle_width_m is not None:
-            require_in_range("vehicle_width_m", self.vehicle_width_m, 0.5, 4.0, "m")
-
-    def required_width_m(self, scenario: str) -> float:
-        """The vehicle's width (m) for a scenario sized by it; WorkbenchInputError naming `vehicle_width_m` (and
-        how to give it) when it is missing."""
-        if self.vehicle_width_m is None:
-            raise WorkbenchInputError(
-                f"{scenario} sizes its lanes for the vehicle driven on it: give ScenarioOptions(vehicle_width_m=...), "
-                f"the vehicle's overall width in m, e.g. make_scenario({scenario!r}, "
-                "ScenarioOptions(vehicle_width_m=vehicle.geometry.width_m)); got vehicle_width_m=None"
-            )
-        return self.vehicle_width_m
-
-
-@dataclass(frozen=True, eq=False)
-class Scenario:
-    """A reference path and the initial condition of a run.
-
-    initial_offset_m: lateral offset of the vehicle's reference point (rear-axle centre) from the path at s = 0,
-    left positive (m, within +-MAX_INITIAL_OFFSET_M); initial_heading_error_rad: vehicle heading minus path heading
-    at the start (rad, within +-pi/2); cones_xy: (n, 2) cone positions (m) to draw, or None; description: one line
-    for `workbench scenarios`.
-    """
-
-    name: str
-    path: ReferencePath
-    description: str
-    initial_offset_m: float = 0.0
-    initial_heading_error_rad: float = 0.0
-    cones_xy: np.ndarray | None = None
-
-    def __post_init__(self) -> None:
-        require_in_range("initial_offset_m", self.initial_offset_m, -MAX_INITIAL_OFFSET_M, MAX_INITIAL_OFFSET_M, "m")
-        bound = MAX_INITIAL_HEADING_ERROR_RAD
-        require_in_range("initial_heading_error_rad", self.initial_heading_error_rad, -bound, bound, "rad")
-
-    def with_initial_error(self, offset_m: float | None = None, heading_error_rad: float | None = None) -> Scenario:
-        """The same scenario started with this lateral offset (m, left positive) and heading error (rad); None keeps
-        the scenario's own (e.g. fig17 starts 1.0 m left of the path)."""
-        offset = self.initial_offset_m if offset_m is None else offset_m
-        heading = self.initial_heading_error_rad if heading_error_rad is None else heading_error_rad
-        return dataclasses.replace(self, initial_offset_m=offset, initial_heading_error_rad=heading)
-
-    def initial_pose(self) -> tuple[float, float, float]:
-        """(x, y, heading) of the vehicle's rear-axle centre at the start."""
-        heading = float(self.path.heading_rad[0])
-        x = self.path.x_m[0] - self.initial_offset_m * math.sin(heading)
-        y = self.path.y_m[0] + self.initial_offset_m * math.cos(heading)
-        return float(x), float(y), heading + self.initial_heading_error_rad
 
 
 # ---------------------------------------------------------------------------------------------- figure-8
@@ -369,20 +296,36 @@ SCENARIOS: dict[str, ScenarioFactory] = {
 def make_scenario(name_or_file: str, options: ScenarioOptions | None = None) -> Scenario:
     """Build a named scenario, or one from a waypoint file when the argument is a path to a file.
 
-    `dlc` needs `options.vehicle_width_m` (the width of the vehicle to be driven: its lanes are sized for it);
-    the other scenarios do not depend on the vehicle.
+    `dlc` and `circuit:SEED` need `options.vehicle_width_m` (the width of the vehicle to be driven: the lanes and
+    the track are sized for it); the other scenarios do not depend on the vehicle.
     """
     options = options or ScenarioOptions()
     if name_or_file in SCENARIOS:
         return SCENARIOS[name_or_file](options)
+    from workbench.simulation.circuits import circuit_seed, generate_circuit
+
+    seed = circuit_seed(name_or_file)
+    if seed is not None:
+        return generate_circuit(seed, vehicle_width_m=options.required_width_m(name_or_file))
     candidate = Path(name_or_file)
     if candidate.suffix.lower() in {".csv", ".txt"} or candidate.is_file():
         if not candidate.is_file():
             raise WorkbenchInputError(f"waypoint file {name_or_file!r} does not exist")
         return from_file(candidate, options)
     raise WorkbenchInputError(
-        f"unknown scenario {name_or_file!r}; choose one of {', '.join(SCENARIOS)} or give a waypoint CSV file"
+        f"unknown scenario {name_or_file!r}; choose one of {', '.join(SCENARIOS)} or give a waypoint CSV file, or "
+        "name a generated circuit circuit:SEED (SEED a whole number >= 0)"
     )
+
+
+def is_named_scenario(name: str) -> bool:
+    """Whether `name` names a scenario rather than a file: one of SCENARIOS, or a generated circuit's name
+    (circuit:SEED). A name that starts with circuit: but has no valid seed is refused (`circuits.circuit_seed`)."""
+    if name in SCENARIOS:
+        return True
+    from workbench.simulation.circuits import circuit_seed
+
+    return circuit_seed(name) is not None
 
 
 #: Each named scenario's one-line description, without building its path (`workbench scenarios` starts fast).
@@ -402,4 +345,7 @@ def describe_scenarios(options: ScenarioOptions | None = None) -> list[tuple[str
             rows.append((name, DESCRIPTIONS[name](options or ScenarioOptions())))
         except WorkbenchInputError as exc:
             rows.append((name, f"{(factory.__doc__ or '').strip().splitlines()[0]} [unavailable: {exc}]"))
+    from workbench.simulation.circuits import CIRCUIT_PREFIX, circuit_family_description
+
+    rows.append((f"{CIRCUIT_PREFIX}SEED", circuit_family_description()))
     return rows

@@ -290,7 +290,7 @@ def test_zandvoort_without_a_track_file(monkeypatch: pytest.MonkeyPatch, tmp_pat
             assert str(folder / name) in message
     # describe_scenarios still lists it, marked unavailable.
     rows = dict(describe_scenarios())
-    assert list(rows) == list(SCENARIOS)
+    assert list(rows) == [*SCENARIOS, "circuit:SEED"]
     assert "[unavailable:" in rows["zandvoort"]
 
 

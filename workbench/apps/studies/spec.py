@@ -56,6 +56,7 @@ from workbench.simulation.scenarios import (
     ZANDVOORT_ENV,
     ZANDVOORT_SOURCE,
     ScenarioOptions,
+    is_named_scenario,
     zandvoort_track_file,
 )
 from workbench.simulation.simulator import SimulationConfig
@@ -143,9 +144,17 @@ def _names(key: str, value: object) -> tuple[str, ...]:
 
 
 def _resolve_name(key: str, name: str, known: Sequence[str], suffixes: tuple[str, ...], base_dir: Path) -> str:
-    """A registered name as it is, or a file (relative to base_dir) as its absolute path."""
+    """A registered name (for scenarios also a generated circuit's, circuit:SEED) as it is, or a file (relative to
+    base_dir) as its absolute path."""
     if name in known:
         return name
+    if key == "scenarios":
+        try:
+            if is_named_scenario(name):
+                return name
+        except WorkbenchInputError as exc:  # circuit: without a valid seed
+            raise WorkbenchInputError(f"study.{key}: {exc}") from None
+        known = [*known, "circuit:SEED"]
     path = Path(name).expanduser()
     path = path if path.is_absolute() else base_dir / path
     if path.suffix.lower() in suffixes or os.path.lexists(path):
@@ -662,7 +671,7 @@ class StudySpec:
         digests: dict[Path, str | None],
     ) -> PlannedRun:
         def canon_name(name: str, known: Mapping[str, Any]) -> Any:
-            return name if name in known else self._canonical(Path(name), digests)
+            return name if name in known or is_named_scenario(name) else self._canonical(Path(name), digests)
 
         track = self.track_file if scenario == "zandvoort" else None
         document = {
