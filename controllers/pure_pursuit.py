@@ -59,9 +59,9 @@ class PurePursuit(Controller):
     name: ClassVar[str] = "pure-pursuit"
     config_type: ClassVar[type] = PurePursuitConfig
     search_space: ClassVar[tuple[Tunable, ...]] = (
-        Tunable("lookahead_gain_s", "log", 0.2, 3.0, reason="longer lookahead per unit speed is calmer and more "
+        Tunable("lookahead_gain_s", "log", 0.3, 3.0, reason="longer lookahead per unit speed is calmer and more "
                 "stable at speed, and cuts the corners more"),
-        Tunable("min_lookahead_m", "linear", 1.0, 10.0, reason="a shorter lookahead at low speed tracks tighter and "
+        Tunable("min_lookahead_m", "linear", 3.0, 12.0, reason="a shorter lookahead at low speed tracks tighter and "
                 "oscillates sooner"),
         Tunable("max_lookahead_m", "linear", 15.0, 60.0, reason="caps the lookahead at high speed: shorter cuts less "
                 "on fast bends, longer keeps high speed stable"),

@@ -91,7 +91,7 @@ class Stanley(Controller):
     name: ClassVar[str] = "stanley"
     config_type: ClassVar[type] = StanleyConfig
     search_space: ClassVar[tuple[Tunable, ...]] = (
-        Tunable("gain_per_s", "log", 0.3, 10.0, reason="higher pulls the front axle onto the path faster; too high "
+        Tunable("gain_per_s", "log", 0.3, 5.0, reason="higher pulls the front axle onto the path faster; too high "
                 "oscillates, most at speed and on a lagging steering"),
         Tunable("softening_mps", "log", 0.1, 10.0, reason="larger calms the cross-track term at low speed, at the "
                 "cost of a weaker pull back onto the path"),

@@ -285,7 +285,8 @@ class MPCConfig:
 
 
 #: The search space of both MPCs (`NMPCController`, `LMPCController`): the cost weights and the horizon. The
-#: weights act through their ratios, over decades: a log scale each.
+#: weights act through their ratios, over decades: a log scale each. The horizon is at least 20 steps of 0.04 s
+#: (0.8 s): on the loaded truck's dlc at 30 km/h a 0.5-0.6 s horizon leaves the path.
 MPC_SEARCH_SPACE = (
     Tunable("weight_cte", "log", 10.0, 5000.0, reason="a heavier cross-track weight tracks tighter for more "
             "steering effort and less damping"),
@@ -297,9 +298,9 @@ MPC_SEARCH_SPACE = (
             "settles on the path sooner, a short horizon stabler"),
     Tunable("terminal_weight_heading", "log", 5.0, 2000.0, reason="the horizon end's heading weight: heavier "
             "arrives aligned with the path, at the cost of effort"),
-    Tunable("horizon_steps", "integer", 10, 50, reason="a longer horizon sees bends earlier and is stabler, for "
+    Tunable("horizon_steps", "integer", 20, 60, reason="a longer horizon sees bends earlier and is stabler, for "
             "solve time growing with the steps"),
-    Tunable("step_s", "linear", 0.03, 0.1, reason="a longer prediction step sees further for the same solve time, "
+    Tunable("step_s", "linear", 0.04, 0.1, reason="a longer prediction step sees further for the same solve time, "
             "with a coarser model of fast motion"),
 )  # fmt: skip
 

@@ -269,7 +269,7 @@ def test_the_command_prints_the_space_as_toml(capsys: pytest.CaptureFixture[str]
     assert main(["controllers", "--show", "stanley", "--search-space"]) == 0
     out = capsys.readouterr().out
     assert out == search_space_toml("stanley")
-    assert "gain_per_s = {log_uniform = [0.3, 10.0]}" in out
+    assert "gain_per_s = {log_uniform = [0.3, 5.0]}" in out
 
 
 @pytest.mark.usefixtures("registry")
