@@ -438,7 +438,8 @@ def _traces_section(judgement: Judgement, traces: Mapping[str, SimulationResult]
 
 def _cases_list(cases: Sequence[str]) -> str:
     items = "".join(f"<li>{html.escape(case.replace('|', ' | '))}</li>" for case in cases)
-    summary = f"{len(cases)} cases (scenario | vehicle | km/h | conditions | seed)"
+    count = f"{len(cases)} case" + ("" if len(cases) == 1 else "s")
+    summary = f"{count} (scenario | vehicle | km/h | conditions | seed)"
     return f"<details><summary>{summary}</summary><ul>{items}</ul></details>"
 
 
@@ -452,7 +453,7 @@ def _rules_section(summary: TournamentSummary, results: pd.DataFrame, judgement:
         "the CPU time each spent is in the leaderboard (an MPC trial costs many times a geometric controller's).",
         f"Objectives of the front (each the mean over the training cases): {', '.join(summary.objectives)}.",
         f"Selection: {summary.selection_rule}.",
-        f"Ranking: the mean over the test cases of {summary.ranking_rule}, lowest first.",
+        f"Ranking: by the mean over the test cases, lowest first, of {summary.ranking_rule}.",
         f"Failure: a run that did not complete, left the track or limit-cycled has failed; it scores "
         f"{summary.failure_score:g} on the ranking, and a trial with a failed run is never chosen.",
         f"Known delays: the controllers {told} the conditions' nominal latency and dead time (inform_delays = "
