@@ -106,7 +106,7 @@ def _parser(command: str | None = None) -> argparse.ArgumentParser:
     )
 
     run = sub.add_parser("run", help="simulate one controller on one vehicle along one scenario")
-    run.add_argument("scenario", help="a scenario name (see `workbench scenarios`) or a waypoint CSV file")
+    run.add_argument("scenario", help="a scenario name (`workbench scenarios`), circuit:SEED or a waypoint CSV file")
     run.add_argument(
         "--controller",
         default=DEFAULT_CONTROLLER,
@@ -118,7 +118,7 @@ def _parser(command: str | None = None) -> argparse.ArgumentParser:
     _run_options(run, several=False)
 
     cmp = sub.add_parser("compare", help="run several controllers (and vehicles) on one scenario; write a report")
-    cmp.add_argument("scenario", help="a scenario name (see `workbench scenarios`) or a waypoint CSV file")
+    cmp.add_argument("scenario", help="a scenario name (`workbench scenarios`), circuit:SEED or a waypoint CSV file")
     cmp.add_argument(
         "--controllers",
         required=True,
@@ -155,7 +155,7 @@ def _parser(command: str | None = None) -> argparse.ArgumentParser:
         "robustness",
         help="each controller against actuation delay, pose latency, position noise, friction and payload mismatch",
     )
-    rob.add_argument("scenario", help="a scenario name (see `workbench scenarios`) or a waypoint CSV file")
+    rob.add_argument("scenario", help="a scenario name (`workbench scenarios`), circuit:SEED or a waypoint CSV file")
     rob.add_argument("--controllers", required=True, metavar="A,B,...", help="comma-separated controller names")
     rob.add_argument("--vehicle", required=True, metavar="NAME", help="vehicle preset or vehicle TOML file")
     rob.add_argument("--out", type=Path, required=True, metavar="DIR", help="output directory (rerun to resume)")

@@ -34,7 +34,7 @@ from workbench.base.console import warn_on_stderr
 from workbench.base.errors import WorkbenchInputError, require_positive
 from workbench.simulation.conditions import load_conditions
 from workbench.simulation.known_delays import KnownDelays
-from workbench.simulation.scenarios import SCENARIOS
+from workbench.simulation.scenarios import is_named_scenario
 from workbench.vehicles import load_vehicle
 
 
@@ -198,7 +198,7 @@ def _check_path(
     from workbench.simulation.simulator import plan_path_speed
 
     model = load_vehicle(vehicle)
-    if scenario not in SCENARIOS:
+    if not is_named_scenario(scenario):  # a file, relative to base_dir
         scenario = str((base_dir or Path.cwd()) / scenario)
     config = SimulationConfig(speed_kmh=speed_kmh)
     path = plan_path_speed(make_scenario(scenario, ScenarioOptions(model.geometry.width_m, track_file)).path, config)

@@ -308,3 +308,10 @@ def test_a_study_spec_refuses_a_bad_circuit_name_and_an_infeasible_circuit(tmp_p
             _spec(tmp_path / "b", '["circuit:3"]', "speed_kmh = [60.0]\nmax_lateral_accel_g = [0.6]",
                   '["tractor-semitrailer"]')
         )  # fmt: skip
+
+
+def test_robustness_checks_a_circuit_by_its_name_not_as_a_file(tmp_path):
+    """`workbench robustness circuit:7` plans the circuit (a name is not a file relative to the spec's folder)."""
+    from workbench.apps.robustness import _check_path
+
+    _check_path("circuit:7", "kinematic-bicycle", 30.0, None, tmp_path, False, False, print)  # raises nothing
