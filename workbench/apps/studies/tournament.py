@@ -42,7 +42,7 @@ import pandas as pd
 
 from workbench.apps.studies.backends import Backend, LocalBackend
 from workbench.apps.studies.optimise import write_controller_config
-from workbench.apps.studies.run_build import option_text
+from workbench.apps.studies.run_build import LEAD_FILTER_SCALES, option_text
 from workbench.apps.studies.runner import build_controller_config
 from workbench.apps.studies.spec import PlannedRun
 from workbench.apps.studies.store import RunStore, write_results
@@ -224,8 +224,10 @@ def write_config_files(
     written: list[tuple[Any, Path]] = []
     files = {}
     for vehicle, run in first_runs.items():
-        # The run's config for this vehicle, without the conditions' delays (the command line tells them).
-        config = _portable(build_controller_config(dataclasses.replace(run, values=()), load_vehicle(vehicle)))
+        # The run's config for this vehicle, without the conditions' delays (the command line tells them) and
+        # without its tuning (a run adds it); the tuning is read only where a lead filter is scaled from it.
+        scaled = any(dict(run.options).get(k, 1.0) != 1.0 for k in LEAD_FILTER_SCALES)
+        config = _portable(build_controller_config(run, load_vehicle(vehicle) if scaled else None))
         same = next((path for other, path in written if other == config), None)
         if same is None:
             stem = name if not written else f"{name}@{_vehicle_label(vehicle)}"
@@ -278,7 +280,7 @@ def _tune(
         batch = [study.ask(distributions) for _ in range(size)]
         plans = [spec.plan(controller, TRAIN, trial.params) for trial in batch]
         first, last = batch[0].number, batch[-1].number
-        log(f"{controller}: training, trials {first}-{last} of {spec.trials} ({cases} cases each)")
+        log(f"{controller}: training, trials {first}-{last} of {spec.trials} ({cases} case{'s' * (cases != 1)} each)")
         batch_rows, n = execute_runs(
             [r for plan in plans for r in plan], store, backend, progress, f"{controller} trials {first}-{last}"
         )
