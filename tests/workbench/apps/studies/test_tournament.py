@@ -13,9 +13,10 @@ from typing import Any
 
 import pandas as pd
 import pytest
-from study_helpers import SerialBackend, write_spec
+from study_helpers import NotSimulating, SerialBackend, write_spec
 
 from controllers import CONTROLLERS
+from tuning.own_tuning import tuning_for
 from workbench.apps.cli import main
 from workbench.apps.controller_config import read_controller_config
 from workbench.apps.studies import TIMING_COLUMNS, PlannedRun
@@ -30,8 +31,10 @@ from workbench.apps.studies.tournament import (
     spread_points,
     trial_objectives,
     weighted,
+    write_config_files,
 )
 from workbench.apps.studies.tournament_spec import load_tournament
+from workbench.vehicles import make_vehicle
 
 SPEC = """
 [tournament]
@@ -225,3 +228,41 @@ def test_the_front_and_its_spread() -> None:
     assert spread_points(front, points, 3) == [5, 1, 0]  # by the last objective: the ends and the middle
     assert spread_points(front, points, 9) == [5, 3, 1, 4, 0]
     assert spread_points(front, points, 0) == []
+
+
+def test_a_controller_whose_every_trial_fails_is_judged_with_its_defaults(tmp_path: Path) -> None:
+    spec = load_tournament(write_spec(tmp_path, SPEC.replace('"stanley", "clothoid"]', '"stanley"]')))
+    backend = NotSimulating()  # every run an error row: every trial fails
+    result = run_tournament(spec, tmp_path / "out", backend, report=False, log=None)
+    history = result.history
+    assert (history["state"] == "failed").all() and not history["pareto"].any() and not history["chosen"].any()
+    assert set(history["reason"]) == {
+        "1 of 1 runs failed (e.g. dlc|kinematic-bicycle|30|ideal|0: did not complete (error: not simulated in this "
+        "test))"
+    }
+    assert result.chosen == {"pure-pursuit": None, "stanley": None}
+    test = result.results[result.results["set"] == "test"]
+    assert list(test["config"]) == ["default", "tuned"] * 2 and (test["trial"] == 0).all() and test["failed"].all()
+    summary = result.summary(spec)
+    assert summary["chosen_trial"].isna().all() and (summary["test_tuned"] == spec.failure_score).all()
+
+
+def test_a_configuration_scaled_from_each_vehicles_filter_gets_a_file_per_vehicle(tmp_path: Path) -> None:
+    text = SPEC.replace('"stanley", "clothoid"]', '"clothoid"]').replace(
+        '["kinematic-bicycle"]', '["kinematic-bicycle", "dynamic-bicycle"]'
+    )
+    spec = load_tournament(write_spec(tmp_path, text))
+    scaled = write_config_files(spec, "clothoid", {"lead_filter_pole_scale": 1.2}, tmp_path / "best", "clothoid", "h")
+    assert scaled == {
+        "kinematic-bicycle": (tmp_path / "best" / "clothoid.toml").resolve(),
+        "dynamic-bicycle": (tmp_path / "best" / "clothoid@dynamic-bicycle.toml").resolve(),
+    }
+    config_type = CONTROLLERS["clothoid"].config_type
+    for vehicle, path in scaled.items():
+        own = tuning_for(make_vehicle(vehicle)).filter_schedule
+        lead = read_controller_config(path, "clothoid", config_type).lead_filter
+        assert [p.omega_p_rad_s for p in lead.params] == [p.omega_p_rad_s * 1.2 for p in own.params]
+    assert (tmp_path / "best" / "clothoid@dynamic-bicycle_lead_filter.json").is_file()
+    # unscaled, the configuration is the same for both vehicles (each run adds its own tuning): one file
+    plain = write_config_files(spec, "clothoid", {"frechet_threshold_m": 0.05}, tmp_path / "plain", "clothoid", "h")
+    assert set(plain.values()) == {(tmp_path / "plain" / "clothoid.toml").resolve()}
