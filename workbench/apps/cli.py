@@ -1,6 +1,7 @@
 """The `workbench` command line: list scenarios, vehicles and controllers; run a closed-loop simulation; compare
 controllers side by side (`compare`, and the paper's Figure 17 set-up, `fig17`); run parameter sweeps and tune
-controllers from a study spec (`sweep`, `optimise`; `workbench.apps.studies`).
+controllers from a study spec (`sweep`, `optimise`), and tune and judge every controller alike on held-out cases
+(`tournament`; `workbench.apps.studies`).
 
 Every input file and output folder is checked before any work starts (`workbench.base.input_files`,
 `workbench.base.output_dir`): a missing or unreadable file, a folder where a file is wanted or a file where a folder is,
