@@ -1,7 +1,8 @@
 """The controller tournament: every controller tuned with the same trial budget on the training cases, its default,
 tuned and carried front configurations judged on the held-out test cases.
 
-Per controller, optuna's multi-objective TPE sampler, seeded with the spec's seed, proposes its searched options;
+Per controller, optuna's multi-objective TPE sampler, seeded with the spec's seed (its first STARTUP_TRIALS trials
+drawn at random), proposes its searched options;
 a trial runs the training cases with them (through the study backends and the run store, as `workbench optimise`
 does) and is told the mean of each objective over those cases. Trial 0 is the controller's shipped defaults
 (enqueued), so that the chosen configuration, picked among every trial by the spec's selection rule over the
@@ -57,6 +58,9 @@ TRIAL, DEFAULT, TUNED, FRONT_PREFIX = "trial", "default", "tuned", "front-"
 HISTORY_FILE = "history.parquet"
 SUMMARY_FILE = "tournament.json"
 BEST_DIR, FRONT_DIR, DEFAULT_DIR = "best", "front", "default"
+#: Trials drawn at random (trial 0 aside, the defaults) before the sampler models the results: optuna's default,
+#: pinned here so that a tournament proposes the same trials whatever optuna's default becomes.
+STARTUP_TRIALS = 10
 #: Where a judged run's `workbench run` command writes its run (relative to where it is run).
 REPLAY_DIR = "replay"
 
@@ -265,7 +269,7 @@ def _tune(
     import optuna
 
     optuna.logging.set_verbosity(optuna.logging.WARNING)
-    sampler = optuna.samplers.TPESampler(seed=spec.seed)
+    sampler = optuna.samplers.TPESampler(seed=spec.seed, n_startup_trials=STARTUP_TRIALS)
     study = optuna.create_study(directions=["minimize"] * len(spec.objectives), sampler=sampler)
     study.enqueue_trial(dict(spec.defaults[controller]))
     distributions = {k: d.to_optuna() for k, d in spec.search[controller].items()}

@@ -1,5 +1,6 @@
 """The tournament end to end on three cheap controllers (pure pursuit, Stanley, the clothoid controller) on the
-kinematic car, one short training case and one test case, 3 trials: what it writes, that no trial runs a test
+kinematic car, one short training case and one test case (under the automotive conditions, the controllers told
+their delays), 3 trials: what it writes, that no trial runs a test
 case, that a tournament killed mid-way resumes with nothing lost or redone and gives the same results bit for bit
 (but the wall-clock columns) as one run straight through, and that a judged run's command reproduces it."""
 
@@ -52,6 +53,8 @@ speeds_kmh = [30]
 [test]
 scenarios = ["dlc"]
 speeds_kmh = [40]
+conditions = ["automotive"]
+seeds = [1]
 """
 CONTROLLER_NAMES = ("pure-pursuit", "stanley", "clothoid")
 
@@ -140,7 +143,7 @@ def test_the_tournament_trains_judges_and_writes(tournament: dict[str, Any]) -> 
     assert results.loc[results["set"] == "test", "command"].str.startswith("workbench run dlc --controller ").all()
     assert result.report == out / "report.html" and result.report.stat().st_size > 10_000
     summary = json.loads((out / "tournament.json").read_text())
-    assert summary["test_cases"] == ["dlc|kinematic-bicycle|40|ideal|0"]
+    assert summary["test_cases"] == ["dlc|kinematic-bicycle|40|automotive|1"]
     assert summary["train_cases"] == ["dlc|kinematic-bicycle|30|ideal|0"]
     assert summary["test_cases_run_by_trials"] == []
 
@@ -183,6 +186,7 @@ def test_a_judged_runs_command_reproduces_it_bit_for_bit(
     row = results[(results["controller"] == "clothoid") & (results["config"] == "tuned")].iloc[0]
     words = shlex.split(row["command"])
     assert words[:2] == ["workbench", "run"] and "--inform-delays" in words
+    assert words[words.index("--conditions") + 1] == "automotive" and words[words.index("--seed") + 1] == "1"
     monkeypatch.chdir(tmp_path)
     assert main([*words[1:], "--no-plots"]) == 0
     metrics = json.loads((tmp_path / "replay" / row["run_id"] / "metrics.json").read_text())
