@@ -815,8 +815,8 @@ def _tournament(args: argparse.Namespace) -> int:
 
     def study() -> int:
         print(
-            f"{len(spec.controllers)} controllers x {spec.trials} trials on {spec.cases('train')} training cases, "
-            f"judged on {spec.cases('test')} test cases, on the {backend.describe()}"
+            f"{len(spec.controllers)} controllers x {spec.trials} trials on {spec.cases_text('train')}, judged on "
+            f"{spec.cases_text('test')}, on the {backend.describe()}"
         )
         result = run_tournament(spec, args.out, backend, progress=sys.stderr.isatty())
         board = result.judgement.leaderboard if result.judgement is not None else result.summary(spec)

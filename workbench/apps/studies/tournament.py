@@ -413,7 +413,7 @@ def run_tournament(
             config_files[controller] = configs[1].files[spec.studies[(controller, TEST)].vehicles[0]]
             tuned[controller] = configs[1].options
             plans = [spec.plan(controller, TEST, judged.options) for judged in configs]
-            say(f"{controller}: judging {len(configs)} configurations on {spec.cases(TEST)} test cases")
+            say(f"{controller}: judging {len(configs)} configurations on {spec.cases_text(TEST)}")
             test_rows, n = execute_runs(
                 [r for plan in plans for r in plan], store, backend, progress, f"{controller} test"
             )

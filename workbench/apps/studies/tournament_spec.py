@@ -431,6 +431,11 @@ class TournamentSpec:
             * len(case_set.seeds)
         )
 
+    def cases_text(self, set_name: str) -> str:
+        """A set's number of cases in words: "1 training case", "12 test cases"."""
+        count = self.cases(set_name)
+        return f"{count} {'training' if set_name == 'train' else 'test'} case{'s' * (count != 1)}"
+
     def total_runs(self) -> int:
         """The most runs the tournament executes: per controller, its trials on the training cases and its default,
         tuned and carried front configurations on the test cases."""

@@ -203,7 +203,7 @@ def test_the_cli_runs_a_tournament_and_prints_its_leaderboard(
     # resumed from the finished tournament's folder: every run is found, none run again
     assert main(["tournament", str(folder / "spec.toml"), "--out", str(folder / "whole"), "--workers", "1"]) == 0
     printed = capsys.readouterr().out
-    assert "3 controllers x 3 trials on 1 training cases, judged on 1 test cases" in printed
+    assert "3 controllers x 3 trials on 1 training case, judged on 1 test case" in printed
     assert "(0 run now)" in printed
     for controller in CONTROLLER_NAMES:
         assert controller in printed

@@ -51,6 +51,7 @@ def refused(tmp_path: Path, text: str) -> str:
 def test_a_spec_plans_each_controller_on_each_set(tmp_path: Path) -> None:
     spec = load(tmp_path)
     assert spec.cases("train") == 4 and spec.cases("test") == 1
+    assert (spec.cases_text("train"), spec.cases_text("test")) == ("4 training cases", "1 test case")
     assert dict(spec.selection) == dict(DEFAULT_SELECTION) and dict(spec.ranking) == dict(DEFAULT_RANKING)
     assert spec.total_runs() == 2 * (3 * 4 + 7 * 1)
     train = spec.plan("stanley", "train", {"gain_per_s": 2.0})
