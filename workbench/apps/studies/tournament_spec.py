@@ -29,7 +29,7 @@ from types import MappingProxyType
 from typing import Any
 
 from controllers import CONTROLLERS
-from workbench.apps.studies.distributions import Distribution
+from workbench.apps.studies.distributions import SEARCHABLE, Distribution
 from workbench.apps.studies.run_build import LEAD_FILTER_SCALES
 from workbench.apps.studies.spec import (
     DEFAULT_MAX_RUNS,
@@ -355,6 +355,11 @@ class TournamentSpec:
         distributions, defaults = {}, {}
         for key, value in space.items():
             dist = value if isinstance(value, Distribution) else Distribution.parse(f"search.{controller}.{key}", value)
+            if dist.kind not in SEARCHABLE:
+                raise WorkbenchInputError(
+                    f"search.{controller}.{key}: a search needs a bounded distribution ({', '.join(SEARCHABLE)}); "
+                    f"got {dist.kind}"
+                )
             default = _default_value(controller, key)
             if not _contains(dist, default):
                 raise WorkbenchInputError(
@@ -368,15 +373,6 @@ class TournamentSpec:
     def _study(self, controller: str, case_set: CaseSet) -> StudySpec:
         """The StudySpec of one controller on one set: its cases as the grid, its fixed options, and (training)
         the trial budget and search space as the [optimise] settings."""
-        optimise = None
-        if case_set.name == "train":
-            optimise = OptimiseSettings(
-                trials=self.trials,
-                objective={self.objectives[0]: 1.0},
-                search=dict(self.search[controller]),
-                batch_size=self.batch_size,
-                seed=self.seed,
-            )
         grid = {
             "speed_kmh": list(case_set.speeds_kmh),
             "conditions": list(case_set.conditions),
@@ -384,6 +380,15 @@ class TournamentSpec:
             "inform_delays": [self.inform_delays],
         }
         try:
+            optimise = None
+            if case_set.name == "train":
+                optimise = OptimiseSettings(
+                    trials=self.trials,
+                    objective={self.objectives[0]: 1.0},
+                    search=dict(self.search[controller]),
+                    batch_size=self.batch_size,
+                    seed=self.seed,
+                )
             return StudySpec(
                 scenarios=case_set.scenarios,
                 controllers=(controller,),

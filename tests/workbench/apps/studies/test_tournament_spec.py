@@ -144,6 +144,13 @@ def test_search_tables_are_checked(tmp_path: Path) -> None:
     assert "gain_per_s is both fixed in [fixed.stanley] and searched in [search.stanley]" in refused(tmp_path, both)
     unknown = SPEC + "\n[search.stanley]\ngain = {uniform = [1.0, 3.0]}\n"
     assert "unknown parameter search.stanley.gain for stanley; allowed:" in refused(tmp_path, unknown)
+    unbounded = SPEC + "\n[search.stanley]\ngain_per_s = {normal = [1.5, 0.5]}\n"
+    bounded = "a search needs a bounded distribution (uniform, log_uniform, integers, choice); got normal"
+    assert f"search.stanley.gain_per_s: {bounded}" in refused(tmp_path, unbounded)
+    bad_fixed = SPEC + "\n[fixed.stanley]\ngain_per_s = -1.0\n"
+    assert "stanley on the train set: fixed.stanley.gain_per_s = -1.0: gain_per_s must be" in refused(
+        tmp_path, bad_fixed
+    )
     other = SPEC + "\n[fixed.clothoid]\nprediction_time_s = 0.1\n"
     assert "[fixed.clothoid] names a controller the tournament does not run" in refused(tmp_path, other)
 
