@@ -249,6 +249,7 @@ COMMANDS_WITH_OUT = {
     "paper": ["paper"],
     "sweep": ["sweep", "{spec}"],
     "optimise": ["optimise", "{spec}"],
+    "tournament": ["tournament", "{spec}"],
 }
 
 

@@ -1,6 +1,6 @@
-"""The study commands' backend options, refused before any work when out of range: --max-runs (below 1, and a
-robustness study larger than it), --workers (below 1 or above MAX_WORKERS_PER_CPU per usable CPU) and --scheduler
-(not tcp://HOST:PORT, or no scheduler answering there)."""
+"""The study commands' backend options (sweep, optimise, robustness, tournament), refused before any work when out
+of range: --max-runs (below 1, and a robustness study larger than it), --workers (below 1 or above
+MAX_WORKERS_PER_CPU per usable CPU) and --scheduler (not tcp://HOST:PORT, or no scheduler answering there)."""
 
 from __future__ import annotations
 
@@ -28,9 +28,25 @@ rms_cte_m = 1.0
 lookahead_gain_s = { uniform = [0.5, 1.5] }
 """
 
+#: A tournament of pure pursuit alone, tuned on the dlc and judged on fig17.
+TOURNAMENT = """
+[tournament]
+controllers = ["pure-pursuit"]
+vehicles = ["kinematic-bicycle"]
+trials = 2
+
+[train]
+scenarios = ["dlc"]
+speeds_kmh = [30]
+
+[test]
+scenarios = ["fig17"]
+speeds_kmh = [30]
+"""
+
 
 def _study_commands(spec: Path, out: Path) -> list[list[str]]:
-    """sweep, optimise and robustness, each complete but for the option under test."""
+    """sweep, optimise, robustness and tournament, each complete but for the option under test."""
     text = spec.read_text().replace('controllers = ["pure-pursuit", "clothoid"]', 'controllers = ["pure-pursuit"]')
     text = text.split("[grid.clothoid]")[0]
     optimise = write_spec(spec.parent, text + OPTIMISE, "optimise.toml")
@@ -38,6 +54,7 @@ def _study_commands(spec: Path, out: Path) -> list[list[str]]:
         ["sweep", str(spec), "--out", str(out)],
         ["optimise", str(optimise), "--out", str(out)],
         [*ROBUSTNESS, "--out", str(out)],
+        ["tournament", str(write_spec(spec.parent, TOURNAMENT, "tournament.toml")), "--out", str(out)],
     ]
 
 
