@@ -82,6 +82,19 @@ rms_cte_m = 1.0
 [optimise.search]
 lookahead_gain_s = { uniform = [0.3, 1.5] }
 """
+GOOD_TOURNAMENT = """[tournament]
+controllers = ["pure-pursuit", "stanley"]
+vehicles = ["kinematic-bicycle"]
+trials = 2
+
+[train]
+scenarios = ["dlc"]
+speeds_kmh = [20, 30]
+
+[test]
+scenarios = ["fig17"]
+speeds_kmh = [30]
+"""
 GOOD_CONTROLLER_CONFIG = "[pure-pursuit]\nlookahead_gain_s = 0.8\n\n[stanley]\ngain_per_s = 4.0\n"
 
 
@@ -111,6 +124,7 @@ def files() -> dict[str, str | bytes | None]:
         "limits.csv": GOOD_LIMITS,
         "spec.toml": GOOD_SPEC,
         "optimise.toml": GOOD_OPTIMISE,
+        "tournament.toml": GOOD_TOURNAMENT,
         "controllers.toml": GOOD_CONTROLLER_CONFIG,
         "vehicle.toml": vehicle,
         "conditions.toml": conditions,
@@ -204,6 +218,7 @@ def files() -> dict[str, str | bytes | None]:
         "ctl-bad-lag.toml": '[nmpc]\nlag_file = "lag-zeta-neg.json"\n',
         # study specs
         **{f"spec-{name}.toml": text for name, text in _spec_mutations()},
+        **{f"tournament-{name}.toml": text for name, text in _tournament_mutations()},
     }
     return made
 
@@ -295,6 +310,51 @@ def _spec_mutations() -> Iterator[tuple[str, str]]:
     yield "optimise-unknown-metric", base + "\n[optimise]\ntrials = 2\n[optimise.objective]\nspeed = 1.0\n"
 
 
+def _tournament_mutations() -> Iterator[tuple[str, str]]:
+    base = GOOD_TOURNAMENT
+    head = "trials = 2\n"
+    for name, line in (
+        ("trials-0", "trials = 0"),
+        ("trials-float", "trials = 1.5"),
+        ("trials-text", 'trials = "2"'),
+        ("batch-size-0", "trials = 2\nbatch_size = 0"),
+        ("front-points-6", "trials = 2\nfront_points = 6"),
+        ("seed-negative", "trials = 2\nseed = -1"),
+        ("objectives-unknown", 'trials = 2\nobjectives = ["speed"]'),
+        ("objectives-empty", "trials = 2\nobjectives = []"),
+        ("selection-not-an-objective", "trials = 2\nselection = {max_ltr = 1.0}"),
+        ("selection-negative", "trials = 2\nselection = {max_abs_cte_m = -1.0}"),
+        ("selection-zero", "trials = 2\nselection = {max_abs_cte_m = 0.0}"),
+        ("ranking-nan", "trials = 2\nranking = {max_abs_cte_m = nan}"),
+        ("failure-score-text", 'trials = 2\nfailure_score = "high"'),
+        ("inform-delays-text", 'trials = 2\ninform_delays = "yes"'),
+        ("max-runs-0", "trials = 2\nmax_runs = 0"),
+        ("max-runs-exceeded", "trials = 2\nmax_runs = 5"),
+        ("unknown-key", "trials = 2\nbudget = 2"),
+    ):
+        yield name, base.replace(head, line + "\n")
+    yield "no-trials", base.replace(head, "")
+    yield "no-test", base.split("[test]")[0]
+    yield "unknown-table", base + "\n[study]\nscenarios = []\n"
+    yield "controllers-unknown", base.replace('"stanley"]', '"stanly"]')
+    yield "controllers-empty", base.replace('["pure-pursuit", "stanley"]', "[]")
+    yield "vehicles-unknown", base.replace('["kinematic-bicycle"]', '["hovercraft"]')
+    yield "set-unknown-key", base.replace("speeds_kmh = [30]", "speeds_kmh = [30]\nlaps = 2")
+    yield "speed-zero", base.replace("speeds_kmh = [30]", "speeds_kmh = [0]")
+    yield "speed-empty", base.replace("speeds_kmh = [30]", "speeds_kmh = []")
+    yield "seeds-negative", base.replace("speeds_kmh = [30]", "speeds_kmh = [30]\nseeds = [-1]")
+    yield "conditions-unknown", base.replace("speeds_kmh = [30]", 'speeds_kmh = [30]\nconditions = ["foggy"]')
+    yield "scenario-unknown", base.replace('["fig17"]', '["moon"]')
+    yield "case-in-both-sets", base.replace('["fig17"]', '["fig17", "dlc"]')
+    yield "search-default-outside", base + "\n[search.stanley]\ngain_per_s = {uniform = [2.0, 3.0]}\n"
+    yield "search-unknown-option", base + "\n[search.stanley]\ngain = {uniform = [1.0, 3.0]}\n"
+    yield "search-unbounded", base + "\n[search.stanley]\ngain_per_s = {normal = [1.5, 0.5]}\n"
+    yield "search-other-controller", base + "\n[search.clothoid]\nprediction_time_s = {uniform = [0.1, 0.3]}\n"
+    yield "fixed-bad-value", base + "\n[fixed.stanley]\ngain_per_s = -1.0\n"
+    searched = "\n[search.stanley]\ngain_per_s = {uniform = [1.0, 3.0]}\n"
+    yield "fixed-and-searched", base + searched + "[fixed.stanley]\ngain_per_s = 2.0\n"
+
+
 def _is_number(text: str) -> bool:
     try:
         float(text.strip())
@@ -320,6 +380,7 @@ WB_BASE = {
                    "out"),
     "sweep": ("sweep", "spec.toml", "--out", "out", "--no-plots"),
     "optimise": ("optimise", "optimise.toml", "--out", "out"),
+    "tournament": ("tournament", "tournament.toml", "--out", "out"),
 }
 TUNING_BASE = {
     "generate-data": ("generate-data", "--vehicle", "kinematic-bicycle", "--maneuver", "step", "--speed", "30", "--out",
@@ -346,8 +407,8 @@ NUMBER_OPTIONS: tuple[tuple[str, tuple[str, ...], str, frozenset[str]], ...] = (
     ("workbench", ("run", "compare"), "--max-time-s", frozenset()),
     ("workbench", ("run", "compare", "fig17", "robustness"), "--seed", frozenset({"0"})),
     ("workbench", ("robustness",), "--max-cte", frozenset()),
-    ("workbench", ("robustness", "sweep", "optimise"), "--workers", frozenset()),
-    ("workbench", ("robustness", "sweep", "optimise"), "--max-runs", frozenset()),
+    ("workbench", ("robustness", "sweep", "optimise", "tournament"), "--workers", frozenset()),
+    ("workbench", ("robustness", "sweep", "optimise", "tournament"), "--max-runs", frozenset()),
     ("tuning", ("generate-data",), "--speed", frozenset()),
     ("tuning", ("generate-data",), "--amplitude-deg", frozenset()),
     ("tuning", ("generate-data",), "--duration-s", frozenset()),
@@ -525,6 +586,10 @@ def cases() -> list[Case]:
     for name in [n for n in names if n.startswith("spec-")] + list(BROKEN_FILES) + ["deep.toml", "not-toml.toml"]:
         command = "optimise" if "optimise" in name else "sweep"
         add(Case(f"workbench-{command}-spec={name}", "workbench", _positional(WB_BASE[command], 1, name)))
+
+    # tournament specs
+    for name in [n for n in names if n.startswith("tournament-")] + list(BROKEN_FILES) + ["deep.toml", "not-toml.toml"]:
+        add(Case(f"workbench-tournament-spec={name}", "workbench", _positional(WB_BASE["tournament"], 1, name)))
 
     # --set text
     for text in ("lookahead_gain_s", "lookahead_gain_s=", "=0.8", "lookahead_gain=0.8", "lookahead_gain_s=abc",
