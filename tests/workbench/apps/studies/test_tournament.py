@@ -20,7 +20,7 @@ from controllers import CONTROLLERS
 from tuning.own_tuning import tuning_for
 from workbench.apps.cli import main
 from workbench.apps.controller_config import read_controller_config
-from workbench.apps.studies import TIMING_COLUMNS, PlannedRun
+from workbench.apps.studies import TIMING_COLUMNS, LocalBackend, PlannedRun
 from workbench.apps.studies.backends import BackendError
 from workbench.apps.studies.runner import ROW_METRICS
 from workbench.apps.studies.tournament import (
@@ -270,3 +270,13 @@ def test_a_configuration_scaled_from_each_vehicles_filter_gets_a_file_per_vehicl
     # unscaled, the configuration is the same for both vehicles (each run adds its own tuning): one file
     plain = write_config_files(spec, "clothoid", {"frechet_threshold_m": 0.05}, tmp_path / "plain", "clothoid", "h")
     assert set(plain.values()) == {(tmp_path / "plain" / "clothoid.toml").resolve()}
+
+
+def test_a_pool_of_two_workers_gives_the_same_tournament(tournament: dict[str, Any]) -> None:
+    out = tournament["folder"] / "pool"
+    pooled = run_tournament(tournament["spec"], out, LocalBackend(workers=2), report=False, log=None)
+    whole = tournament["whole"]
+    pd.testing.assert_frame_equal(
+        comparable(pooled.results, out), comparable(whole.results, tournament["folder"] / "whole"), check_exact=True
+    )
+    pd.testing.assert_frame_equal(comparable(pooled.history, out), comparable(whole.history, out), check_exact=True)
