@@ -819,7 +819,7 @@ def _tournament(args: argparse.Namespace) -> int:
             f"{spec.cases_text('test')}, on the {backend.describe()}"
         )
         result = run_tournament(spec, args.out, backend, progress=sys.stderr.isatty())
-        board = result.judgement.leaderboard if result.judgement is not None else result.summary(spec)
+        board = result.judgement.leaderboard
         board = board[[c for c in _LEADERBOARD_COLUMNS if c in board.columns] or list(board.columns)]
         print(f"{len(result.results)} runs ({result.ran} run now); on the test set, {spec.ranking_text()}:")
         print(board.to_string(index=False, float_format=lambda v: f"{v:.4g}", na_rep="-"))

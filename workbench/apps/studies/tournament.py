@@ -145,47 +145,6 @@ class TournamentResult:
     judgement: Any = None
     report: Path | None = None
 
-    def summary(self, spec: TournamentSpec) -> pd.DataFrame:
-        """Per controller: failed trials, the chosen trial, the selection score of the default (trial 0) and of
-        the chosen trial on the training cases, the mean ranking scalar of the default and the tuned configuration
-        on the test cases (failed runs as the spec's failure_score) and the CPU time of its runs (s)."""
-        rows = []
-        test = self.results[self.results["set"] == TEST]
-        for controller in spec.controllers:
-            history = self.history[self.history["controller"] == controller].set_index("trial")
-            chosen = self.chosen[controller]
-
-            def train_score(trial: int | None, history: pd.DataFrame = history) -> float | None:
-                if trial is None or history.loc[trial, "state"] != "complete":
-                    return None
-                values = [history.loc[trial, f"train_{m}"] for m in spec.objectives]
-                return weighted(values, spec.objectives, spec.selection)
-
-            def test_score(config: str, controller: str = controller) -> float:
-                runs = test[(test["controller"] == controller) & (test["config"] == config)]
-                return float(np.mean([ranking_score(r, spec) for _, r in runs.iterrows()]))
-
-            rows.append(
-                {
-                    "controller": controller,
-                    "failed_trials": int((history["state"] == "failed").sum()),
-                    "chosen_trial": chosen,
-                    "train_default": train_score(0),
-                    "train_tuned": train_score(chosen),
-                    "test_default": test_score(DEFAULT),
-                    "test_tuned": test_score(TUNED),
-                    "cpu_time_s": float(self.results.loc[self.results["controller"] == controller, "cpu_time_s"].sum()),
-                }
-            )
-        return pd.DataFrame(rows).sort_values(["test_tuned", "controller"], kind="stable").reset_index(drop=True)
-
-
-def ranking_score(row: Mapping[str, Any], spec: TournamentSpec) -> float:
-    """A run's ranking scalar: the spec's weighted sum of its metrics, its failure_score for a failed run."""
-    if row["failed"]:
-        return spec.failure_score
-    return float(sum(weight * row[metric] for metric, weight in spec.ranking.items()))
-
 
 def run_command(run: PlannedRun, config_file: Path) -> str:
     """The `workbench run` command line that reproduces a judged run bit for bit: its scenario (name, circuit or
@@ -515,7 +474,6 @@ __all__ = [
     "TournamentIsolationError",
     "TournamentResult",
     "pareto_front",
-    "ranking_score",
     "run_command",
     "run_failure",
     "run_tournament",

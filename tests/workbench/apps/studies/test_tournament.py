@@ -237,7 +237,7 @@ def test_the_front_and_its_spread() -> None:
 def test_a_controller_whose_every_trial_fails_is_judged_with_its_defaults(tmp_path: Path) -> None:
     spec = load_tournament(write_spec(tmp_path, SPEC.replace('"stanley", "clothoid"]', '"stanley"]')))
     backend = NotSimulating()  # every run an error row: every trial fails
-    result = run_tournament(spec, tmp_path / "out", backend, report=False, log=None)
+    result = run_tournament(spec, tmp_path / "out", backend, log=None)
     history = result.history
     assert (history["state"] == "failed").all() and not history["pareto"].any() and not history["chosen"].any()
     assert set(history["reason"]) == {
@@ -247,8 +247,9 @@ def test_a_controller_whose_every_trial_fails_is_judged_with_its_defaults(tmp_pa
     assert result.chosen == {"pure-pursuit": None, "stanley": None}
     test = result.results[result.results["set"] == "test"]
     assert list(test["config"]) == ["default", "tuned"] * 2 and (test["trial"] == 0).all() and test["failed"].all()
-    summary = result.summary(spec)
-    assert summary["chosen_trial"].isna().all() and (summary["test_tuned"] == spec.failure_score).all()
+    board = result.judgement.leaderboard  # judged and reported all the same: every run scores the failure score
+    assert set(board["controller"]) == {"pure-pursuit", "stanley"} and (board["score"] == spec.failure_score).all()
+    assert result.report.is_file()
 
 
 def test_a_configuration_scaled_from_each_vehicles_filter_gets_a_file_per_vehicle(tmp_path: Path) -> None:
