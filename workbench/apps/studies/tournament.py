@@ -13,11 +13,12 @@ chosen, when one of its runs failed: did not complete (status and message), left
 and kept in DIR/runs/ as they finish, so a restarted tournament replays the sampler, finds its runs and goes on
 where it stopped (nothing lost or redone).
 
-The chosen configuration is written to DIR/best/<controller>.toml, up to front_points points spread along the
-front (by the last objective, least first) to DIR/front/<controller>-<k>.toml and the default (the fixed options
-only) to DIR/default/<controller>.toml, each a `workbench run --controller-config` file; a controller whose
-configuration differs between the vehicles (a lead filter scaled from each vehicle's own) gets one file per
-vehicle, `<name>@<vehicle>.toml`, beside the first vehicle's. Then the test stage runs every controller's default,
+The chosen configuration is written to DIR/best/<controller>.toml, up to front_points other points spread along
+the front (by the last objective, least first; neither the default nor the chosen trial, which are judged under
+their own names) to DIR/front/<controller>-<k>.toml and the default (the fixed options only) to
+DIR/default/<controller>.toml, each a `workbench run --controller-config` file; a controller whose configuration
+differs between the vehicles (a lead filter scaled from each vehicle's own) gets one file per vehicle,
+`<name>@<vehicle>.toml`, beside the first vehicle's. Then the test stage runs every controller's default,
 tuned and carried configurations on the test cases, which no trial ever runs (checked: `TournamentIsolationError`).
 
 Writes DIR/results.parquet (every run: the runner's row plus set, config, trial, case, failed, failure and, for a
@@ -274,7 +275,8 @@ def _tune(
             rows += [_annotated(r, TRAIN, TRIAL, trial.number) for r in trial_rows]
     front = pareto_front(points)
     chosen = min(front, key=lambda t: (weighted(points[t], spec.objectives, spec.selection), t)) if front else None
-    carried = spread_points(front, points, spec.front_points)
+    # the default (trial 0) and the chosen trial are judged under their own names: carried are the front's others
+    carried = spread_points([t for t in front if t not in (0, chosen)], points, spec.front_points)
     for entry in history:
         entry["pareto"] = entry["trial"] in front
         entry["chosen"] = entry["trial"] == chosen

@@ -126,6 +126,8 @@ def test_the_tournament_trains_judges_and_writes(tournament: dict[str, Any]) -> 
         assert all(score(chosen) <= score(t) for t in own.index[own["pareto"]])
         carried = own["carried"].dropna()
         assert sorted(carried) == list(range(1, len(carried) + 1)) and len(carried) <= spec.front_points
+        # carried: the front's other points, the default and the chosen trial being judged under their own names
+        assert set(carried.index) <= set(own.index[own["pareto"]]) - {0, chosen}
         assert (own["runs"] == 1).all() and (own["cpu_time_s"] > 0).all()
         # its judged configurations: default (trial 0), tuned (the chosen trial), the carried points
         test = results[(results["controller"] == controller) & (results["set"] == "test")]
