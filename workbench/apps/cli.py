@@ -45,6 +45,7 @@ if TYPE_CHECKING:
     from workbench.apps.studies.backends import Backend
     from workbench.apps.studies.tournament_spec import TournamentSpec
     from workbench.base.output_dir import OutputDir
+    from workbench.simulation.circuit_ranges import CircuitRanges
     from workbench.simulation.plot_worker import PlotWorker
     from workbench.simulation.result import SimulationResult
     from workbench.simulation.run_config import SimulationConfig
@@ -71,6 +72,7 @@ TRACK_SCENARIO = "zandvoort"
 #: The input-file options of the commands (argparse dest -> what the message calls it).
 INPUT_FILES = {
     "track": "--track",
+    "circuit_ranges": "--circuit-ranges",
     "controller_config": "--controller-config",
     "vehicle_file": "--vehicle-file",
     "spec": "the spec",
@@ -93,6 +95,15 @@ def _parser(command: str | None = None) -> argparse.ArgumentParser:
 
     scen = sub.add_parser("scenarios", help="list the named scenarios")
     scen.add_argument("--track", type=Path, help="Zandvoort track CSV (TUMFTM racetrack-database format)")
+    scen.add_argument(
+        "--circuit-ranges",
+        dest="show_circuit_ranges",
+        nargs="?",
+        const="",
+        metavar="FILE.toml",
+        help="print instead the ranges circuit:SEED is drawn within, as a [circuits] table: the defaults, or those "
+        "of FILE (copy, edit, give with --circuit-ranges)",
+    )
     veh = sub.add_parser("vehicles", help="list the vehicle models and presets")
     veh.add_argument("--show", metavar="NAME", help="print a preset's TOML (copy, edit, pass with --vehicle-file)")
     cond = sub.add_parser("conditions", help="list the sensing, actuation and road conditions presets")
@@ -162,6 +173,7 @@ def _parser(command: str | None = None) -> argparse.ArgumentParser:
     rob.add_argument("--out", type=Path, required=True, metavar="DIR", help="output directory (rerun to resume)")
     rob.add_argument("--speed", type=float, default=30.0, metavar="KMH", help="target speed, km/h (default 30)")
     rob.add_argument("--track", type=Path, help="track CSV for the zandvoort scenario")
+    _circuit_ranges_option(rob)
     rob.add_argument(
         "--max-cte", type=float, default=0.5, metavar="M", help="a run passes within this max |CTE| (default 0.5 m)"
     )
@@ -301,6 +313,7 @@ def _run_options(parser: argparse.ArgumentParser, several: bool) -> None:
     parser.add_argument("--speed", type=float, default=30.0, metavar="KMH", help="target speed, km/h (default 30)")
     parser.add_argument("--out", type=Path, required=True, metavar="DIR", help="output directory")
     parser.add_argument("--track", type=Path, metavar="FILE", help="track CSV for the zandvoort scenario")
+    _circuit_ranges_option(parser)
     parser.add_argument("--laps", type=int, default=1, metavar="N", help="laps of a closed path (default 1)")
     parser.add_argument(
         "--controller-rate-hz", type=float, default=50.0, metavar="HZ", help="controller rate (default 50 Hz)"
@@ -329,6 +342,26 @@ def _run_options(parser: argparse.ArgumentParser, several: bool) -> None:
     what = "trace and metrics" if not several else "traces, metrics and summary.csv, without figures or report.html"
     parser.add_argument("--no-plots", action="store_true", help=f"write the {what} only")
     _overwrite_option(parser)
+
+
+def _circuit_ranges_option(parser: argparse.ArgumentParser) -> None:
+    """--circuit-ranges, of run, compare and robustness: the ranges a circuit:SEED scenario is drawn within."""
+    parser.add_argument(
+        "--circuit-ranges",
+        type=Path,
+        metavar="FILE.toml",
+        help="with a circuit:SEED scenario: draw it within the ranges of this file's [circuits] table (`workbench "
+        "scenarios --circuit-ranges` prints the defaults; a spec carrying the table will do)",
+    )
+
+
+def _circuit_ranges(args: argparse.Namespace) -> CircuitRanges | None:
+    """The ranges --circuit-ranges names, read (None without it)."""
+    if args.circuit_ranges is None:
+        return None
+    from workbench.simulation.circuit_ranges import read_circuit_ranges
+
+    return read_circuit_ranges(args.circuit_ranges)
 
 
 def _allow_infeasible_option(parser: argparse.ArgumentParser) -> None:
@@ -557,7 +590,7 @@ def _compare(args: argparse.Namespace) -> int:
         args.scenario,
         runs,
         _run_config(args),
-        ScenarioOptions(track_file=args.track),
+        ScenarioOptions(track_file=args.track, circuit_ranges=_circuit_ranges(args)),
         warn=warn_on_stderr,
         progress=sys.stderr.isatty(),
         allow_long_run=args.allow_long_run,
@@ -705,6 +738,7 @@ def _robustness(args: argparse.Namespace) -> int:
         allow_long_run=args.allow_long_run,
         allow_infeasible=args.allow_infeasible,
         inform_delays=args.inform_delays,
+        circuit_ranges=args.circuit_ranges,
     )
     limit = DEFAULT_MAX_RUNS if max_runs is None else max_runs
     if len(runs) > limit:
@@ -928,7 +962,10 @@ def _run_stages(
     delays = KnownDelays.from_conditions(config.conditions) if config.inform_delays else None
     controller = tuned_controller(args.controller, vehicle, options, delays)
     scenario = make_scenario(
-        args.scenario, ScenarioOptions(vehicle_width_m=vehicle.geometry.width_m, track_file=args.track)
+        args.scenario,
+        ScenarioOptions(
+            vehicle_width_m=vehicle.geometry.width_m, track_file=args.track, circuit_ranges=_circuit_ranges(args)
+        ),
     )
     if args.scenario == TRACK_SCENARIO and scenario.name != TRACK_SCENARIO:  # another file given: named by it
         progress.warn(scenario.description)
@@ -955,6 +992,14 @@ def _scenarios(args: argparse.Namespace) -> None:
     from workbench.simulation.scenarios import ScenarioOptions, describe_scenarios, make_scenario
 
     _check_inputs(args)
+    if args.show_circuit_ranges is not None:
+        from workbench.simulation.circuit_ranges import circuit_ranges_toml, read_circuit_ranges
+
+        path = args.show_circuit_ranges
+        if args.track is not None:
+            raise WorkbenchInputError("--circuit-ranges prints the circuits' ranges and reads no --track: drop one")
+        print(circuit_ranges_toml(read_circuit_ranges(path) if path else None), end="")
+        return
     options = ScenarioOptions(track_file=args.track)
     if args.track is not None:
         make_scenario(TRACK_SCENARIO, options)  # a track that cannot be used is refused, not described

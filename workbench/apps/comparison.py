@@ -24,7 +24,7 @@ from __future__ import annotations
 import math
 import sys
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -308,7 +308,7 @@ def _simulation(
         scen = scenario
     else:
         options = scenario_options or ScenarioOptions()
-        scen = make_scenario(scenario, ScenarioOptions(vehicle.geometry.width_m, options.track_file))
+        scen = make_scenario(scenario, replace(options, vehicle_width_m=vehicle.geometry.width_m))
     config_type = CONTROLLERS[spec.controller].config_type
     options = read_controller_config(spec.config_file, spec.controller, config_type, spec.overrides, vehicle.geometry)
     delays = KnownDelays.from_conditions(config.conditions) if config.inform_delays else None

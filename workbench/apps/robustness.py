@@ -20,7 +20,7 @@ import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import pandas as pd
 
@@ -36,6 +36,9 @@ from workbench.simulation.conditions import load_conditions
 from workbench.simulation.known_delays import KnownDelays
 from workbench.simulation.scenarios import is_named_scenario
 from workbench.vehicles import load_vehicle
+
+if TYPE_CHECKING:
+    from workbench.simulation.circuit_ranges import CircuitRanges
 
 
 @dataclass(frozen=True)
@@ -133,6 +136,7 @@ def plan_robustness(
     allow_infeasible: bool = False,
     warn: Callable[[str], None] | None = warn_on_stderr,
     inform_delays: bool = False,
+    circuit_ranges: Path | None = None,
 ) -> list[PlannedRun]:
     """Every run of the study: per controller, the base run and each axis's other values (axes: None for
     `robustness_axes(vehicle)`; the payload axis's runs keep the controller built for the nominal payload). Each
@@ -141,9 +145,19 @@ def plan_robustness(
     (`--allow-long-run`); so is a path the vehicle, at its own payload, cannot follow at the planned speed
     (`feasibility.refuse_infeasible`, as `workbench run` refuses it), unless allow_infeasible
     (`--allow-infeasible`): then where it cannot is said through `warn` (None: silent). inform_delays: every
-    run's controller is told the base conditions' nominal delays (`told_options`, the module docstring)."""
-    _check_path(scenario, vehicle, speed_kmh, track_file, base_dir, allow_long_run, allow_infeasible, warn)
-    base = {"speed_kmh": speed_kmh, "conditions": conditions, "seed": seed}
+    run's controller is told the base conditions' nominal delays (`told_options`, the module docstring).
+    circuit_ranges: a file whose [circuits] table a circuit:SEED scenario is drawn within (the run parameter of
+    that name; relative to base_dir)."""
+    ranges = None
+    if circuit_ranges is not None:
+        from workbench.simulation.circuit_ranges import read_circuit_ranges
+
+        circuit_ranges = Path(base_dir or Path.cwd()) / circuit_ranges
+        ranges = read_circuit_ranges(circuit_ranges)
+    _check_path(scenario, vehicle, speed_kmh, track_file, base_dir, allow_long_run, allow_infeasible, warn, ranges)
+    base: dict[str, Any] = {"speed_kmh": speed_kmh, "conditions": conditions, "seed": seed}
+    if circuit_ranges is not None:
+        base["circuit_ranges"] = circuit_ranges
     told: dict[str, dict[str, Any]] = {}
     if inform_delays:
         named = load_conditions(resolve_conditions(conditions, base_dir or Path.cwd()))
@@ -185,12 +199,13 @@ def _check_path(
     allow_long_run: bool,
     allow_infeasible: bool,
     warn: Callable[[str], None] | None,
+    circuit_ranges: CircuitRanges | None = None,
 ) -> None:
     """Refuse runs that may simulate more than the bounds of `run_size` (`check_run_size`), unless
     allow_long_run, and a path the vehicle cannot follow at the planned speed (`refuse_infeasible`), unless
     allow_infeasible (then said through `warn`): every run of the study drives the scenario's path at the same
     speed, so one planned path is every run's (the payload axis's lighter plants ask less of the vehicle than its
-    own payload)."""
+    own payload). circuit_ranges: what a circuit:SEED scenario is drawn within (None: the defaults)."""
     from workbench.simulation.feasibility import path_feasibility_warnings, refuse_infeasible
     from workbench.simulation.run_config import SimulationConfig
     from workbench.simulation.run_size import RunSize, check_run_size
@@ -201,7 +216,8 @@ def _check_path(
     if not is_named_scenario(scenario):  # a file, relative to base_dir
         scenario = str((base_dir or Path.cwd()) / scenario)
     config = SimulationConfig(speed_kmh=speed_kmh)
-    path = plan_path_speed(make_scenario(scenario, ScenarioOptions(model.geometry.width_m, track_file)).path, config)
+    options = ScenarioOptions(model.geometry.width_m, track_file, circuit_ranges)
+    path = plan_path_speed(make_scenario(scenario, options).path, config)
     if not allow_long_run:
         size = RunSize.of(path, config, len(model.output_names))
         shorten = f"a higher --speed (now {speed_kmh:g} km/h) shortens it"

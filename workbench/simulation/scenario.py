@@ -14,12 +14,12 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from workbench.base.errors import WorkbenchInputError, require_in_range
+from workbench.simulation.vehicle_widths import VEHICLE_WIDTH_RANGE_M
 
 if TYPE_CHECKING:
     from workbench.base.path import ReferencePath
+    from workbench.simulation.circuit_ranges import CircuitRanges
 
-#: The vehicle widths (m) the scenarios size lanes and tracks for.
-VEHICLE_WIDTH_RANGE_M = (0.5, 4.0)
 #: Bounds of a run's initial error: lateral offset (m, either side) and heading error (rad, either way).
 MAX_INITIAL_OFFSET_M = 50.0
 MAX_INITIAL_HEADING_ERROR_RAD = math.pi / 2
@@ -34,15 +34,25 @@ class ScenarioOptions:
     it. It has no default because a lane sized for one vehicle and driven by another measures nothing the standard
     defines, and nothing in a run would show the mismatch: `dlc` refuses to be built without it, from Python as
     from the command line (which passes the width of the vehicle it runs). track_file: a track CSV for scenarios
-    that read one (zandvoort).
+    that read one (zandvoort). circuit_ranges: the ranges a generated circuit (circuit:SEED) is drawn within
+    (`workbench.simulation.circuits.CircuitRanges`; None: the defaults); any other scenario refuses them, since
+    nothing in it would follow them.
     """
 
     vehicle_width_m: float | None = None
     track_file: Path | None = None
+    circuit_ranges: CircuitRanges | None = None
 
     def __post_init__(self) -> None:
         if self.vehicle_width_m is not None:
             require_in_range("vehicle_width_m", self.vehicle_width_m, *VEHICLE_WIDTH_RANGE_M, "m")
+        if self.circuit_ranges is not None:
+            from workbench.simulation.circuit_ranges import CircuitRanges
+
+            if not isinstance(self.circuit_ranges, CircuitRanges):
+                raise WorkbenchInputError(
+                    f"circuit_ranges must be a CircuitRanges or None; got {type(self.circuit_ranges).__name__}"
+                )
 
     def required_width_m(self, scenario: str) -> float:
         """The vehicle's width (m) for a scenario sized by it; WorkbenchInputError naming `vehicle_width_m` (and

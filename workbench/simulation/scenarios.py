@@ -297,16 +297,23 @@ def make_scenario(name_or_file: str, options: ScenarioOptions | None = None) -> 
     """Build a named scenario, or one from a waypoint file when the argument is a path to a file.
 
     `dlc` and `circuit:SEED` need `options.vehicle_width_m` (the width of the vehicle to be driven: the lanes and
-    the track are sized for it); the other scenarios do not depend on the vehicle.
+    the track are sized for it); the other scenarios do not depend on the vehicle. `circuit:SEED` is drawn within
+    `options.circuit_ranges` (None: the defaults), which any other scenario refuses.
     """
     options = options or ScenarioOptions()
+    from workbench.simulation.circuits import DEFAULT_RANGES, circuit_seed, generate_circuit
+
+    seed = None if name_or_file in SCENARIOS else circuit_seed(name_or_file)
+    if seed is None and options.circuit_ranges is not None:
+        raise WorkbenchInputError(
+            f"circuit ranges shape the generated circuits (circuit:SEED) only; scenario {name_or_file!r} is not one: "
+            "drop the ranges (--circuit-ranges) or name a circuit"
+        )
     if name_or_file in SCENARIOS:
         return SCENARIOS[name_or_file](options)
-    from workbench.simulation.circuits import circuit_seed, generate_circuit
-
-    seed = circuit_seed(name_or_file)
     if seed is not None:
-        return generate_circuit(seed, vehicle_width_m=options.required_width_m(name_or_file))
+        ranges = options.circuit_ranges if options.circuit_ranges is not None else DEFAULT_RANGES
+        return generate_circuit(seed, ranges, vehicle_width_m=options.required_width_m(name_or_file))
     candidate = Path(name_or_file)
     if candidate.suffix.lower() in {".csv", ".txt"} or candidate.is_file():
         if not candidate.is_file():

@@ -317,3 +317,68 @@ def test_robustness_checks_a_circuit_by_its_name_not_as_a_file(tmp_path):
     from workbench.apps.robustness import _check_path
 
     _check_path("circuit:7", "kinematic-bicycle", 30.0, None, tmp_path, False, False, print)  # raises nothing
+
+
+# ---------------------------------------------------------------------------------------------- given ranges
+#: Small tight circuits (a car's; no trailer to make room for): 150-400 m laps of 12-20 m turns.
+SMALL_RANGES = CircuitRanges(
+    min_radius_m=12.0, max_radius_m=20.0, max_curvature_rate_1pm2=0.02, offtracking_length_m=0.0, clearance_m=14.0,
+    min_length_m=150.0, max_length_m=400.0,
+)  # fmt: skip
+SMALL_RANGES_TOML = """[circuits]
+min_radius_m = 12.0
+max_radius_m = 20.0
+max_curvature_rate_1pm2 = 0.02
+offtracking_length_m = 0.0
+clearance_m = 14.0
+min_length_m = 150.0
+max_length_m = 400.0
+"""
+
+
+def test_make_scenario_draws_a_circuit_within_the_ranges_given_and_other_scenarios_refuse_them(tmp_path):
+    options = ScenarioOptions(vehicle_width_m=1.8, circuit_ranges=SMALL_RANGES)
+    built = make_scenario("circuit:7", options)
+    direct = generate_circuit(7, SMALL_RANGES, vehicle_width_m=1.8)
+    assert np.array_equal(built.path.x_m, direct.path.x_m) and np.array_equal(built.path.y_m, direct.path.y_m)
+    assert built.path.length_m < SMALL_RANGES.max_length_m < generate_circuit(7, vehicle_width_m=1.8).path.length_m
+    waypoints = tmp_path / "loop.csv"
+    waypoints.write_text("x,y\n0,0\n10,0\n20,5\n")
+    for other in ("dlc", "figure8", str(waypoints)):
+        with pytest.raises(WorkbenchInputError, match=f"scenario {other!r} is not one: drop the ranges"):
+            make_scenario(other, options)
+    with pytest.raises(WorkbenchInputError, match="circuit_ranges must be a CircuitRanges or None; got dict"):
+        ScenarioOptions(circuit_ranges={"min_radius_m": 12.0})  # type: ignore[arg-type]
+
+
+def test_workbench_run_and_compare_draw_the_circuit_within_the_ranges_file(capsys, tmp_path):
+    ranges = tmp_path / "ranges.toml"
+    ranges.write_text(SMALL_RANGES_TOML)
+    length = generate_circuit(7, SMALL_RANGES).path.length_m
+    run = ["run", "circuit:7", "--controller", "pure-pursuit", "--circuit-ranges", str(ranges), "--no-plots"]
+    assert main([*run, "--out", str(tmp_path / "run")]) == 0, capsys.readouterr().err
+    metrics = json.loads((tmp_path / "run" / "metrics.json").read_text())
+    assert metrics["path_length_m"] == pytest.approx(length, abs=0.5) and metrics["status"] == "completed"
+    compare = ["compare", "circuit:7", "--controllers", "pure-pursuit", "--vehicle", "kinematic-bicycle"]
+    assert main([*compare, "--circuit-ranges", str(ranges), "--no-plots", "--out", str(tmp_path / "cmp")]) == 0
+    (compared,) = (tmp_path / "cmp" / "runs").glob("*/metrics.json")
+    assert json.loads(compared.read_text())["path_length_m"] == metrics["path_length_m"]
+    capsys.readouterr()
+    assert main(["run", "dlc", "--circuit-ranges", str(ranges), "--out", str(tmp_path / "dlc")]) == 2
+    assert "scenario 'dlc' is not one: drop the ranges (--circuit-ranges)" in capsys.readouterr().err
+    missing = ["run", "circuit:7", "--circuit-ranges", str(tmp_path / "none.toml"), "--out", str(tmp_path / "x")]
+    assert main(missing) == 2
+    assert "--circuit-ranges" in capsys.readouterr().err and not (tmp_path / "dlc").exists()
+
+
+def test_robustness_runs_carry_the_ranges_file_and_a_scenario_that_is_not_a_circuit_refuses_it(capsys, tmp_path):
+    from workbench.apps.robustness import plan_robustness
+
+    (tmp_path / "ranges.toml").write_text(SMALL_RANGES_TOML)
+    runs = plan_robustness(
+        "circuit:7", ["pure-pursuit"], "kinematic-bicycle", base_dir=tmp_path, circuit_ranges=Path("ranges.toml")
+    )
+    assert runs and all(dict(run.values)["circuit_ranges"] == tmp_path / "ranges.toml" for run in runs)
+    robustness = ["robustness", "dlc", "--controllers", "pure-pursuit", "--vehicle", "kinematic-bicycle"]
+    code = main([*robustness, "--circuit-ranges", str(tmp_path / "ranges.toml"), "--out", str(tmp_path / "rob")])
+    assert code == 2 and "scenario 'dlc' is not one" in capsys.readouterr().err

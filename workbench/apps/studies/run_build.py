@@ -30,6 +30,7 @@ EXTRA_RUN_PARAMETERS: dict[str, Any] = {
     "controller_payload_kg": float,
     "initial_offset_m": float,
     "initial_heading_error_deg": float,
+    "circuit_ranges": Path,
 }
 #: Factors on a lead filter's zero and pole frequencies, parameters of controllers that read one (`filter_file`).
 LEAD_FILTER_SCALES = ("lead_filter_zero_scale", "lead_filter_pole_scale")

@@ -2,9 +2,10 @@
 status, message).
 
 The run is built as `workbench run` builds one: the vehicle (with its payload), the scenario sized for it (with
-the initial offset and heading error), the controller's options from the controller-config file and the run's
-options on top (`workbench.apps.controller_config.read_controller_config`, the `--set KEY=VALUE` path), told the
-conditions' nominal delays when the run parameter inform_delays is true (`known_delays.KnownDelays`, as `workbench
+the initial offset and heading error; a generated circuit within the ranges of the run parameter circuit_ranges),
+the controller's options from the controller-config file and the run's options on top
+(`workbench.apps.controller_config.read_controller_config`, the `--set KEY=VALUE` path), told the conditions' nominal
+delays when the run parameter inform_delays is true (`known_delays.KnownDelays`, as `workbench
 run --inform-delays`), the lead filter scaled when asked (`lead_filter_scaling.py`), then `Simulation(...).run()`.
 Nothing in it is random, so the same PlannedRun gives the same row, bit for bit, on any worker, except the
 wall-clock fields (TIMING_COLUMNS). One exception: the MPCs drop a solve that overruns its wall-clock budget
@@ -34,6 +35,7 @@ from workbench.apps.studies.run_build import (
     with_scaled_filter,
 )
 from workbench.apps.studies.spec import PlannedRun
+from workbench.simulation.circuit_ranges import read_circuit_ranges
 from workbench.simulation.known_delays import KnownDelays
 from workbench.simulation.metrics import METRIC_KEYS
 from workbench.simulation.result import SimulationResult
@@ -78,7 +80,8 @@ def simulate(run: PlannedRun, progress: bool = False) -> SimulationResult:
     vehicle, built_for = plant_and_controller_vehicles(
         load_vehicle(run.vehicle), extra["payload_kg"], extra["controller_payload_kg"]
     )  # run.vehicle: a preset name or a vehicle file
-    scenario = make_scenario(run.scenario, ScenarioOptions(vehicle.geometry.width_m, run.track_file))
+    ranges = read_circuit_ranges(extra["circuit_ranges"]) if extra["circuit_ranges"] is not None else None
+    scenario = make_scenario(run.scenario, ScenarioOptions(vehicle.geometry.width_m, run.track_file, ranges))
     scenario = started_scenario(
         scenario, extra["initial_offset_m"], extra["initial_heading_error_deg"], config.max_abs_cte_m
     )

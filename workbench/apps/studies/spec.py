@@ -5,13 +5,16 @@ The format, tables [study], [grid], [grid.NAME], [random], [random.NAME] and [op
 search), is described with an example in README.md ("Studies: sweeps and optimisation"). Run parameters
 (RUN_PARAMETERS) are the fields of `SimulationConfig` (its conditions as a preset name or file, and each of their
 scalar fields, `condition_parameters.py`), payload_kg, controller_payload_kg (the payload the controller is built
-for; omitted: the plant's), initial_offset_m and initial_heading_error_deg (omitted: the scenario's own).
+for; omitted: the plant's), initial_offset_m and initial_heading_error_deg (omitted: the scenario's own), and
+circuit_ranges (a file whose [circuits] table the generated circuits are drawn within, `circuit_parameters.py`;
+a spec may carry the table and name itself).
 Controller parameters are the controller's options and, for a controller that reads a lead filter,
 lead_filter_zero_scale and lead_filter_pole_scale (`lead_filter_scaling.py`).
 
 Planned runs are the product, per scenario, vehicle and controller, of the run-parameter axes, that controller's
 axes and the random samples (draw i of every key together). Each run's id is a hash of its canonical parameters
-(files by their path relative to the spec and a hash of their content), so the same run always has the same id
+(files by their path relative to the spec and a hash of their content; a circuit_ranges file by the ranges it
+holds), so the same run always has the same id
 and a restarted or extended study finds the runs it already has.
 
 The spec is checked before any run starts, so that a mistake costs no runs: unknown tables, keys and names,
@@ -41,6 +44,14 @@ from types import MappingProxyType
 from typing import Any
 
 from controllers import CONTROLLERS
+from workbench.apps.studies.circuit_parameters import (
+    CIRCUIT_RANGES,
+    check_circuits_table,
+    planned_circuit_ranges,
+    ranged_options,
+    ranges_identity,
+    scenario_values,
+)
 from workbench.apps.studies.condition_parameters import CONDITION_PARAMETERS, resolve_conditions
 from workbench.apps.studies.distributions import SEARCHABLE, Distribution, key_rng
 from workbench.apps.studies.run_build import EXTRA_RUN_PARAMETERS, LEAD_FILTER_SCALES
@@ -551,12 +562,15 @@ class StudySpec:
 
         scenarios = {}
         width = next(iter(models.values())).geometry.width_m
+        ranges = planned_circuit_ranges(self)
         for scenario in self.scenarios:
             key, track = ("study.track_file", self.track_file) if scenario == "zandvoort" else ("study.scenarios", None)
-            try:
-                scenarios[scenario] = make_scenario(scenario, ScenarioOptions(width, track))
-            except WorkbenchInputError as exc:
-                raise WorkbenchInputError(f"{key}: {exc}") from None
+            built_with = ranged_options(scenario, ScenarioOptions(width, track), ranges, self.base_dir)
+            for label, options in built_with.items():
+                try:
+                    scenarios[label] = make_scenario(scenario, options)
+                except WorkbenchInputError as exc:
+                    raise WorkbenchInputError(f"{key}: {exc}") from None
         geometry = next(iter(models.values())).geometry
         checked: set[Path] = set()
         for controller in self.controllers:
@@ -674,6 +688,10 @@ class StudySpec:
             return name if name in known or is_named_scenario(name) else self._canonical(Path(name), digests)
 
         track = self.track_file if scenario == "zandvoort" else None
+        values = scenario_values(scenario, values)
+        parameters = {k: self._canonical(v, digests) for k, v in sorted(values.items())}
+        if CIRCUIT_RANGES in values:  # by the ranges it holds: a spec naming itself keeps its ids when edited
+            parameters[CIRCUIT_RANGES] = ranges_identity(values[CIRCUIT_RANGES])
         document = {
             "format": RUN_FORMAT,
             "scenario": canon_name(scenario, SCENARIOS),
@@ -681,7 +699,7 @@ class StudySpec:
             "controller": controller,
             "controller_config": self._canonical(self.controller_config, digests),
             "track_file": self._canonical(track, digests),
-            "parameters": {k: self._canonical(v, digests) for k, v in sorted(values.items())},
+            "parameters": parameters,
             "options": {k: self._canonical(v, digests) for k, v in sorted(options.items())},
             "sample": sample,
         }
@@ -747,13 +765,16 @@ def load_spec(path: str | Path, kind: str = "sweep", max_runs: int | None = None
     path = Path(path)
     document = read_toml(path, f"spec file {str(path)!r}")
     try:
-        return _from_document(document, kind, path.resolve().parent, max_runs)
+        spec = _from_document(document, kind, path.resolve().parent, max_runs)
+        named = list(spec.grid.get("circuit_ranges", ())) + list(spec.drawn().get("circuit_ranges", ()))
+        check_circuits_table(document, path, named, "in [grid]")
+        return spec
     except WorkbenchInputError as exc:
         raise WorkbenchInputError(f"spec {path}: {exc}") from None
 
 
 def _from_document(document: Mapping[str, Any], kind: str, base_dir: Path, max_runs: int | None = None) -> StudySpec:
-    tables = ("study", "grid", "random") + (("optimise",) if kind == "optimise" else ())
+    tables = ("study", "grid", "random", "circuits") + (("optimise",) if kind == "optimise" else ())
     unknown = [k for k in document if k not in tables]
     if unknown:
         hint = " ([optimise] belongs to `workbench optimise`)" if "optimise" in unknown else ""
