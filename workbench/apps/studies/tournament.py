@@ -149,8 +149,8 @@ class TournamentResult:
 
 def run_command(run: PlannedRun, config_file: Path) -> str:
     """The `workbench run` command line that reproduces a judged run bit for bit: its scenario (name, circuit or
-    file), controller, vehicle (preset or file), speed, conditions, seed, informed delays, track file and the
-    controller-config file of its configuration; it writes to replay/<run id>."""
+    file), controller, vehicle (preset or file), speed, conditions, seed, informed delays, track file, circuit
+    ranges file and the controller-config file of its configuration; it writes to replay/<run id>."""
     values = dict(run.values)
     words = ["workbench", "run", run.scenario, "--controller", run.controller]
     words += ["--vehicle", run.vehicle] if run.vehicle in VEHICLES else ["--vehicle-file", run.vehicle]
@@ -160,6 +160,8 @@ def run_command(run: PlannedRun, config_file: Path) -> str:
         words.append("--inform-delays")
     if run.track_file is not None:
         words += ["--track", str(run.track_file)]
+    if values.get("circuit_ranges") is not None:
+        words += ["--circuit-ranges", str(values["circuit_ranges"])]
     words += ["--controller-config", str(config_file), "--out", f"{REPLAY_DIR}/{run.run_id}"]
     return shlex.join(words)
 

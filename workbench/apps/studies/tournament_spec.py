@@ -4,18 +4,21 @@ controller's chosen configuration and rank the controllers.
 
 Tables: [tournament] (controllers, vehicles, trials, batch_size, seed, objectives, selection, ranking,
 failure_score, front_points, inform_delays, max_runs, track_file, description), [train] and [test] (scenarios,
-speeds_kmh, conditions, seeds: a set's cases are their product with the vehicles), [search.NAME] (a controller's
-search space: its own, `controllers.search_space.controller_search_space`, with the table's entries over it, key by
-key) and [fixed.NAME] (options fixed for every run of a controller). README.md ("Tournament") shows an annotated
-example.
+speeds_kmh, conditions, seeds: a set's cases are their product with the vehicles; circuit_ranges: a file whose
+[circuits] table the set's generated circuits are drawn within, the run parameter of that name, which may be the
+spec itself when it carries the table), [circuits] (`workbench.simulation.circuit_ranges`), [search.NAME] (a
+controller's search space: its own, `controllers.search_space.controller_search_space`, with the table's entries
+over it, key by key) and [fixed.NAME] (options fixed for every run of a controller). README.md ("Tournament") shows
+an annotated example.
 
-A case is one scenario, vehicle, speed, conditions and seed; its id (`case_id`) is the same text across
-controllers and configurations. A case in both sets is refused: the test set is held out. Internally the spec is
-one `StudySpec` per controller and set (`studies`), so that every check of a study applies to each (names, files,
-values every run would refuse, run sizes, feasibility of each path for each vehicle at the set's fastest speed);
-the training study carries the trial budget and the search space as its [optimise] settings, which checks them
-against the controller's options. The MPCs (every controller with a `max_solve_time_s` option) get a solve budget
-they never reach, MPC_SOLVE_BUDGET_S, unless [fixed.NAME] gives one, so that their runs reproduce bit for bit.
+A case is one scenario (a generated circuit with the ranges file it is drawn within), vehicle, speed, conditions
+and seed; its id (`case_id`) is the same text across controllers and configurations. A case in both sets is
+refused: the test set is held out. Internally the spec is one `StudySpec` per controller and set (`studies`), so
+that every check of a study applies to each (names, files, values every run would refuse, run sizes, feasibility
+of each path for each vehicle at the set's fastest speed); the training study carries the trial budget and the
+search space as its [optimise] settings, which checks them against the controller's options. The MPCs (every
+controller with a `max_solve_time_s` option) get a solve budget they never reach, MPC_SOLVE_BUDGET_S, unless
+[fixed.NAME] gives one, so that their runs reproduce bit for bit.
 """
 
 from __future__ import annotations
@@ -29,6 +32,7 @@ from types import MappingProxyType
 from typing import Any
 
 from controllers import CONTROLLERS
+from workbench.apps.studies.circuit_parameters import check_circuits_table
 from workbench.apps.studies.distributions import SEARCHABLE, Distribution
 from workbench.apps.studies.run_build import LEAD_FILTER_SCALES
 from workbench.apps.studies.spec import (
@@ -43,7 +47,7 @@ from workbench.base.errors import WorkbenchInputError, value_text
 from workbench.base.input_files import read_toml
 from workbench.base.typed_tables import typed_value
 
-TABLES = ("tournament", "train", "test", "search", "fixed")
+TABLES = ("tournament", "train", "test", "search", "fixed", "circuits")
 TOURNAMENT_KEYS = (
     "controllers",
     "vehicles",
@@ -60,7 +64,7 @@ TOURNAMENT_KEYS = (
     "track_file",
     "description",
 )
-SET_KEYS = ("scenarios", "speeds_kmh", "conditions", "seeds")
+SET_KEYS = ("scenarios", "speeds_kmh", "conditions", "seeds", "circuit_ranges")
 SETS = ("train", "test")
 #: The objectives a front is drawn over unless the spec names others: tracking (RMS and max |CTE|, m) against
 #: steering effort (RMS steering-wheel rate, deg/s), each the mean over the training cases.
@@ -85,8 +89,12 @@ SOLVE_BUDGET_OPTION = "max_solve_time_s"
 
 
 def case_id(row: Mapping[str, Any]) -> str:
-    """A case's id from a run's row or parameters: "scenario|vehicle|speed_kmh|conditions|seed" (speed as %g)."""
-    return f"{row['scenario']}|{row['vehicle']}|{row['speed_kmh']:g}|{row['conditions']}|{row['seed']}"
+    """A case's id from a run's row or parameters: "scenario|vehicle|speed_kmh|conditions|seed" (speed as %g); a
+    circuit drawn within a circuit_ranges file is "circuit:SEED (FILE NAME)"."""
+    scenario, ranges = row["scenario"], row.get("circuit_ranges")
+    if isinstance(ranges, str | Path) and str(ranges):
+        scenario = f"{scenario} ({Path(ranges).name})"
+    return f"{scenario}|{row['vehicle']}|{row['speed_kmh']:g}|{row['conditions']}|{row['seed']}"
 
 
 def weights_text(weights: Mapping[str, float]) -> str:
@@ -97,13 +105,16 @@ def weights_text(weights: Mapping[str, float]) -> str:
 @dataclass(frozen=True)
 class CaseSet:
     """A set of cases (train or test): its scenarios (names, "circuit:SEED", or waypoint/track files relative to
-    the spec), speeds (km/h), conditions (presets or files) and seeds of the conditions' noise."""
+    the spec), speeds (km/h), conditions (presets or files) and seeds of the conditions' noise; circuit_ranges: a
+    file (relative to the spec) whose [circuits] table its generated circuits are drawn within (None: the
+    defaults)."""
 
     name: str
     scenarios: tuple[str, ...]
     speeds_kmh: tuple[float, ...]
     conditions: tuple[str, ...] = ("ideal",)
     seeds: tuple[int, ...] = (0,)
+    circuit_ranges: str | None = None
 
     @classmethod
     def from_table(cls, name: str, table: object) -> CaseSet:
@@ -135,7 +146,10 @@ class CaseSet:
         for seed in values.get("seeds", ()):
             if seed < 0:
                 raise WorkbenchInputError(f"{name}.seeds must be whole numbers >= 0; got {seed}")
-        return cls(name, **values)
+        ranges = None
+        if "circuit_ranges" in table:
+            ranges = typed_value(f"{name}.circuit_ranges", table["circuit_ranges"], str)
+        return cls(name, **values, circuit_ranges=ranges)
 
 
 def _weights(where: str, table: object, allowed: Sequence[str], default: Mapping[str, float]) -> dict[str, float]:
@@ -379,6 +393,8 @@ class TournamentSpec:
             "seed": list(case_set.seeds),
             "inform_delays": [self.inform_delays],
         }
+        if case_set.circuit_ranges is not None:
+            grid["circuit_ranges"] = [case_set.circuit_ranges]
         try:
             optimise = None
             if case_set.name == "train":
@@ -485,6 +501,7 @@ _TERMS = (
     ("grid.speed_kmh", "{set}.speeds_kmh"),
     ("grid.conditions", "{set}.conditions"),
     ("grid.seed", "{set}.seeds"),
+    ("grid.circuit_ranges", "{set}.circuit_ranges"),
     ("grid.{controller}.", "fixed.{controller}."),
     ("[grid.{controller}]", "[fixed.{controller}]"),
     ("optimise.search.", "search.{controller}."),
@@ -537,11 +554,14 @@ def tournament_from_document(
         options["objectives"] = tuple(options["objectives"])
     if max_runs is not None:
         options["max_runs"] = max_runs
+    sets = {name: CaseSet.from_table(name, document[name]) for name in SETS}
+    named = [base_dir / s.circuit_ranges for s in sets.values() if s.circuit_ranges is not None]
+    check_circuits_table(document, source if source is not None else base_dir, named, "in [train] or [test]")
     return TournamentSpec(
         controllers=head["controllers"],
         vehicles=head["vehicles"],
-        train=CaseSet.from_table("train", document["train"]),
-        test=CaseSet.from_table("test", document["test"]),
+        train=sets["train"],
+        test=sets["test"],
         trials=head["trials"],
         search_tables=document.get("search", {}),
         fixed_tables=document.get("fixed", {}),

@@ -27,6 +27,7 @@ from workbench.apps.studies.tournament import (
     TournamentIsolationError,
     _check_isolation,
     pareto_front,
+    run_command,
     run_failure,
     run_tournament,
     spread_points,
@@ -195,6 +196,34 @@ def test_a_judged_runs_command_reproduces_it_bit_for_bit(
     for key in ROW_METRICS:
         if key not in TIMING_COLUMNS:
             assert metrics[key] == row[key] or (metrics[key] is None and pd.isna(row[key])), key
+
+
+def test_a_judged_run_on_a_circuit_under_a_sets_ranges_replays_bit_for_bit(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The command of a run on a circuit drawn within the test set's circuit_ranges names the ranges file, and
+    replays the run exactly (a circuit under the default ranges would be another path)."""
+    from workbench.apps.studies import execute_run
+
+    ranges = "[circuits]\nmin_radius_m = 12.0\nmax_radius_m = 20.0\nmax_curvature_rate_1pm2 = 0.02\n"
+    ranges += "offtracking_length_m = 0.0\nclearance_m = 14.0\nmin_length_m = 150.0\nmax_length_m = 400.0\n"
+    write_spec(tmp_path / "spec" / "circuits", ranges, "small.toml")
+    text = SPEC.replace('scenarios = ["dlc"]\nspeeds_kmh = [40]', 'scenarios = ["circuit:7"]\nspeeds_kmh = [30]')
+    spec = load_tournament(write_spec(tmp_path / "spec", text + 'circuit_ranges = "circuits/small.toml"\n'))
+    options = {"gain_per_s": 2.5}
+    (run,) = spec.plan("stanley", "test", options)
+    files = write_config_files(spec, "stanley", options, tmp_path / "best", "stanley", "a test's configuration")
+    row = execute_run(run)
+    assert row["status"] == "completed" and row["path_length_m"] < 400.0
+    words = shlex.split(run_command(run, files[run.vehicle]))
+    assert words[words.index("--circuit-ranges") + 1] == str(tmp_path / "spec" / "circuits" / "small.toml")
+    assert "--inform-delays" in words and words[words.index("--conditions") + 1] == "automotive"
+    monkeypatch.chdir(tmp_path)
+    assert main([*words[1:], "--no-plots"]) == 0
+    metrics = json.loads((tmp_path / "replay" / run.run_id / "metrics.json").read_text())
+    for key in ROW_METRICS:
+        if key not in TIMING_COLUMNS:
+            assert metrics[key] == row[key], key
 
 
 def test_the_cli_runs_a_tournament_and_prints_its_leaderboard(

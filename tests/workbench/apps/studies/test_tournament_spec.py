@@ -169,3 +169,55 @@ def test_the_cli_refuses_a_bad_spec_in_one_line(tmp_path: Path, capsys: pytest.C
     err = capsys.readouterr().err
     assert err.startswith("workbench: error: spec ") and "unknown key(s) tournament.budget" in err
     assert len(err.strip().splitlines()) == 1
+
+
+#: Small tight circuits (no trailer to make room for): 150-400 m laps of 12-20 m turns.
+SMALL_CIRCUITS = """[circuits]
+min_radius_m = 12.0
+max_radius_m = 20.0
+max_curvature_rate_1pm2 = 0.02
+offtracking_length_m = 0.0
+clearance_m = 14.0
+min_length_m = 150.0
+max_length_m = 400.0
+"""
+
+
+def test_a_set_draws_its_circuits_within_its_ranges_file(tmp_path: Path) -> None:
+    write_spec(tmp_path, SMALL_CIRCUITS, "small.toml")
+    text = SPEC.replace('scenarios = ["dlc"]', 'scenarios = ["dlc", "circuit:7"]\ncircuit_ranges = "small.toml"')
+    spec = load(tmp_path, text.replace('scenarios = ["fig17"]', 'scenarios = ["circuit:7"]'))
+    train = spec.plan("stanley", "train")
+    ranges = {r.scenario: dict(r.values).get("circuit_ranges") for r in train}
+    assert ranges == {"dlc": None, "circuit:7": tmp_path / "small.toml"}  # the set's circuits only
+    cases = [case_id(r.parameters()) for r in train]
+    assert {"circuit:7 (small.toml)|kinematic-bicycle|20|ideal|0", "dlc|kinematic-bicycle|20|ideal|0"} <= set(cases)
+    # the test set's circuit:7 is drawn within the default ranges: another circuit, another case
+    (test,) = spec.plan("stanley", "test")
+    assert "circuit_ranges" not in dict(test.values) and case_id(test.parameters()).startswith("circuit:7|")
+    same = text.replace('scenarios = ["fig17"]', 'scenarios = ["circuit:7"]\ncircuit_ranges = "small.toml"')
+    assert "case 'circuit:7 (small.toml)|kinematic-bicycle|30|ideal|0'" in refused(tmp_path, same)
+
+
+def test_a_spec_names_itself_for_its_own_circuits_table_and_an_unread_table_is_refused(tmp_path: Path) -> None:
+    text = SPEC.replace('scenarios = ["fig17"]', 'scenarios = ["circuit:7"]\ncircuit_ranges = "spec.toml"')
+    spec = load(tmp_path, text + SMALL_CIRCUITS)
+    (run,) = spec.plan("pure-pursuit", "test")
+    assert dict(run.values)["circuit_ranges"] == tmp_path / "spec.toml"
+    message = refused(tmp_path, SPEC + SMALL_CIRCUITS)
+    assert "[circuits] holds circuit ranges, read by the runs whose circuit_ranges names this spec file" in message
+    assert "give circuit_ranges = 'spec.toml' in [train] or [test]" in message
+
+
+@pytest.mark.parametrize(
+    ("ranges", "message"),
+    [
+        ('"none.toml"', "on the test set: test.circuit_ranges: circuit ranges file '"),
+        ("3", "test.circuit_ranges must be a text; got 3"),
+    ],
+)
+def test_a_sets_unusable_ranges_are_refused_naming_the_key(tmp_path: Path, ranges: str, message: str) -> None:
+    text = SPEC.replace('scenarios = ["fig17"]', f'scenarios = ["circuit:7"]\ncircuit_ranges = {ranges}')
+    assert message in refused(tmp_path, text)
+    no_circuit = SPEC.replace('scenarios = ["fig17"]', 'scenarios = ["fig17"]\ncircuit_ranges = "spec.toml"')
+    assert "test.circuit_ranges gives the ranges of generated circuits" in refused(tmp_path, no_circuit)
