@@ -433,6 +433,7 @@ FILE_OPTIONS: tuple[tuple[str, tuple[str, ...], str, tuple[str, ...]], ...] = (
     ("workbench", ("run", "compare"), "--controller-config", ("deep.toml", "not-toml.toml")),
     ("workbench", ("run", "compare", "fig17", "robustness"), "--conditions", ("deep.toml", "not-toml.toml")),
     ("workbench", ("paper", "run", "compare", "robustness"), "--track", ()),
+    ("workbench", ("run", "compare", "robustness"), "--circuit-ranges", ("deep.toml", "not-toml.toml")),
     ("tuning", ("generate-data", "fit-lag", "rollover-limits", "steering-limits", "schedule"), "--vehicle-file", ()),
     ("tuning", ("design-lead", "margins"), "--lag", ("deep.json", "not-json.json")),
     ("tuning", ("margins",), "--lead", ("deep.json", "not-json.json")),
