@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import dataclasses
 import functools
+import json
 import os
 from collections.abc import Iterable, Mapping
 from pathlib import Path
@@ -50,6 +51,17 @@ def ranges_identity(path: Path) -> dict[str, Any]:
     except OSError:
         return {CIRCUITS_TABLE: dataclasses.asdict(read_circuit_ranges(path))}  # a file gone: refused, named
     return _identity(str(Path(path).resolve()), stat.st_size, stat.st_mtime_ns)
+
+
+def drawn_ranges_key(path: Path | None) -> str:
+    """Which circuits a run's circuit_ranges file draws, as text: "" for none or for a file of the default ranges
+    (the same circuits), else the ranges it holds, so that two files of the same ranges give the same key."""
+    if path is None:
+        return ""
+    ranges = ranges_identity(path)[CIRCUITS_TABLE]
+    if ranges == dataclasses.asdict(CircuitRanges()):
+        return ""
+    return json.dumps(ranges, sort_keys=True)
 
 
 @functools.lru_cache(maxsize=64)
@@ -119,6 +131,7 @@ def check_circuits_table(document: Mapping[str, Any], spec_file: Path, named: It
 __all__ = [
     "CIRCUIT_RANGES",
     "check_circuits_table",
+    "drawn_ranges_key",
     "is_circuit",
     "planned_circuit_ranges",
     "ranged_options",

@@ -32,7 +32,7 @@ from types import MappingProxyType
 from typing import Any
 
 from controllers import CONTROLLERS
-from workbench.apps.studies.circuit_parameters import check_circuits_table
+from workbench.apps.studies.circuit_parameters import check_circuits_table, drawn_ranges_key
 from workbench.apps.studies.distributions import SEARCHABLE, Distribution
 from workbench.apps.studies.run_build import LEAD_FILTER_SCALES
 from workbench.apps.studies.spec import (
@@ -422,7 +422,10 @@ class TournamentSpec:
             raise WorkbenchInputError(_in_tournament_terms(str(exc), case_set.name, controller)) from None
 
     def _check_held_out(self, train: StudySpec, test: StudySpec) -> None:
-        both = sorted({case_id(r.parameters()) for r in train.plan()} & {case_id(r.parameters()) for r in test.plan()})
+        """Refuse a case in both sets: compared with a circuit's ranges file as the circuits it draws, so that one
+        circuit under two files of the same ranges (or a file of the default ranges) is one case."""
+        trained = {_held_out_key(r): case_id(r.parameters()) for r in train.plan()}
+        both = sorted(trained[key] for key in {_held_out_key(r) for r in test.plan()} & set(trained))
         if both:
             raise WorkbenchInputError(
                 f"case {both[0]!r} (scenario|vehicle|speed|conditions|seed) is in both the train and the test set"
@@ -490,6 +493,14 @@ class TournamentSpec:
             return "no controller in the tournament has a solve budget"
         budgets = ", ".join(f"{c} {self.fixed[c][SOLVE_BUDGET_OPTION]:g} s" for c in mpcs)
         return f"{SOLVE_BUDGET_OPTION}: {budgets} (never reached, so no solve is cut short and runs reproduce)"
+
+
+def _held_out_key(run: PlannedRun) -> str:
+    """A run's case as the held-out check compares it: its case id without the ranges file's name, with the
+    circuits that file draws (`circuit_parameters.drawn_ranges_key`)."""
+    parameters = run.parameters()
+    ranges = parameters.pop("circuit_ranges", None)
+    return f"{case_id(parameters)}|{drawn_ranges_key(None if ranges is None else Path(ranges))}"
 
 
 _TERMS = (

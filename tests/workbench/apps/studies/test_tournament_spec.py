@@ -221,3 +221,19 @@ def test_a_sets_unusable_ranges_are_refused_naming_the_key(tmp_path: Path, range
     assert message in refused(tmp_path, text)
     no_circuit = SPEC.replace('scenarios = ["fig17"]', 'scenarios = ["fig17"]\ncircuit_ranges = "spec.toml"')
     assert "test.circuit_ranges gives the ranges of generated circuits" in refused(tmp_path, no_circuit)
+
+
+def test_one_circuit_named_through_two_files_of_the_same_ranges_is_one_case(tmp_path: Path) -> None:
+    from workbench.simulation.circuit_ranges import circuit_ranges_toml
+
+    write_spec(tmp_path, SMALL_CIRCUITS, "small.toml")
+    write_spec(tmp_path, "# a copy\n" + SMALL_CIRCUITS, "copy.toml")
+    write_spec(tmp_path, circuit_ranges_toml(), "defaults.toml")
+    head = '[tournament]\ncontrollers = ["stanley"]\nvehicles = ["kinematic-bicycle"]\ntrials = 2\n'
+    circuit = 'scenarios = ["circuit:7"]\nspeeds_kmh = [30]\n'
+    for train, test, shown in (
+        ('circuit_ranges = "small.toml"\n', 'circuit_ranges = "copy.toml"\n', "circuit:7 (small.toml)"),
+        ("", 'circuit_ranges = "defaults.toml"\n', "circuit:7"),
+    ):
+        text = f"{head}[train]\n{circuit}{train}[test]\n{circuit}{test}"
+        assert f"case '{shown}|kinematic-bicycle|30|ideal|0'" in refused(tmp_path, text)
