@@ -40,7 +40,7 @@ from workbench.base.errors import WorkbenchInputError
 from workbench.simulation.feasibility import refuse_infeasible
 from workbench.simulation.known_delays import KnownDelays
 from workbench.simulation.limit_cycle import LimitCycle, detect_limit_cycle
-from workbench.simulation.metrics import METRIC_KEYS
+from workbench.simulation.metrics import CONVERGED_CTE_M, METRIC_KEYS, approach_end
 from workbench.simulation.plots import RunStyle, Stretch, run_styles
 from workbench.simulation.result import SimulationResult
 from workbench.simulation.run_size import check_run_size
@@ -53,8 +53,6 @@ if TYPE_CHECKING:
 
     from workbench.vehicles.base import VehicleModel
 
-#: |CTE| (m) within which a run counts as converged onto the path (the fig17 scenario starts 1 m off it).
-CONVERGED_CTE_M = 0.1
 #: The stretch the trajectories' inset magnifies (`hardest_stretch`) reaches this many times the largest |CTE| either
 #: side of it along the path, and at least ZOOM_MIN_HALF_LENGTH_M (m): the runs' spread then shows at the inset's
 #: scale.
@@ -123,13 +121,6 @@ def converge_distance_m(progress_m: np.ndarray, cte_m: np.ndarray, tolerance_m: 
     if last + 1 >= cte_m.size:
         return math.nan
     return float(progress_m[last + 1] - progress_m[0])
-
-
-def approach_end(cte_m: np.ndarray, tolerance_m: float = CONVERGED_CTE_M) -> int:
-    """Index of the first sample with |CTE| within tolerance_m: where a run that started off the path has come
-    onto it (0 for one that started on it; also 0 when it never comes within, so that the whole run counts)."""
-    within = np.flatnonzero(np.abs(cte_m) <= tolerance_m)
-    return int(within[0]) if within.size else 0
 
 
 def step_time_ratios(table: pd.DataFrame, reference_controller: str | None) -> list[float]:

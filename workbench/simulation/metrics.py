@@ -1,7 +1,8 @@
 """Run metrics: the numbers in metrics.json. Other tools read these keys, so they are stable.
 
 CTE is measured at the reference point (the tractor's rear-axle centre), signed, left of the path positive, at
-every logged (controller) step. Vehicle fields (max_ltr, max_offtracking_m) are null for vehicles that do not
+every logged (controller) step; max_abs_cte_on_path_m leaves out the approach of a run started off the path
+(`approach_end`). Vehicle fields (max_ltr, max_offtracking_m) are null for vehicles that do not
 output them; the track fields (min_track_margin_m, left_track) are null when the path has no track widths or the
 vehicle's outline is not known (`track_margin.py`).
 """
@@ -18,6 +19,10 @@ from workbench.simulation.limit_cycle import detect_limit_cycle, oscillation
 from workbench.simulation.speed_profile import G_MPS2
 from workbench.simulation.track_margin import VehicleOutline, track_margins, trailer_feet
 
+#: A run is on the path once its |CTE| is within this (m): where a run started off it has come onto it
+#: (`approach_end`), and the band comparisons call converged.
+CONVERGED_CTE_M = 0.1
+
 #: The keys of metrics.json, in order.
 METRIC_KEYS: tuple[str, ...] = (
     "scenario",
@@ -27,6 +32,7 @@ METRIC_KEYS: tuple[str, ...] = (
     "distance_m",
     "path_length_m",
     "max_abs_cte_m",
+    "max_abs_cte_on_path_m",
     "rms_cte_m",
     "max_abs_heading_error_deg",
     "max_abs_steer_wheel_deg",
@@ -51,7 +57,10 @@ class Metrics:
     """Summary of one run; None where a quantity does not apply (no samples, no trailer, no roll model).
 
     distance_m: distance travelled by the reference point; path_length_m: the length the run was asked to cover
-    (the path, times the laps of a closed path); max_abs_steer_rate_deg_s, rms_steer_rate_deg_s: the largest and the
+    (the path, times the laps of a closed path); max_abs_cte_on_path_m: the max |CTE| from the first sample within
+    CONVERGED_CTE_M of the path (`approach_end`): max_abs_cte_m itself for a run that starts on the path, and for
+    one started off it (fig17's 1 m) its tracking once it has come onto the path, overshoot included, without the
+    start every controller shares; max_abs_steer_rate_deg_s, rms_steer_rate_deg_s: the largest and the
     RMS steering-wheel rate (the steering effort), from the measured steering-wheel angle differenced at the
     controller rate; steer_oscillation_deg: the RMS of the measured steering-wheel angle about its centred 1 s moving
     average, away from the trace's ends (`limit_cycle.oscillation`; None for a trace under about 2 s);
@@ -70,6 +79,7 @@ class Metrics:
     distance_m: float
     path_length_m: float
     max_abs_cte_m: float | None
+    max_abs_cte_on_path_m: float | None
     rms_cte_m: float | None
     max_abs_heading_error_deg: float | None
     max_abs_steer_wheel_deg: float | None
@@ -89,6 +99,13 @@ class Metrics:
 
     def to_dict(self) -> dict[str, object]:
         return asdict(self)
+
+
+def approach_end(cte_m: np.ndarray, tolerance_m: float = CONVERGED_CTE_M) -> int:
+    """Index of the first sample with |CTE| within tolerance_m: where a run that started off the path has come
+    onto it (0 for one that started on it; also 0 when it never comes within, so that the whole run counts)."""
+    within = np.flatnonzero(np.abs(cte_m) <= tolerance_m)
+    return int(within[0]) if within.size else 0
 
 
 def _max_abs(values: np.ndarray | None, scale: float = 1.0) -> float | None:
@@ -141,6 +158,7 @@ def compute_metrics(
         distance_m=distance,
         path_length_m=float(path_length_m),
         max_abs_cte_m=_max_abs(cte),
+        max_abs_cte_on_path_m=_max_abs(cte[approach_end(cte) :]),
         rms_cte_m=float(math.sqrt(np.mean(cte**2))) if n else None,
         max_abs_heading_error_deg=_max_abs(trace["heading_error_rad"], 180.0 / math.pi),
         max_abs_steer_wheel_deg=_max_abs(steer, 180.0 / math.pi),

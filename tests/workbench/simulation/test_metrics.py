@@ -78,11 +78,28 @@ def test_keys_are_the_stable_metrics_json_names() -> None:
     assert tuple(_metrics(_straight_trace()).to_dict()) == METRIC_KEYS
     assert METRIC_KEYS == (
         "scenario", "controller", "vehicle", "completed", "distance_m", "path_length_m", "max_abs_cte_m",
-        "rms_cte_m", "max_abs_heading_error_deg", "max_abs_steer_wheel_deg", "max_abs_steer_rate_deg_s",
+        "max_abs_cte_on_path_m", "rms_cte_m", "max_abs_heading_error_deg", "max_abs_steer_wheel_deg",
+        "max_abs_steer_rate_deg_s",
         "rms_steer_rate_deg_s", "steer_oscillation_deg", "limit_cycle", "limit_cycle_hz", "limit_cycle_amplitude_deg",
         "max_abs_lat_accel_g", "max_ltr", "max_offtracking_m", "step_time_median_us", "step_time_p99_us",
         "min_track_margin_m", "left_track",
     )  # fmt: skip
+
+
+def test_max_cte_on_path_leaves_out_the_approach_of_a_run_started_off_the_path() -> None:
+    trace = _straight_trace()
+    assert _metrics(trace).max_abs_cte_on_path_m == _metrics(trace).max_abs_cte_m == pytest.approx(0.5)
+    # started 1 m off: approaching until the first sample within CONVERGED_CTE_M, then an overshoot of 0.25 m
+    n = trace["t_s"].size
+    cte = np.concatenate([np.linspace(1.0, 0.12, 20), [0.05], -0.25 * np.sin(np.linspace(0.0, np.pi, n - 21))])
+    trace["cte_m"] = cte
+    m = _metrics(trace)
+    assert m.max_abs_cte_m == pytest.approx(1.0)
+    assert m.max_abs_cte_on_path_m == pytest.approx(np.max(np.abs(cte[20:])), rel=1e-12)
+    assert m.max_abs_cte_on_path_m == pytest.approx(0.25, rel=1e-3)
+    # one that never comes within the band is measured whole
+    trace["cte_m"] = np.linspace(1.0, 0.5, n)
+    assert _metrics(trace).max_abs_cte_on_path_m == pytest.approx(1.0)
 
 
 def test_empty_trace_gives_nulls_not_nan() -> None:
@@ -91,6 +108,7 @@ def test_empty_trace_gives_nulls_not_nan() -> None:
     assert m.distance_m == 0.0
     for key in (
         "max_abs_cte_m",
+        "max_abs_cte_on_path_m",
         "rms_cte_m",
         "max_abs_steer_rate_deg_s",
         "rms_steer_rate_deg_s",

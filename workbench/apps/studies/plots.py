@@ -18,6 +18,7 @@ if TYPE_CHECKING:
 LABELS = {
     "rms_cte_m": "RMS CTE (m)",
     "max_abs_cte_m": "max |CTE| (m)",
+    "max_abs_cte_on_path_m": "max |CTE| once on the path (m)",
     "rms_steer_rate_deg_s": "RMS steering-wheel rate (deg/s)",
     "max_abs_steer_rate_deg_s": "max |steering-wheel rate| (deg/s)",
     "steer_oscillation_deg": "steering-wheel oscillation, RMS about its 1 s average (deg)",

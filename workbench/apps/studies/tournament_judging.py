@@ -8,7 +8,7 @@ each with its case (the same text for the same scenario, vehicle, speed, conditi
 and the trial whose options it used. Every statistic works per case: a case's runs (one, as a tournament plans
 them) are averaged first, so that each case weighs alike.
 
-- The ranking scalar of a run: the weighted sum of the ranking metrics (`ranking`, e.g. max_abs_cte_m + 0.002 x
+- The ranking scalar of a run: the weighted sum of the ranking metrics (`ranking`, e.g. max_abs_cte_on_path_m + 0.002 x
   rms_steer_rate_deg_s); a failed run (did not complete, left the track, limit-cycled) scores `failure_score`.
   The objective metrics are averaged over the runs that did not fail; the fraction that failed is given beside.
 - Intervals: the percentile bootstrap of the mean over cases (`bootstrap_mean`): the cases are drawn with

@@ -62,6 +62,8 @@ EFFORT = "rms_steer_rate_deg_s"
 WIDE_FIGURE_IN = (12.0, 4.5)
 TRACES_FIGURE_IN = (8.0, 11.0)
 SCORE_LABEL = "ranking score (lower is better)"
+#: The tracking metrics a front may be drawn with, the preferred first.
+TRACKING_METRICS = ("max_abs_cte_on_path_m", "max_abs_cte_m", "rms_cte_m")
 _PERCENT = f"{CONFIDENCE:.0%}"
 
 
@@ -75,11 +77,11 @@ def _new_axes(size: tuple[float, float] = plots.FIGURE_SIZE_IN, panels: int = 1,
 
 def front_metrics(objectives: Sequence[str], ranking: Mapping[str, float]) -> tuple[str, str]:
     """(effort, error): the objectives the fronts are drawn with. Effort: the RMS steering rate when it is an
-    objective, else the last objective; error: of max |CTE| and RMS CTE the one the ranking weighs (max |CTE| first)
-    when it is an objective, else the other, else the first objective."""
+    objective, else the last objective; error: of the TRACKING_METRICS the first the ranking weighs when it is an
+    objective, else the first that is one, else the first objective."""
     effort = EFFORT if EFFORT in objectives else objectives[-1]
-    weighed = [m for m in ("max_abs_cte_m", "rms_cte_m") if m in ranking]
-    preferred = [*weighed, "max_abs_cte_m", "rms_cte_m"]
+    weighed = [m for m in TRACKING_METRICS if m in ranking]
+    preferred = [*weighed, *TRACKING_METRICS]
     error = next((m for m in preferred if m in objectives and m != effort), objectives[0])
     return effort, error
 
@@ -89,7 +91,7 @@ def _label(metric: str) -> str:
 
 
 def training_front(
-    history: pd.DataFrame, controller: str, ax: Axes, error: str = "max_abs_cte_m", effort: str = EFFORT
+    history: pd.DataFrame, controller: str, ax: Axes, error: str = "max_abs_cte_on_path_m", effort: str = EFFORT
 ) -> Axes:
     """The controller's trials on the training cases (the history's train_ means of `error` against `effort`):
     every trial, the points of its front (over every objective: with more than two, a front point may look beaten
@@ -128,7 +130,7 @@ def _mark(ax: Axes, rows: pd.DataFrame, x: str, y: str, marker: str, label: str)
 
 
 def judged_points(
-    scores: pd.DataFrame, controller: str, ax: Axes, error: str = "max_abs_cte_m", effort: str = EFFORT
+    scores: pd.DataFrame, controller: str, ax: Axes, error: str = "max_abs_cte_on_path_m", effort: str = EFFORT
 ) -> Axes:
     """The controller's judged configurations on the test cases: mean `error` against mean `effort`, with their
     intervals as error bars: the default, the tuned configuration and the carried front points (F1..)."""
@@ -274,9 +276,7 @@ def _leaderboard_section(summary: TournamentSummary, judgement: Judgement) -> li
                 f"tuned score [{_PERCENT}]": _interval_text(row.score, row.score_low, row.score_high),
                 f"default score [{_PERCENT}]": _interval_text(row.default_score, row.default_low, row.default_high),
                 "failed runs": f"{row.failed_fraction:.0%}",
-                "max |CTE| (m)": getattr(row, "max_abs_cte_m", np.nan),
-                "RMS CTE (m)": getattr(row, "rms_cte_m", np.nan),
-                "RMS steering rate (deg/s)": getattr(row, "rms_steer_rate_deg_s", np.nan),
+                **{_label(m): getattr(row, m) for m in (*TRACKING_METRICS, EFFORT) if m in board.columns},
                 "step median (µs)": row.step_time_median_us,
                 "step p99 (µs)": row.step_time_p99_us,
                 "CPU time, training (s)": row.cpu_time_s,

@@ -9,7 +9,7 @@ import dataclasses
 import numpy as np
 import pandas as pd
 import pytest
-from judging_frames import FAILURE_SCORE, RANKING, Run, case_id, results_frame, summary
+from judging_frames import FAILURE_SCORE, OBJECTIVES, RANKING, Run, case_id, results_frame, summary
 from scipy import stats
 
 from workbench.apps.studies.tournament_judging import (
@@ -47,7 +47,7 @@ def _tournament(margins: dict[str, float], failed: frozenset[tuple[str, str, int
 
 
 def _judge(results: pd.DataFrame, seed: int = 3, resamples: int = 2000) -> Judgement:
-    return judge(results, RANKING, seed, resamples, failure_score=FAILURE_SCORE)
+    return judge(results, RANKING, seed, resamples, failure_score=FAILURE_SCORE, objectives=OBJECTIVES)
 
 
 def test_the_bootstrap_interval_of_a_normal_sample_s_mean_is_the_t_interval() -> None:
@@ -208,7 +208,8 @@ def test_malformed_results_are_refused(change, message: str) -> None:
     ],
 )
 def test_bad_settings_are_refused(kwargs: dict, message: str) -> None:
-    settings = {"ranking": RANKING, "seed": 1, "resamples": 200, "failure_score": FAILURE_SCORE} | kwargs
+    settings = {"ranking": RANKING, "seed": 1, "resamples": 200, "failure_score": FAILURE_SCORE}
+    settings |= {"objectives": OBJECTIVES} | kwargs
     with pytest.raises(WorkbenchInputError, match=message):
         judge(_tournament({"clothoid": 0.0}), **settings)
 

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import matplotlib
 import pytest
-from judging_frames import FAILURE_SCORE, RANKING, Run, history_frame, results_frame, summary
+from judging_frames import FAILURE_SCORE, OBJECTIVES, RANKING, Run, history_frame, results_frame, summary
 
 from workbench.apps.studies.tournament_judging import judge
 from workbench.apps.studies.tournament_report import SECTIONS, front_metrics, training_front, write_report
@@ -117,7 +117,7 @@ class _Page(HTMLParser):
 def tournament() -> tuple:
     results = results_frame(_runs())
     history = history_frame(results, chosen=dict.fromkeys(CONTROLLERS, 2), carried={"pure-pursuit": {3: 1, 1: 2}})
-    judgement = judge(results, RANKING, 3, 500, failure_score=FAILURE_SCORE)
+    judgement = judge(results, RANKING, 3, 500, failure_score=FAILURE_SCORE, objectives=OBJECTIVES)
     return results, history, judgement
 
 
@@ -198,7 +198,7 @@ def test_the_training_front_marks_the_default_the_chosen_and_the_carried_points(
     from matplotlib.figure import Figure
 
     ax = Figure().add_subplot()
-    assert training_front(tournament[1], "pure-pursuit", ax) is ax
+    assert training_front(tournament[1], "pure-pursuit", ax, error="max_abs_cte_m") is ax
     labels = ax.get_legend_handles_labels()[1]
     for label in ("trials", "failed trials", "front", "default (trial 0)", "chosen (tuned)", "carried to the test set"):
         assert label in labels
@@ -210,7 +210,9 @@ def test_the_training_front_marks_the_default_the_chosen_and_the_carried_points(
 @pytest.mark.parametrize(
     ("objectives", "ranking", "expected"),
     [
-        (DEFAULT_OBJECTIVES, RANKING, ("rms_steer_rate_deg_s", "max_abs_cte_m")),
+        (DEFAULT_OBJECTIVES, RANKING, ("rms_steer_rate_deg_s", "max_abs_cte_on_path_m")),
+        (DEFAULT_OBJECTIVES, {"max_abs_cte_on_path_m": 1.0}, ("rms_steer_rate_deg_s", "max_abs_cte_on_path_m")),
+        (OBJECTIVES, RANKING, ("rms_steer_rate_deg_s", "max_abs_cte_m")),
         (DEFAULT_OBJECTIVES, {"rms_cte_m": 1.0}, ("rms_steer_rate_deg_s", "rms_cte_m")),
         (("rms_cte_m", "max_abs_steer_rate_deg_s"), RANKING, ("max_abs_steer_rate_deg_s", "rms_cte_m")),
     ],

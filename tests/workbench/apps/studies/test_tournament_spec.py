@@ -110,7 +110,7 @@ softening_mps = 2.0
         ),
         (
             ("trials = 3", "trials = 3\nselection = {max_ltr = 1.0}"),
-            "unknown metric tournament.selection.max_ltr; allowed: rms_cte_m, max_abs_cte_m, rms_steer_rate_deg_s",
+            "unknown metric tournament.selection.max_ltr; allowed: rms_cte_m, max_abs_cte_on_path_m, rms_steer_rate_deg_s",
         ),
         (
             ("trials = 3", "trials = 3\nranking = {max_abs_cte_m = -1.0}"),
