@@ -20,7 +20,7 @@ from controllers import CONTROLLERS
 from tuning.own_tuning import tuning_for
 from workbench.apps.cli import main
 from workbench.apps.controller_config import read_controller_config
-from workbench.apps.studies import TIMING_COLUMNS, LocalBackend, PlannedRun
+from workbench.apps.studies import TIMING_COLUMNS, DaskBackend, LocalBackend, PlannedRun
 from workbench.apps.studies.backends import BackendError
 from workbench.apps.studies.runner import ROW_METRICS
 from workbench.apps.studies.tournament import (
@@ -304,9 +304,11 @@ def test_a_configuration_scaled_from_each_vehicles_filter_gets_a_file_per_vehicl
     assert set(plain.values()) == {(tmp_path / "plain" / "clothoid.toml").resolve()}
 
 
-def test_a_pool_of_two_workers_gives_the_same_tournament(tournament: dict[str, Any]) -> None:
-    out = tournament["folder"] / "pool"
-    pooled = run_tournament(tournament["spec"], out, LocalBackend(workers=2), report=False, log=None)
+@pytest.mark.parametrize("backend", ["local", "dask"])
+def test_two_workers_on_either_backend_give_the_same_tournament(tournament: dict[str, Any], backend: str) -> None:
+    out = tournament["folder"] / backend
+    workers = LocalBackend(workers=2) if backend == "local" else DaskBackend(workers=2)
+    pooled = run_tournament(tournament["spec"], out, workers, report=False, log=None)
     whole = tournament["whole"]
     pd.testing.assert_frame_equal(
         comparable(pooled.results, out), comparable(whole.results, tournament["folder"] / "whole"), check_exact=True
