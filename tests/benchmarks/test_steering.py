@@ -149,3 +149,25 @@ def test_no_held_out_leaves_them_out_of_the_run_and_of_the_goals(steering, monke
     text = capsys.readouterr().out
     assert "| tractor-semitrailer | ideal | held-out | 20 | 0 | 1.40 | 1.40 | 100 | 0 |" in text
     assert "median max |CTE| ratio over the held-out circuits: 1.4 (bound 1.3) MISSED" in text
+
+
+def test_a_circuit_the_feasibility_check_refuses_is_reported_excluded(steering, monkeypatch, tmp_path, capsys) -> None:
+    reason = "circuit:1003: the vehicle cannot follow it at 30 km/h (constructed)"
+    fake = _fake_runs(steering, 1.0)
+
+    def run_all(jobs, workers):
+        runs = fake(jobs, workers)
+        for r in runs:
+            if r.scenario == "circuit:1003":
+                r.status, r.max_abs_cte_m, r.excluded_reason = "excluded", math.nan, reason
+        return runs
+
+    monkeypatch.setattr(steering, "run_all", run_all)
+    out = tmp_path / "s.json"
+    argv = ["--quick", "--vehicles", "dynamic-bicycle", "--conditions", "ideal", "--scenarios", "development"]
+    assert steering.main([*argv, "--out", str(out), "--check"]) == 0
+    document = json.loads(out.read_text())
+    assert [r["scenario"] for r in document["excluded"]] == ["circuit:1003"]
+    (row,) = document["summary"]
+    assert (row["runs"], row["excluded"], row["goals_missed"]) == (3, 1, 0)
+    assert f"dynamic-bicycle ideal circuit:1003: {reason}" in capsys.readouterr().out
