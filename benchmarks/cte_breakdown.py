@@ -1,0 +1,366 @@
+"""Where the clothoid controller's cross-track error comes from: one factor switched at a time, in simulation and in
+the loop analysis, on the loaded truck and the dynamic-bicycle car, against the NMPC on the same runs.
+
+Switches (each against `nominal`, the shipped defaults on the preset vehicle):
+  - no_actuator_lag: the plant's steering actuator without its first-order lag (time constant 1 ms instead of the
+    preset's 0.1 s truck / 0.05 s car); the rest of the steering-to-curvature lag (tyre relaxation, yaw and
+    sideslip dynamics) stays;
+  - stiff_tyres: the plant's cornering coefficients at the top of their allowed range (truck 30 /rad, about 6 x;
+    car 60 /rad, about 2.7 x) and a 0.05 m relaxation length: much less tyre slip and sideslip, in braking
+    and cornering alike;
+  - constant_speed: the speed profile's lateral bound lifted (2 g), so every run is at 30 km/h throughout: no
+    braking or accelerating anywhere (corners are then taken faster than the profile's 0.3 g);
+  - floor_lowered: the lookahead floor keeps 30 deg / 3 dB instead of 45 deg / 6 dB;
+  - floor_off: no floor (the paper's 5 m lower end; margins not kept);
+  - feedforward_off: Eq. 3 alone (`path_feedforward=false`).
+  - ideal_plant: no_actuator_lag + stiff_tyres + constant_speed together (what the controller's geometry and floor
+    leave).
+Both controllers are built for the vehicle they drive: the clothoid controller with that plant's own tuning (its lags
+identified, its lead filter designed and its floor computed by the tuning chain; about a minute per switched plant
+the first time, cached after: `tuning/own_tuning.py`), the NMPC with that plant's model. So a plant switch shows what
+the factor costs a controller designed for it, not a model mismatch. The NMPC runs every plant and speed switch too;
+a controller switch is compared with the nominal NMPC run.
+
+Loop analysis (30 km/h, `controllers/clothoid/loop_analysis.py`, about a straight): the floor, the margins at it and
+the closed-loop bandwidth (|T| = |L / (1 + L)| falling to -3 dB, the loop broken at the steering sent) with the
+identified lags and the lead filter of each switched plant's own tuning (no actuator lag, stiff tyres, both), and
+with the nominal lags altered: the measured curvature without the sideslip's lead (the measured lag = the path
+lag), no understeer (K = 1), the speed bands a braking truck passes (20 and 25 km/h), the floor lowered or off.
+The feed-forward does not enter the loop (its term depends on the path only), so it changes nothing there.
+
+Prints the tables and writes benchmarks/results/cte_breakdown.json and one figure per vehicle
+(benchmarks/results/cte_breakdown_<vehicle>.png: |CTE| against distance for each switch on the worst case, with the
+path curvature and the longitudinal acceleration beneath). About 2-4 minutes on 2 cores.
+
+    python benchmarks/cte_breakdown.py [--out benchmarks/results/cte_breakdown.json] [--vehicles a,b]
+        [--scenarios dlc,figure8,circuit:1000,...] [--workers 2] [--no-automotive] [--figures-dir DIR]
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import json
+import math
+import os
+import sys
+import time
+from concurrent.futures import ProcessPoolExecutor
+from dataclasses import asdict, dataclass
+from pathlib import Path
+
+import numpy as np
+
+from tuning.own_tuning import tuned_controller
+from workbench.simulation.conditions import CONDITIONS
+from workbench.simulation.known_delays import KnownDelays
+from workbench.simulation.scenarios import ScenarioOptions, make_scenario
+from workbench.simulation.simulator import Simulation, SimulationConfig
+from workbench.vehicles import make_vehicle
+
+VEHICLES = ("tractor-semitrailer", "dynamic-bicycle")
+#: dlc, figure8 and four circuits of the development set (seeds below 9000 only: 9000 and up are held out).
+SCENARIOS = ("dlc", "figure8", "circuit:1000", "circuit:1001", "circuit:1002", "circuit:1003")
+AUTOMOTIVE_SCENARIOS = ("dlc", "figure8")
+#: Generated circuits from this seed up are the held-out set (`benchmarks/steering.py`): refused here.
+HELD_OUT_FIRST_SEED = 9000
+SPEED_KMH = 30.0
+#: switch -> (plant changes, run-config changes, clothoid config changes).
+PLANT_SWITCHES = ("no_actuator_lag", "stiff_tyres", "constant_speed", "ideal_plant")
+CONTROLLER_SWITCHES = ("floor_lowered", "floor_off", "feedforward_off")
+SWITCHES = ("nominal", *PLANT_SWITCHES, *CONTROLLER_SWITCHES)
+#: The plant's actuator time constant (s) with its lag switched off (the smallest the presets allow).
+NO_LAG_TIME_CONSTANT_S = 1e-3
+#: Stiff tyres: cornering coefficients (1/rad) at the top of each model's allowed range, relaxation length (m).
+STIFF_CORNERING_PER_RAD = {"tractor-semitrailer": 30.0, "dynamic-bicycle": 60.0}
+STIFF_RELAXATION_M = 0.05
+#: The profile's lateral bound (g) that leaves the speed at SPEED_KMH everywhere.
+CONSTANT_SPEED_LATERAL_G = 2.0
+#: Longitudinal acceleration is smoothed over this many controller samples (0.1 s) before it is read.
+ACCEL_SMOOTHING_SAMPLES = 5
+
+
+def plant_for(vehicle_name: str, switch: str):
+    """The vehicle the run drives: the preset, or the preset with the switch's plant changes."""
+    vehicle = make_vehicle(vehicle_name)
+    changes: dict[str, float] = {}
+    if switch in ("no_actuator_lag", "ideal_plant"):
+        changes["steering_time_constant_s"] = NO_LAG_TIME_CONSTANT_S
+    if switch in ("stiff_tyres", "ideal_plant"):
+        stiff = STIFF_CORNERING_PER_RAD[vehicle_name]
+        names = [f"{axle}_cornering_coeff_per_rad" for axle in ("front", "rear", "drive", "trailer")]
+        changes |= {name: stiff for name in names if hasattr(vehicle.params, name)}
+        changes["relaxation_length_m"] = STIFF_RELAXATION_M
+    if not changes:
+        return vehicle
+    return type(vehicle)(dataclasses.replace(vehicle.params, **changes))
+
+
+def clothoid_config_for(switch: str, config):
+    if switch == "floor_lowered":
+        return dataclasses.replace(config, min_phase_margin_deg=30.0, min_gain_margin_db=3.0)
+    if switch == "floor_off":
+        return dataclasses.replace(config, min_phase_margin_deg=0.0, min_gain_margin_db=0.0)
+    if switch == "feedforward_off":
+        return dataclasses.replace(config, path_feedforward=False)
+    return config
+
+
+@dataclass
+class Run:
+    vehicle: str
+    scenario: str
+    switch: str
+    controller: str
+    conditions: str
+    status: str
+    max_abs_cte_m: float
+    rms_cte_m: float
+    s_at_max_m: float
+    curvature_at_max_1pm: float
+    long_accel_at_max_mps2: float
+    speed_at_max_mps: float
+    peak_lat_accel_g: float
+    steer_oscillation_deg: float
+    rms_steer_rate_deg_s: float
+    limit_cycle: bool
+    mean_lookahead_m: float
+    wall_s: float
+
+
+def run_one(job: tuple[str, str, str, str, str]) -> tuple[Run, dict[str, list[float]]]:
+    vehicle_name, scenario_name, switch, controller_name, conditions = job
+    plant = plant_for(vehicle_name, switch)
+    scenario = make_scenario(scenario_name, ScenarioOptions(plant.geometry.width_m, None))
+    cfg = SimulationConfig(
+        speed_kmh=SPEED_KMH,
+        max_lateral_accel_g=CONSTANT_SPEED_LATERAL_G if switch in ("constant_speed", "ideal_plant") else 0.3,
+        conditions=CONDITIONS[conditions],
+        inform_delays=conditions != "ideal",
+    )
+    delays = KnownDelays.from_conditions(cfg.conditions) if cfg.inform_delays else None
+    controller = tuned_controller(controller_name, plant, delays=delays)
+    if controller_name == "clothoid" and switch in CONTROLLER_SWITCHES:
+        from controllers import make_controller
+
+        config = clothoid_config_for(switch, controller.config)
+        controller = make_controller("clothoid", plant.geometry, config, vehicle=plant)
+    start = time.perf_counter()
+    result = Simulation(scenario, plant, controller, cfg).run()
+    m, tr = result.metrics, result.trace
+    cte = np.asarray(tr["cte_m"], dtype=float)
+    s = np.asarray(tr["progress_m"], dtype=float)
+    t = np.asarray(tr["t_s"], dtype=float)
+    v = np.asarray(tr["speed_mps"], dtype=float)
+    kernel = np.ones(ACCEL_SMOOTHING_SAMPLES) / ACCEL_SMOOTHING_SAMPLES
+    accel = np.convolve(np.gradient(v, t), kernel, mode="same")
+    kappa = np.asarray(tr["path_curvature_1pm"], dtype=float)
+    i = int(np.nanargmax(np.abs(cte)))
+    lookahead = np.asarray(tr["ctrl_lookahead_m"], dtype=float) if "ctrl_lookahead_m" in tr else np.array([math.nan])
+    run = Run(
+        vehicle_name, scenario_name, switch, controller_name, conditions, result.status.value,
+        float(np.nanmax(np.abs(cte))), float(np.sqrt(np.nanmean(cte**2))), float(s[i]), float(kappa[i]),
+        float(accel[i]), float(v[i]), float(np.nanmax(np.abs(v**2 * kappa)) / 9.80665),
+        m.steer_oscillation_deg or math.nan, m.rms_steer_rate_deg_s or math.nan, bool(m.limit_cycle),
+        float(np.nanmean(lookahead[lookahead > 0])) if np.any(lookahead > 0) else math.nan,
+        time.perf_counter() - start,
+    )  # fmt: skip
+    step = max(1, len(s) // 2000)
+    trace = {k: a[::step].tolist() for k, a in (("s", s), ("cte", cte), ("kappa", kappa), ("accel", accel))}
+    return run, trace
+
+
+def jobs_for(vehicles: list[str], scenarios: list[str], automotive: bool) -> list[tuple[str, str, str, str, str]]:
+    out = []
+    for conditions, names in (("ideal", scenarios), ("automotive", AUTOMOTIVE_SCENARIOS if automotive else ())):
+        for v in vehicles:
+            for sc in names:
+                for sw in SWITCHES:
+                    out.append((v, sc, sw, "clothoid", conditions))
+                    if sw == "nominal" or sw in PLANT_SWITCHES:
+                        out.append((v, sc, sw, "nmpc", conditions))
+    return out
+
+
+def loop_rows(vehicle_name: str) -> list[dict[str, object]]:
+    """The loop analysis at SPEED_KMH, each switched plant with its own tuning, and each factor taken out of the
+    nominal identified lags (module docstring)."""
+    from controllers.clothoid import loop_analysis as la
+
+    def built(switch: str):
+        vehicle = plant_for(vehicle_name, switch)
+        controller = tuned_controller("clothoid", vehicle)
+        controller.reset(make_scenario("dlc", ScenarioOptions(vehicle.geometry.width_m, None)).path, 0.02)
+        return controller
+
+    def unit_gain(lag):
+        return dataclasses.replace(lag, steady_state_gain=1.0)
+
+    controller = built("nominal")
+    nominal = controller.plant_lags(SPEED_KMH)
+    own = {sw: built(sw) for sw in ("no_actuator_lag", "stiff_tyres", "ideal_plant")}
+    cases = [
+        ("nominal", controller, nominal, SPEED_KMH, 45.0, 6.0, None),
+        *((f"{sw} (its own lags and lead)", c, c.plant_lags(SPEED_KMH), SPEED_KMH, 45.0, 6.0, None)
+          for sw, c in own.items()),
+        ("no sideslip lead (measured = path lag)", controller, la.PlantLags(nominal.path, None), SPEED_KMH, 45.0,
+         6.0, None),
+        ("no understeer (K = 1)", controller, la.PlantLags(unit_gain(nominal.path), unit_gain(nominal.measured)),
+         SPEED_KMH, 45.0, 6.0, None),
+        ("25 km/h (braking)", controller, controller.plant_lags(25.0), 25.0, 45.0, 6.0, None),
+        ("20 km/h (braking)", controller, controller.plant_lags(20.0), 20.0, 45.0, 6.0, None),
+        ("floor lowered (30 deg / 3 dB)", controller, nominal, SPEED_KMH, 30.0, 3.0, None),
+        ("floor off (5 m)", controller, nominal, SPEED_KMH, 0.0, 0.0, 5.0),
+    ]  # fmt: skip
+    rows = []
+    for name, controller, lags, speed_kmh, pm, gm, fixed in cases:
+        settings = controller.loop_settings(speed_kmh)
+        v = speed_kmh / 3.6
+        arc = min(controller.limits.at_speed(v)[0], 0.4 * 9.80665 / v**2)
+        floor = fixed or la.lookahead_floor(lags, settings, v, 5.0, 40.0, 0.5, (0.0, arc), pm, gm)
+        mg = la.loop_margins(lags, settings, v, floor)
+        loop = la.loop_transfer(lags, settings, v, floor)
+        omega = np.logspace(-2, math.log10(math.pi / settings.sample_time_s) - 0.01, 3000)
+        resp = la._response(loop, omega)
+        closed = np.abs(resp / (1.0 + resp))
+        below = np.nonzero(closed < 1.0 / math.sqrt(2.0))[0]
+        below = below[omega[below] > mg.crossover_rad_s * 0.3] if mg.stable else below
+        bandwidth_hz = float(omega[below[0]] / (2 * math.pi)) if below.size else math.nan
+        rows.append({
+            "vehicle": vehicle_name, "case": name, "speed_kmh": speed_kmh, "floor_m": floor,
+            "phase_margin_deg": mg.phase_margin_deg, "gain_margin_db": mg.gain_margin_db,
+            "gain_reduction_margin_db": mg.gain_reduction_margin_db,
+            "crossover_hz": mg.crossover_rad_s / (2 * math.pi), "bandwidth_hz": bandwidth_hz, "stable": mg.stable,
+        })  # fmt: skip
+    return rows
+
+
+def summary(runs: list[Run]) -> list[dict[str, object]]:
+    """Per vehicle, conditions and switch: the clothoid's max |CTE| against its nominal run's and the NMPC's, as the
+    median over the scenarios, and the share of the nominal gap to the NMPC the switch closes."""
+    by = {(r.vehicle, r.scenario, r.switch, r.controller, r.conditions): r for r in runs}
+    out = []
+    for vehicle, conditions in sorted({(r.vehicle, r.conditions) for r in runs}):
+        scenarios = sorted({r.scenario for r in runs if r.vehicle == vehicle and r.conditions == conditions})
+        for sw in [sw for sw in SWITCHES if any(r.switch == sw for r in runs)]:
+            ratios, closed, vs_nmpc, rms, cycles = [], [], [], [], 0
+            for sc in scenarios:
+                c0 = by[(vehicle, sc, "nominal", "clothoid", conditions)]
+                n0 = by[(vehicle, sc, "nominal", "nmpc", conditions)]
+                c = by[(vehicle, sc, sw, "clothoid", conditions)]
+                n = by.get((vehicle, sc, sw, "nmpc", conditions), n0)
+                ratios.append(c.max_abs_cte_m / c0.max_abs_cte_m)
+                gap = c0.max_abs_cte_m - n0.max_abs_cte_m
+                closed.append((c0.max_abs_cte_m - c.max_abs_cte_m) / gap if gap > 1e-9 else math.nan)
+                vs_nmpc.append(c.max_abs_cte_m / n.max_abs_cte_m)
+                rms.append(c.rms_cte_m / c0.rms_cte_m)
+                cycles += c.limit_cycle
+            out.append({
+                "vehicle": vehicle, "conditions": conditions, "switch": sw,
+                "median_max_cte_vs_nominal": float(np.median(ratios)),
+                "median_rms_cte_vs_nominal": float(np.median(rms)),
+                "median_gap_closed": float(np.nanmedian(closed)),
+                "median_ratio_to_nmpc_same_run": float(np.median(vs_nmpc)), "limit_cycles": cycles,
+                "scenarios": len(scenarios),
+            })  # fmt: skip
+    return out
+
+
+def figure(vehicle: str, scenario: str, traces: dict, runs: dict, path: Path) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(3, 1, figsize=(9, 6.5), sharex=True, gridspec_kw={"height_ratios": [3, 1, 1]})
+    for sw in SWITCHES:
+        tr = traces.get((vehicle, scenario, sw, "clothoid", "ideal"))
+        if tr is None:
+            continue
+        r = runs[(vehicle, scenario, sw, "clothoid", "ideal")]
+        style = {"lw": 2.0, "color": "k"} if sw == "nominal" else {"lw": 0.9}
+        axes[0].plot(tr["s"], np.abs(tr["cte"]), label=f"{sw} ({r.max_abs_cte_m:.3f} m)", **style)
+    nmpc = traces[(vehicle, scenario, "nominal", "nmpc", "ideal")]
+    r = runs[(vehicle, scenario, "nominal", "nmpc", "ideal")]
+    axes[0].plot(nmpc["s"], np.abs(nmpc["cte"]), "k--", lw=1.2, label=f"NMPC, nominal ({r.max_abs_cte_m:.3f} m)")
+    axes[0].set_ylabel("|CTE| (m)")
+    axes[0].legend(fontsize=7, ncol=2)
+    axes[0].set_title(f"{vehicle}, {scenario}, 30 km/h, ideal: the clothoid controller, one factor switched at a time")
+    base = traces[(vehicle, scenario, "nominal", "clothoid", "ideal")]
+    axes[1].plot(base["s"], base["kappa"], color="tab:blue")
+    axes[1].set_ylabel("path κ (1/m)")
+    axes[2].plot(base["s"], base["accel"], color="tab:red")
+    axes[2].set_ylabel("long. accel (m/s²)")
+    axes[2].set_xlabel("distance along the path (m)")
+    for ax in axes:
+        ax.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(path, dpi=80)
+    plt.close(fig)
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--out", type=Path, default=Path(__file__).parent / "results" / "cte_breakdown.json")
+    parser.add_argument("--vehicles", default=",".join(VEHICLES))
+    parser.add_argument("--scenarios", default=",".join(SCENARIOS))
+    parser.add_argument("--workers", type=int, default=os.cpu_count() or 1)
+    parser.add_argument("--no-automotive", action="store_true", help="skip the automotive check (dlc, figure8)")
+    parser.add_argument("--figures-dir", type=Path, default=None, help="also write the figures here")
+    args = parser.parse_args(argv)
+    vehicles, scenarios = args.vehicles.split(","), args.scenarios.split(",")
+    held_out = [s for s in scenarios if s.startswith("circuit:") and int(s.split(":")[1]) >= HELD_OUT_FIRST_SEED]
+    if held_out:
+        parser.error(f"{', '.join(held_out)}: seeds {HELD_OUT_FIRST_SEED} and up are the held-out set, not for this")
+    jobs = jobs_for(vehicles, scenarios, not args.no_automotive)
+    with ProcessPoolExecutor(max_workers=args.workers) as pool:
+        results = list(pool.map(run_one, jobs, chunksize=2))
+    runs = {(r.vehicle, r.scenario, r.switch, r.controller, r.conditions): r for r, _ in results}
+    traces = {(r.vehicle, r.scenario, r.switch, r.controller, r.conditions): t for r, t in results}
+    print(f"{'vehicle':<20} {'scenario':<13} {'cond':<5} {'switch':<16} {'ctrl':<8} {'max|CTE|':>8} {'RMS':>6} "
+          f"{'s@max':>7} {'κ@max':>7} {'ax@max':>6} {'osc°':>5} {'rate':>5} LC")  # fmt: skip
+    for r, _ in results:
+        print(
+            f"{r.vehicle:<20} {r.scenario:<13} {r.conditions[:5]:<5} {r.switch:<16} {r.controller:<8} "
+            f"{r.max_abs_cte_m:8.3f} {r.rms_cte_m:6.3f} {r.s_at_max_m:7.1f} {r.curvature_at_max_1pm:7.3f} "
+            f"{r.long_accel_at_max_mps2:6.2f} {r.steer_oscillation_deg:5.1f} {r.rms_steer_rate_deg_s:5.0f} "
+            f"{'yes' if r.limit_cycle else 'no'}"
+        )
+    table = summary([r for r, _ in results])
+    print(f"\n{'vehicle':<20} {'cond':<10} {'switch':<16} {'max|CTE| x':>10} {'RMS x':>6} {'gap closed':>10} "
+          f"{'/ NMPC':>7} LC")  # fmt: skip
+    for row in table:
+        print(
+            f"{row['vehicle']:<20} {row['conditions']:<10} {row['switch']:<16} "
+            f"{row['median_max_cte_vs_nominal']:10.2f} {row['median_rms_cte_vs_nominal']:6.2f} "
+            f"{row['median_gap_closed']:10.0%} {row['median_ratio_to_nmpc_same_run']:7.2f} {row['limit_cycles']}"
+        )
+    loops = [row for v in vehicles for row in loop_rows(v)]
+    print(f"\n{'vehicle':<20} {'loop (30 km/h unless said)':<40} {'floor':>6} {'PM°':>5} {'GM dB':>6} {'GRM dB':>7} "
+          f"{'xover Hz':>8} {'BW Hz':>6}")  # fmt: skip
+    for row in loops:
+        print(
+            f"{row['vehicle']:<20} {row['case']:<40} {row['floor_m']:6.1f} {row['phase_margin_deg']:5.0f} "
+            f"{row['gain_margin_db']:6.1f} {row['gain_reduction_margin_db']:7.1f} {row['crossover_hz']:8.2f} "
+            f"{row['bandwidth_hz']:6.2f}"
+        )
+    args.out.parent.mkdir(parents=True, exist_ok=True)
+    figures = []
+    for v in vehicles:
+        worst = max(scenarios, key=lambda sc: runs[(v, sc, "nominal", "clothoid", "ideal")].max_abs_cte_m)
+        for folder in [args.out.parent] + ([args.figures_dir] if args.figures_dir else []):
+            folder.mkdir(parents=True, exist_ok=True)
+            path = folder / f"cte_breakdown_{v}.png"
+            figure(v, worst, traces, runs, path)
+            figures.append(str(path))
+    payload = {
+        "created_unix_s": time.time(), "speed_kmh": SPEED_KMH, "runs": [asdict(r) for r, _ in results],
+        "summary": table, "loop_analysis": loops, "figures": figures,
+    }  # fmt: skip
+    args.out.write_text(json.dumps(payload, indent=2) + "\n")
+    print(f"wrote {args.out} and {', '.join(figures)}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,108 @@
+"""benchmarks/cte_breakdown.py without simulations: each switch changes what it names and nothing else, the held-out
+circuits are refused, and the summary's arithmetic (gap to the NMPC closed, ratios) on constructed runs."""
+
+from __future__ import annotations
+
+import dataclasses
+import importlib.util
+import sys
+from pathlib import Path
+
+import pytest
+
+from workbench.vehicles import make_vehicle
+
+#: The benchmark is a script, not a package: loaded from its file (the repository's root is two levels up).
+SCRIPT = Path(__file__).resolve().parents[2] / "benchmarks" / "cte_breakdown.py"
+
+
+@pytest.fixture(scope="module")
+def breakdown():
+    spec = importlib.util.spec_from_file_location("benchmark_cte_breakdown", SCRIPT)
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = module  # dataclasses look their module up while being built
+    spec.loader.exec_module(module)
+    yield module
+    del sys.modules[spec.name]
+
+
+def _changed(vehicle_name: str, plant) -> dict[str, object]:
+    preset = make_vehicle(vehicle_name).params
+    return {
+        f.name: getattr(plant.params, f.name)
+        for f in dataclasses.fields(preset)
+        if getattr(plant.params, f.name) != getattr(preset, f.name)
+    }
+
+
+@pytest.mark.parametrize("vehicle", ["tractor-semitrailer", "dynamic-bicycle"])
+def test_each_plant_switch_changes_only_what_it_names(breakdown, vehicle: str) -> None:
+    assert _changed(vehicle, breakdown.plant_for(vehicle, "nominal")) == {}
+    assert _changed(vehicle, breakdown.plant_for(vehicle, "constant_speed")) == {}
+    assert _changed(vehicle, breakdown.plant_for(vehicle, "no_actuator_lag")) == {
+        "steering_time_constant_s": breakdown.NO_LAG_TIME_CONSTANT_S
+    }
+    stiff = _changed(vehicle, breakdown.plant_for(vehicle, "stiff_tyres"))
+    assert stiff.pop("relaxation_length_m") == breakdown.STIFF_RELAXATION_M
+    axles = ("front", "drive", "trailer") if vehicle == "tractor-semitrailer" else ("front", "rear")
+    assert stiff == {f"{a}_cornering_coeff_per_rad": breakdown.STIFF_CORNERING_PER_RAD[vehicle] for a in axles}
+    both = _changed(vehicle, breakdown.plant_for(vehicle, "ideal_plant"))
+    assert both == {**stiff, "relaxation_length_m": breakdown.STIFF_RELAXATION_M,
+                    "steering_time_constant_s": breakdown.NO_LAG_TIME_CONSTANT_S}  # fmt: skip
+
+
+def test_the_controller_switches(breakdown) -> None:
+    from controllers.clothoid.controller import ClothoidConfig
+
+    config = ClothoidConfig()
+    assert breakdown.clothoid_config_for("nominal", config) is config
+    low = breakdown.clothoid_config_for("floor_lowered", config)
+    assert (low.min_phase_margin_deg, low.min_gain_margin_db) == (30.0, 3.0)
+    off = breakdown.clothoid_config_for("floor_off", config)
+    assert (off.min_phase_margin_deg, off.min_gain_margin_db) == (0.0, 0.0)
+    assert breakdown.clothoid_config_for("feedforward_off", config).path_feedforward is False
+    assert config.path_feedforward is True and config.min_phase_margin_deg == 45.0
+
+
+def test_the_held_out_circuits_are_refused(breakdown, capsys) -> None:
+    with pytest.raises(SystemExit) as exit_info:
+        breakdown.main(["--scenarios", "dlc,circuit:9003"])
+    assert exit_info.value.code == 2
+    assert "circuit:9003" in capsys.readouterr().err
+
+
+def test_the_plan_runs_the_nmpc_on_plant_switches_only(breakdown) -> None:
+    jobs = breakdown.jobs_for(["dynamic-bicycle"], ["dlc"], automotive=False)
+    nmpc = {j[2] for j in jobs if j[3] == "nmpc"}
+    assert nmpc == {"nominal", *breakdown.PLANT_SWITCHES}
+    assert {j[2] for j in jobs if j[3] == "clothoid"} == set(breakdown.SWITCHES)
+    with_automotive = breakdown.jobs_for(["dynamic-bicycle"], ["dlc"], automotive=True)
+    assert {j[1] for j in with_automotive if j[4] == "automotive"} == set(breakdown.AUTOMOTIVE_SCENARIOS)
+
+
+def _run(breakdown, scenario: str, switch: str, controller: str, cte: float, rms: float = 0.01):
+    return breakdown.Run("tractor-semitrailer", scenario, switch, controller, "ideal", "completed", cte, rms,
+                         0.0, 0.0, 0.0, 8.3, 0.3, 1.0, 10.0, False, 8.5, 0.1)  # fmt: skip
+
+
+def test_the_summary_arithmetic(breakdown) -> None:
+    runs = []
+    for scenario, (clothoid, nmpc) in {"a": (0.08, 0.04), "b": (0.06, 0.02), "c": (0.05, 0.03)}.items():
+        runs += [_run(breakdown, scenario, "nominal", "clothoid", clothoid, 0.02),
+                 _run(breakdown, scenario, "nominal", "nmpc", nmpc)]  # fmt: skip
+        # a plant switch: the clothoid halves its error, the NMPC on the same switched plant keeps its own
+        runs += [_run(breakdown, scenario, "stiff_tyres", "clothoid", clothoid / 2, 0.01),
+                 _run(breakdown, scenario, "stiff_tyres", "nmpc", nmpc)]  # fmt: skip
+        # a controller switch: compared with the nominal NMPC run
+        runs.append(_run(breakdown, scenario, "floor_off", "clothoid", nmpc))
+    table = {row["switch"]: row for row in breakdown.summary(runs)}
+    assert table["nominal"]["median_gap_closed"] == 0.0
+    assert table["nominal"]["median_ratio_to_nmpc_same_run"] == pytest.approx(2.0)  # 2, 3, 5/3
+    stiff = table["stiff_tyres"]
+    assert stiff["median_max_cte_vs_nominal"] == pytest.approx(0.5)
+    assert stiff["median_rms_cte_vs_nominal"] == pytest.approx(0.5)
+    # gaps 0.04, 0.04, 0.02 closed by 0.04, 0.03, 0.025: 100 %, 75 %, 125 %
+    assert stiff["median_gap_closed"] == pytest.approx(1.0)
+    assert table["floor_off"]["median_gap_closed"] == pytest.approx(1.0)
+    assert table["floor_off"]["median_ratio_to_nmpc_same_run"] == pytest.approx(1.0)
+    assert set(table) == {"nominal", "stiff_tyres", "floor_off"}  # switches not run are not summarised
