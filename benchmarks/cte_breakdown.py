@@ -12,7 +12,9 @@ Switches (each against `nominal`, the shipped defaults on the preset vehicle):
     braking or accelerating anywhere (corners are then taken faster than the profile's 0.3 g);
   - floor_lowered: the lookahead floor keeps 30 deg / 3 dB instead of 45 deg / 6 dB;
   - floor_off: no floor (the paper's 5 m lower end; margins not kept);
-  - feedforward_off: Eq. 3 alone (`path_feedforward=false`).
+  - feedforward_off: Eq. 3 alone (`path_feedforward=false`);
+  - feedforward_window_2m: the feed-forward's path curvature rate averaged over 2 m instead of 6 m (a diagnosis of
+    how much of the error is the feed-forward's smoothing, not a proposed setting).
   - ideal_plant: no_actuator_lag + stiff_tyres + constant_speed together (what the controller's geometry and floor
     leave).
 Both controllers are built for the vehicle they drive: the clothoid controller with that plant's own tuning (its lags
@@ -30,7 +32,8 @@ The feed-forward does not enter the loop (its term depends on the path only), so
 
 Prints the tables and writes benchmarks/results/cte_breakdown.json and one figure per vehicle
 (benchmarks/results/cte_breakdown_<vehicle>.png: |CTE| against distance for each switch on the worst case, with the
-path curvature and the longitudinal acceleration beneath). About 2-4 minutes on 2 cores.
+path curvature and the longitudinal acceleration beneath). About 4-6 minutes on 2 shared cores, and once about a
+minute per switched plant for its tuning (cached after).
 
     python benchmarks/cte_breakdown.py [--out benchmarks/results/cte_breakdown.json] [--vehicles a,b]
         [--scenarios dlc,figure8,circuit:1000,...] [--workers 2] [--no-automotive] [--figures-dir DIR]
@@ -67,7 +70,9 @@ HELD_OUT_FIRST_SEED = 9000
 SPEED_KMH = 30.0
 #: switch -> (plant changes, run-config changes, clothoid config changes).
 PLANT_SWITCHES = ("no_actuator_lag", "stiff_tyres", "constant_speed", "ideal_plant")
-CONTROLLER_SWITCHES = ("floor_lowered", "floor_off", "feedforward_off")
+CONTROLLER_SWITCHES = ("floor_lowered", "floor_off", "feedforward_off", "feedforward_window_2m")
+#: The feed-forward's curvature-rate window (m) of the feedforward_window_2m switch (the default: 6 m).
+SHORT_FEEDFORWARD_WINDOW_M = 2.0
 SWITCHES = ("nominal", *PLANT_SWITCHES, *CONTROLLER_SWITCHES)
 #: The plant's actuator time constant (s) with its lag switched off (the smallest the presets allow).
 NO_LAG_TIME_CONSTANT_S = 1e-3
@@ -103,6 +108,8 @@ def clothoid_config_for(switch: str, config):
         return dataclasses.replace(config, min_phase_margin_deg=0.0, min_gain_margin_db=0.0)
     if switch == "feedforward_off":
         return dataclasses.replace(config, path_feedforward=False)
+    if switch == "feedforward_window_2m":
+        return dataclasses.replace(config, feedforward_window_m=SHORT_FEEDFORWARD_WINDOW_M)
     return config
 
 
@@ -317,21 +324,21 @@ def main(argv: list[str] | None = None) -> int:
         results = list(pool.map(run_one, jobs, chunksize=2))
     runs = {(r.vehicle, r.scenario, r.switch, r.controller, r.conditions): r for r, _ in results}
     traces = {(r.vehicle, r.scenario, r.switch, r.controller, r.conditions): t for r, t in results}
-    print(f"{'vehicle':<20} {'scenario':<13} {'cond':<5} {'switch':<16} {'ctrl':<8} {'max|CTE|':>8} {'RMS':>6} "
+    print(f"{'vehicle':<20} {'scenario':<13} {'cond':<5} {'switch':<21} {'ctrl':<8} {'max|CTE|':>8} {'RMS':>6} "
           f"{'s@max':>7} {'κ@max':>7} {'ax@max':>6} {'osc°':>5} {'rate':>5} LC")  # fmt: skip
     for r, _ in results:
         print(
-            f"{r.vehicle:<20} {r.scenario:<13} {r.conditions[:5]:<5} {r.switch:<16} {r.controller:<8} "
+            f"{r.vehicle:<20} {r.scenario:<13} {r.conditions[:5]:<5} {r.switch:<21} {r.controller:<8} "
             f"{r.max_abs_cte_m:8.3f} {r.rms_cte_m:6.3f} {r.s_at_max_m:7.1f} {r.curvature_at_max_1pm:7.3f} "
             f"{r.long_accel_at_max_mps2:6.2f} {r.steer_oscillation_deg:5.1f} {r.rms_steer_rate_deg_s:5.0f} "
             f"{'yes' if r.limit_cycle else 'no'}"
         )
     table = summary([r for r, _ in results])
-    print(f"\n{'vehicle':<20} {'cond':<10} {'switch':<16} {'max|CTE| x':>10} {'RMS x':>6} {'gap closed':>10} "
+    print(f"\n{'vehicle':<20} {'cond':<10} {'switch':<21} {'max|CTE| x':>10} {'RMS x':>6} {'gap closed':>10} "
           f"{'/ NMPC':>7} LC")  # fmt: skip
     for row in table:
         print(
-            f"{row['vehicle']:<20} {row['conditions']:<10} {row['switch']:<16} "
+            f"{row['vehicle']:<20} {row['conditions']:<10} {row['switch']:<21} "
             f"{row['median_max_cte_vs_nominal']:10.2f} {row['median_rms_cte_vs_nominal']:6.2f} "
             f"{row['median_gap_closed']:10.0%} {row['median_ratio_to_nmpc_same_run']:7.2f} {row['limit_cycles']}"
         )

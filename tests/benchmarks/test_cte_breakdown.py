@@ -61,7 +61,9 @@ def test_the_controller_switches(breakdown) -> None:
     off = breakdown.clothoid_config_for("floor_off", config)
     assert (off.min_phase_margin_deg, off.min_gain_margin_db) == (0.0, 0.0)
     assert breakdown.clothoid_config_for("feedforward_off", config).path_feedforward is False
+    assert breakdown.clothoid_config_for("feedforward_window_2m", config).feedforward_window_m == 2.0
     assert config.path_feedforward is True and config.min_phase_margin_deg == 45.0
+    assert config.feedforward_window_m == 6.0
 
 
 def test_the_held_out_circuits_are_refused(breakdown, capsys) -> None:
