@@ -273,7 +273,8 @@ class ClothoidConfig:
     )
     feedforward_window_m: float = option(
         6.0,
-        "the window the path's curvature rate is averaged over for the feed-forward",
+        "the window the path's curvature rate is averaged over for the feed-forward (with feedforward_inversion: "
+        "the window of the curvature's derivatives it inverts the lag with)",
         Number(0.1, 100.0, "m"),
     )
     feedforward_time_s: float | None = option(
@@ -285,6 +286,15 @@ class ClothoidConfig:
         None,
         "how far ahead of the foot point the feedback's reference pose starts (at most the prediction time)",
         Number(0.0, 5.0, "s", none_means="from the vehicle's lags"),
+    )
+    feedforward_inversion: bool = option(
+        False,
+        "experimental: the feed-forward inverts the identified steering-to-path-curvature lag of Eq. 5 in full (the "
+        "path's curvature its dead time plus known_delay_s ahead, with its first and second time derivatives "
+        "weighted 2 zeta / wn and 1 / wn^2, over K; `path_feedforward.lag_inverse_curvature`) and is added to the "
+        "steering after the lead filter instead of integrated through it (feedforward_time_s is then unused); needs "
+        "path_feedforward; without a tuning, the path's curvature at the foot point",
+        Flag(),
     )
     tuning: VehicleTuning | None = option(  # noqa: RUF009  (option is a dataclasses.field)
         None,
@@ -318,6 +328,12 @@ class ClothoidConfig:
                 f"delay_compensation 'model' predicts the measured kappa(0), initial_curvature 'yaw-rate'; got "
                 f"initial_curvature {self.initial_curvature!r} with known_delay_s = {value_text(self.known_delay_s)}: "
                 "set delay_compensation = 'arc' (the pose predicted on kappa(0)) or initial_curvature = 'yaw-rate'"
+            )
+        if self.feedforward_inversion and not self.path_feedforward:
+            raise WorkbenchInputError(
+                "feedforward_inversion inverts the lag for the two-degree-of-freedom form's feed-forward and needs "
+                "path_feedforward = true; got path_feedforward = false: set path_feedforward = true or "
+                "feedforward_inversion = false"
             )
         if self.max_lookahead_m < self.min_lookahead_m:
             raise WorkbenchInputError(
@@ -499,6 +515,7 @@ class ClothoidController(Controller):
         p[sk.P_TOLERANCE_X], p[sk.P_TOLERANCE_Y] = cfg.tolerance_x_m, cfg.tolerance_y_m
         p[sk.P_KDOT_MAX], p[sk.P_FEEDFORWARD] = cfg.max_curvature_rate_1pm2, cfg.path_feedforward
         p[sk.P_FEEDFORWARD_WINDOW] = cfg.feedforward_window_m
+        p[sk.P_FEEDFORWARD_INVERSION] = cfg.feedforward_inversion
         for index, value in (
             (sk.P_FEEDFORWARD_TIME, cfg.feedforward_time_s),
             (sk.P_REFERENCE_LEAD, cfg.reference_lead_s),

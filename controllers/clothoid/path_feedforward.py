@@ -26,6 +26,7 @@ trailer make it much longer than a car's).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -105,3 +106,42 @@ def two_degree_of_freedom_rate(
     ) / window_m
     feedforward /= steady_state_gain
     return vehicle_kdot - reference_kdot + feedforward, reference_kdot, feedforward
+
+
+@njit(cache=True)
+def lag_inverse_curvature(
+    path_curvature: np.ndarray,
+    spacing: float,
+    length: float,
+    closed: bool,
+    s_m: float,
+    speed_mps: float,
+    dead_time_s: float,
+    omega_n_rad_s: float,
+    zeta: float,
+    steady_state_gain: float,
+    window_m: float,
+) -> tuple[float, float]:  # pragma: no cover - compiled
+    """(kinematic curvature to steer 1/m, its path curvature rate dkappa/ds 1/m^2): the identified
+    steering-to-path-curvature lag of Eq. 5 inverted along the path (`ClothoidConfig.feedforward_inversion`).
+
+    Eq. 5 makes the path curvature K wn^2 / (s^2 + 2 zeta wn s + wn^2) e^(-T s) times the kinematic curvature
+    steered, so the steering that makes the vehicle follow the path's curvature kappa_p exactly is
+
+        u(t) = (kappa_p + 2 zeta / wn dkappa_p/dt + 1 / wn^2 d2kappa_p/dt^2)(t + T) / K,
+
+    with d/dt = V d/ds at the speed V now (the speed's own change is left out). The path is read speed x T ahead
+    of the foot point s_m (T: dead_time_s, the lag's delay plus any known delay); its derivatives are central
+    differences over window_m (dkappa/ds the mean slope over the window, d2kappa/ds2 the second difference over
+    half of it), so a clothoid's corner in curvature rate is spread over the window, not a one-step impulse.
+    omega_n_rad_s NaN (no identified lag): the path's curvature there, over K."""
+    s, half = s_m + speed_mps * dead_time_s, 0.5 * window_m
+    ahead = value_at(path_curvature, s + half, spacing, length, closed)
+    middle = value_at(path_curvature, s, spacing, length, closed)
+    behind = value_at(path_curvature, s - half, spacing, length, closed)
+    slope = (ahead - behind) / window_m
+    curvature = middle
+    if not math.isnan(omega_n_rad_s):
+        second = (ahead - 2.0 * middle + behind) / (half * half)
+        curvature += 2.0 * zeta / omega_n_rad_s * speed_mps * slope + (speed_mps / omega_n_rad_s) ** 2 * second
+    return curvature / steady_state_gain, slope / steady_state_gain

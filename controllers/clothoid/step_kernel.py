@@ -22,7 +22,7 @@ from controllers.clothoid import delay_predictor as dp
 from controllers.clothoid.lead_filter import lead_step
 from controllers.clothoid.lookahead import adaptive_search, evaluate_candidate, evaluated, turn_limited_lookahead
 from controllers.clothoid.lookahead_filter import filtered_lookahead
-from controllers.clothoid.path_feedforward import two_degree_of_freedom_rate
+from controllers.clothoid.path_feedforward import lag_inverse_curvature, two_degree_of_freedom_rate
 from controllers.clothoid.pose_prediction import along_arc
 from controllers.clothoid.speed_tables import table_row
 from workbench.base.path_search import TRACK_OUT_SIZE, track
@@ -39,9 +39,9 @@ KAPPA0_YAW_RATE, KAPPA0_COMMAND, KAPPA0_STEERING = 0, 1, 2
     P_LOOKAHEAD_GAIN, P_MAX_TURN_RAD, P_FRECHET_THRESHOLD, P_POINT_SPACING, P_TOLERANCE_X, P_TOLERANCE_Y,
     P_KDOT_MAX, P_FEEDFORWARD, P_FEEDFORWARD_WINDOW, P_FEEDFORWARD_TIME, P_REFERENCE_LEAD, P_HYSTERESIS,
     P_MAX_GROWTH, P_MAX_SHRINK, P_MIN_SPEED, P_BAND_KMH, P_BAND_HYSTERESIS_KMH, P_PATH_SPACING, P_PATH_LENGTH,
-    P_PATH_EXTENT, P_TRACKER_WINDOW, P_PATH_MAX_SEGMENT, P_WARM_SEARCH, P_DELAY_MODEL,
-) = range(39)  # fmt: skip
-PARAM_COUNT = 39
+    P_PATH_EXTENT, P_TRACKER_WINDOW, P_PATH_MAX_SEGMENT, P_WARM_SEARCH, P_DELAY_MODEL, P_FEEDFORWARD_INVERSION,
+) = range(40)  # fmt: skip
+PARAM_COUNT = 40
 
 # The step's own state (`state`).
 S_KAPPA_CMD = 0  # the integrator's curvature command (1/m; NaN before the first step)
@@ -51,7 +51,10 @@ S_FILTER_X = 4  # the lead filter's three states (rad), shared by the filters of
 S_NEED = 7  # what a NEED_* return asks for: the speed band or the km/h
 S_SEARCHED = 8  # the adaptive search's last choice (m; NaN before the first search): where the next one starts
 S_MODEL = 9  # the delay predictor's model (`delay_predictor.MODEL_SIZE` values; NaN before the first step)
-STATE_SIZE = S_MODEL + dp.MODEL_SIZE
+#: With the lag-inverting feed-forward: its kinematic curvature sent last step (1/m; NaN before the first step);
+#: S_KAPPA_CMD then holds the feedback's integrated curvature alone.
+S_FEEDFORWARD_KAPPA = S_MODEL + dp.MODEL_SIZE
+STATE_SIZE = S_FEEDFORWARD_KAPPA + 1
 
 # `clothoid_step`'s status.
 STEP_DONE, NEED_FLOOR, NEED_FILTER = 0, 1, 2
@@ -165,7 +168,9 @@ def clothoid_step(
 
     wheelbase, ratio = p[P_WHEELBASE], p[P_STEERING_RATIO]
     steering_kappa = math.tan(steer_wheel_rad / ratio) / wheelbase
-    if math.isnan(state[S_KAPPA_CMD]):  # first step: continue from the vehicle's current steering
+    inverting = p[P_FEEDFORWARD] != 0.0 and p[P_FEEDFORWARD_INVERSION] != 0.0
+    first = math.isnan(state[S_KAPPA_CMD])
+    if first:  # first step: continue from the vehicle's current steering
         state[S_KAPPA_CMD] = steering_kappa
         state[S_FILTER_X] = state[S_FILTER_X + 1] = state[S_FILTER_X + 2] = steer_wheel_rad
     table_row(limit_speeds, limits, speed * 3.6, False, scratch[:2])
@@ -177,6 +182,8 @@ def clothoid_step(
         kappa0 = steering_kappa
     else:
         kappa0 = state[S_KAPPA_CMD]
+        if inverting and not math.isnan(state[S_FEEDFORWARD_KAPPA]):  # the curvature sent: feedback + feed-forward
+            kappa0 += state[S_FEEDFORWARD_KAPPA]
     kappa0 = min(max(kappa0, -kappa_max), kappa_max)
 
     # Sections 2 and 3: the start pose, the lookahead, then the hyper-clothoid to the target (Eq. 3).
@@ -249,6 +256,7 @@ def clothoid_step(
             buffers, max_segment, np.inf,
         )  # fmt: skip
     clothoid_kdot = reference_kdot = feedforward_kdot = kdot
+    feedforward_kappa = 0.0
     if p[P_FEEDFORWARD] != 0.0:  # path_feedforward.py: feedback relative to the path's own clothoid, plus its rate
         track(
             path_x, path_y, path_heading, path_curvature, spacing, length, closed, p[P_PATH_EXTENT],
@@ -261,15 +269,43 @@ def clothoid_step(
             kdot, path_x, path_y, path_heading, path_curvature, spacing, length, closed, foot, tx, ty, speed,
             horizon, ff_time, reference_lead, gain, p[P_FEEDFORWARD_WINDOW], p[P_HORIZON] - horizon,
         )  # fmt: skip
+        if inverting:  # the lag inverted, added after the lead filter; the integrator holds the feedback alone
+            kdot = clothoid_kdot - reference_kdot
+            omega_n, zeta, dead_time = math.nan, 1.0, 0.0
+            if lags.shape[0] > 0:
+                table_row(lag_speeds, lags, speed * 3.6, False, scratch[:4])
+                omega_n, zeta, dead_time, gain = scratch[0], scratch[1], scratch[2], scratch[3]
+            feedforward_kappa, feedforward_kdot = lag_inverse_curvature(
+                path_curvature, spacing, length, closed, foot[0], speed, dead_time + p[P_KNOWN_DELAY], omega_n, zeta,
+                gain, p[P_FEEDFORWARD_WINDOW],
+            )  # fmt: skip
+            feedforward_kappa = min(max(feedforward_kappa, -kappa_max), kappa_max)
+            state[S_FEEDFORWARD_KAPPA] = feedforward_kappa
+            if first:  # the feedback's share of the steering now (bumpless)
+                state[S_KAPPA_CMD] = steering_kappa - feedforward_kappa
+                steer_feedback = math.atan(wheelbase * state[S_KAPPA_CMD]) * ratio
+                state[S_FILTER_X] = state[S_FILTER_X + 1] = state[S_FILTER_X + 2] = steer_feedback
 
     # Figure 2: kappa' x V integrated to curvature, under the rate and curvature limits (section 4).
     rate = min(max(kdot * speed, -rate_max), rate_max)
-    kappa_cmd = min(max(state[S_KAPPA_CMD] + rate * p[P_DT], -kappa_max), kappa_max)
-    state[S_KAPPA_CMD] = kappa_cmd
-    steer = math.atan(wheelbase * kappa_cmd) * ratio  # Ackermann: tan(phi) = L kappa
-    command = steer
-    if filtered:  # Eq. 6: this km/h's filter, on the state the last one left (the same lag-chain signals)
-        command = lead_step(filters[kmh], state[S_FILTER_X : S_FILTER_X + 3], steer)
+    if inverting:  # the feedback integrated within what the feed-forward leaves of the curvature limit
+        kappa_fb = state[S_KAPPA_CMD] + rate * p[P_DT]
+        kappa_fb = min(max(kappa_fb, -kappa_max - feedforward_kappa), kappa_max - feedforward_kappa)
+        state[S_KAPPA_CMD] = kappa_fb
+        kappa_cmd = kappa_fb + feedforward_kappa
+        steer_feedback = math.atan(wheelbase * kappa_fb) * ratio
+        steer = math.atan(wheelbase * kappa_cmd) * ratio
+        command = steer
+        if filtered:  # Eq. 6 on the feedback's steering; the feed-forward's share added after it
+            command = lead_step(filters[kmh], state[S_FILTER_X : S_FILTER_X + 3], steer_feedback)
+            command += steer - steer_feedback
+    else:
+        kappa_cmd = min(max(state[S_KAPPA_CMD] + rate * p[P_DT], -kappa_max), kappa_max)
+        state[S_KAPPA_CMD] = kappa_cmd
+        steer = math.atan(wheelbase * kappa_cmd) * ratio  # Ackermann: tan(phi) = L kappa
+        command = steer
+        if filtered:  # Eq. 6: this km/h's filter, on the state the last one left (the same lag-chain signals)
+            command = lead_step(filters[kmh], state[S_FILTER_X : S_FILTER_X + 3], steer)
     limit = p[P_MAX_STEER]
     command = min(max(command, -limit), limit)
     if predicting:
