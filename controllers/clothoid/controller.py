@@ -296,6 +296,15 @@ class ClothoidConfig:
         "path_feedforward; without a tuning, the path's curvature at the foot point",
         Flag(),
     )
+    lag_model_reference: bool = option(
+        False,
+        "experimental, with feedforward_inversion: the feedback's reference pose starts at the path's pose (ahead by "
+        "the known delay only) on the curvature a vehicle following the path exactly would measure, the measured "
+        "(yaw-rate) lag driven by the inverted path lag (`step_kernel.reference_curvature`), instead of the path's "
+        "pose and curvature reference_lead_s ahead (reference_lead_s is then unused); without a tuning it changes "
+        "nothing",
+        Flag(),
+    )
     tuning: VehicleTuning | None = option(  # noqa: RUF009  (option is a dataclasses.field)
         None,
         "the steered vehicle's own tuning: lead filter, curvature limits, identified lags "
@@ -334,6 +343,11 @@ class ClothoidConfig:
                 "feedforward_inversion inverts the lag for the two-degree-of-freedom form's feed-forward and needs "
                 "path_feedforward = true; got path_feedforward = false: set path_feedforward = true or "
                 "feedforward_inversion = false"
+            )
+        if self.lag_model_reference and not self.feedforward_inversion:
+            raise WorkbenchInputError(
+                "lag_model_reference drives the measured lag with the inverted lag's feed-forward and needs "
+                "feedforward_inversion = true; got feedforward_inversion = false"
             )
         if self.max_lookahead_m < self.min_lookahead_m:
             raise WorkbenchInputError(
@@ -516,6 +530,7 @@ class ClothoidController(Controller):
         p[sk.P_KDOT_MAX], p[sk.P_FEEDFORWARD] = cfg.max_curvature_rate_1pm2, cfg.path_feedforward
         p[sk.P_FEEDFORWARD_WINDOW] = cfg.feedforward_window_m
         p[sk.P_FEEDFORWARD_INVERSION] = cfg.feedforward_inversion
+        p[sk.P_LAG_MODEL_REFERENCE] = cfg.lag_model_reference
         for index, value in (
             (sk.P_FEEDFORWARD_TIME, cfg.feedforward_time_s),
             (sk.P_REFERENCE_LEAD, cfg.reference_lead_s),

@@ -85,6 +85,7 @@ def two_degree_of_freedom_rate(
     steady_state_gain: float,
     window_m: float,
     path_time_s: float = 0.0,
+    reference_curvature: float = math.nan,
 ) -> tuple[float, float, float]:  # pragma: no cover - compiled
     """(kappa' to integrate, the reference's kappa', the feed-forward kappa') (1/m^2), module docstring. here: the
     foot point of the vehicle's measured position (`path_search.track`'s output: s, progress, x, y, heading,
@@ -93,7 +94,8 @@ def two_degree_of_freedom_rate(
     The reference pose: the path's pose path_time_s + reference_lead_s ahead of the foot point, moved over the rest
     of the prediction time on the path's curvature there, by the chord of that arc (as the vehicle's own
     prediction; path_time_s: the known delay when the vehicle's pose is predicted over it with the lags' model,
-    which follows the path's own curvature, `delay_predictor.py`; else 0).
+    which follows the path's own curvature, `delay_predictor.py`; else 0); reference_curvature: the curvature the
+    reference pose moves on (NaN: the path's there).
     The feed-forward: dkappa/ds of the path speed x feedforward_time_s ahead of the foot point, averaged over
     window_m, over K."""
     lead = min(reference_lead_s, prediction_time_s)
@@ -105,6 +107,8 @@ def two_degree_of_freedom_rate(
         rk = value_at(path_curvature, s_ref, spacing, length, closed)
     else:
         rx, ry, rh, rk = here[2], here[3], here[4], here[5]
+    if not math.isnan(reference_curvature):
+        rk = reference_curvature
     rx, ry, rh = along_arc(rx, ry, rh, rk, speed_mps * (prediction_time_s - lead))
     reference_kdot = fit_kernel(rx, ry, rh, rk, target_x, target_y, REFERENCE_KDOT_MAX)[0]
     s_ff, half = here[0] + speed_mps * feedforward_time_s, 0.5 * window_m
@@ -114,6 +118,32 @@ def two_degree_of_freedom_rate(
     ) / window_m
     feedforward /= steady_state_gain
     return vehicle_kdot - reference_kdot + feedforward, reference_kdot, feedforward
+
+
+@njit(cache=True)
+def previewed_curvature(
+    path_curvature: np.ndarray,
+    spacing: float,
+    length: float,
+    closed: bool,
+    s_m: float,
+    speed_mps: float,
+    preview_s: float,
+    first_s: float,
+    second_s2: float,
+    window_m: float,
+) -> tuple[float, float]:  # pragma: no cover - compiled
+    """(kappa + first_s dkappa/dt + second_s2 d2kappa/dt2 1/m, dkappa/ds 1/m^2) of the path speed x preview_s ahead
+    of s_m, with d/dt = V d/ds at the speed V now (the speed's own change is left out); the derivatives are central
+    differences over window_m (dkappa/ds the mean slope over the window, d2kappa/ds2 the second difference over half
+    of it), so a clothoid's corner in curvature rate is spread over the window, not a one-step impulse."""
+    s, half = s_m + speed_mps * preview_s, 0.5 * window_m
+    ahead = value_at(path_curvature, s + half, spacing, length, closed)
+    middle = value_at(path_curvature, s, spacing, length, closed)
+    behind = value_at(path_curvature, s - half, spacing, length, closed)
+    slope = (ahead - behind) / window_m
+    second = (ahead - 2.0 * middle + behind) / (half * half)
+    return middle + first_s * speed_mps * slope + second_s2 * speed_mps * speed_mps * second, slope
 
 
 @njit(cache=True)
@@ -138,18 +168,12 @@ def lag_inverse_curvature(
 
         u(t) = (kappa_p + 2 zeta / wn dkappa_p/dt + 1 / wn^2 d2kappa_p/dt^2)(t + T) / K,
 
-    with d/dt = V d/ds at the speed V now (the speed's own change is left out). The path is read speed x T ahead
-    of the foot point s_m (T: dead_time_s, the lag's delay plus any known delay); its derivatives are central
-    differences over window_m (dkappa/ds the mean slope over the window, d2kappa/ds2 the second difference over
-    half of it), so a clothoid's corner in curvature rate is spread over the window, not a one-step impulse.
-    omega_n_rad_s NaN (no identified lag): the path's curvature there, over K."""
-    s, half = s_m + speed_mps * dead_time_s, 0.5 * window_m
-    ahead = value_at(path_curvature, s + half, spacing, length, closed)
-    middle = value_at(path_curvature, s, spacing, length, closed)
-    behind = value_at(path_curvature, s - half, spacing, length, closed)
-    slope = (ahead - behind) / window_m
-    curvature = middle
+    read along the path from the foot point s_m by `previewed_curvature` (T: dead_time_s, the lag's delay plus any
+    known delay). omega_n_rad_s NaN (no identified lag): the path's curvature there, over K."""
+    first = second = 0.0
     if not math.isnan(omega_n_rad_s):
-        second = (ahead - 2.0 * middle + behind) / (half * half)
-        curvature += 2.0 * zeta / omega_n_rad_s * speed_mps * slope + (speed_mps / omega_n_rad_s) ** 2 * second
+        first, second = 2.0 * zeta / omega_n_rad_s, 1.0 / (omega_n_rad_s * omega_n_rad_s)
+    curvature, slope = previewed_curvature(
+        path_curvature, spacing, length, closed, s_m, speed_mps, dead_time_s, first, second, window_m
+    )
     return curvature / steady_state_gain, slope / steady_state_gain

@@ -22,7 +22,7 @@ from controllers.clothoid import delay_predictor as dp
 from controllers.clothoid.lead_filter import lead_step
 from controllers.clothoid.lookahead import adaptive_search, evaluate_candidate, evaluated, turn_limited_lookahead
 from controllers.clothoid.lookahead_filter import filtered_lookahead
-from controllers.clothoid.path_feedforward import lag_inverse_curvature, two_degree_of_freedom_rate
+from controllers.clothoid.path_feedforward import lag_inverse_curvature, previewed_curvature, two_degree_of_freedom_rate
 from controllers.clothoid.pose_prediction import along_arc
 from controllers.clothoid.speed_tables import table_row
 from workbench.base.path_search import TRACK_OUT_SIZE, track
@@ -40,8 +40,9 @@ KAPPA0_YAW_RATE, KAPPA0_COMMAND, KAPPA0_STEERING = 0, 1, 2
     P_KDOT_MAX, P_FEEDFORWARD, P_FEEDFORWARD_WINDOW, P_FEEDFORWARD_TIME, P_REFERENCE_LEAD, P_HYSTERESIS,
     P_MAX_GROWTH, P_MAX_SHRINK, P_MIN_SPEED, P_BAND_KMH, P_BAND_HYSTERESIS_KMH, P_PATH_SPACING, P_PATH_LENGTH,
     P_PATH_EXTENT, P_TRACKER_WINDOW, P_PATH_MAX_SEGMENT, P_WARM_SEARCH, P_DELAY_MODEL, P_FEEDFORWARD_INVERSION,
-) = range(40)  # fmt: skip
-PARAM_COUNT = 40
+    P_LAG_MODEL_REFERENCE,
+) = range(41)  # fmt: skip
+PARAM_COUNT = 41
 
 # The step's own state (`state`).
 S_KAPPA_CMD = 0  # the integrator's curvature command (1/m; NaN before the first step)
@@ -103,6 +104,42 @@ def feedforward_timing(
     if math.isnan(ref):
         ref = min(max(path_delay - measured_delay, 0.0), params[P_HORIZON])
     return min(ff, 5.0), min(ref, 5.0), gain
+
+
+@njit(cache=True)
+def reference_curvature(
+    path_curvature: np.ndarray,
+    spacing: float,
+    length: float,
+    closed: bool,
+    s_m: float,
+    speed_mps: float,
+    lags: np.ndarray,
+    measured_lags: np.ndarray,
+    lag_speeds: np.ndarray,
+    window_m: float,
+    rows: np.ndarray,
+) -> float:  # pragma: no cover - compiled
+    """The measured (yaw-rate) curvature kappa(0) of a vehicle that follows the path exactly, at the path's arc
+    length s_m (`ClothoidConfig.lag_model_reference`): the measured lag driven by the steering that inverts the path
+    lag, Km Gm(s) e^(-Tm s) / (Kp Gp(s) e^(-Tp s)) on the path's curvature, with Gm / Gp = (1 + a_p s + b_p s^2) /
+    (1 + a_m s + b_m s^2) (a = 2 zeta / wn, b = 1 / wn^2) to second order in s: the curvature Tp - Tm ahead plus
+    (a_p - a_m) and (b_p - b_m - a_m (a_p - a_m)) times its first and second time derivatives, times Km / Kp
+    (`path_feedforward.previewed_curvature`). Without a measured lag: the path's curvature at s_m. rows: 8 floats
+    of scratch (the two lags' rows at this speed)."""
+    path_lag, measured_lag = rows[:4], rows[4:8]
+    table_row(lag_speeds, lags, speed_mps * 3.6, False, path_lag)
+    if measured_lags.shape[0] == 0:
+        return previewed_curvature(path_curvature, spacing, length, closed, s_m, speed_mps, 0.0, 0.0, 0.0, window_m)[0]
+    table_row(lag_speeds, measured_lags, speed_mps * 3.6, False, measured_lag)
+    a_p, b_p = 2.0 * path_lag[1] / path_lag[0], 1.0 / (path_lag[0] * path_lag[0])
+    a_m, b_m = 2.0 * measured_lag[1] / measured_lag[0], 1.0 / (measured_lag[0] * measured_lag[0])
+    first = a_p - a_m
+    curvature = previewed_curvature(
+        path_curvature, spacing, length, closed, s_m, speed_mps, path_lag[2] - measured_lag[2], first,
+        b_p - b_m - a_m * first, window_m,
+    )[0]  # fmt: skip
+    return curvature * measured_lag[3] / path_lag[3]
 
 
 @njit(cache=True)
@@ -265,10 +302,20 @@ def clothoid_step(
         ff_time, reference_lead, gain = feedforward_timing(
             speed, p, lags, measured_lags, lag_speeds, schedule, schedule_speeds, scratch[:4]
         )
-        kdot, reference_kdot, feedforward_kdot = two_degree_of_freedom_rate(
-            kdot, path_x, path_y, path_heading, path_curvature, spacing, length, closed, foot, tx, ty, speed,
-            horizon, ff_time, reference_lead, gain, p[P_FEEDFORWARD_WINDOW], p[P_HORIZON] - horizon,
-        )  # fmt: skip
+        if inverting and p[P_LAG_MODEL_REFERENCE] != 0.0 and lags.shape[0] > 0:
+            reference_kappa = reference_curvature(
+                path_curvature, spacing, length, closed, foot[0] + speed * (p[P_HORIZON] - horizon), speed, lags,
+                measured_lags, lag_speeds, p[P_FEEDFORWARD_WINDOW], scratch[LAG_ROWS : LAG_ROWS + 8],
+            )  # fmt: skip
+            kdot, reference_kdot, feedforward_kdot = two_degree_of_freedom_rate(
+                kdot, path_x, path_y, path_heading, path_curvature, spacing, length, closed, foot, tx, ty, speed,
+                horizon, ff_time, 0.0, gain, p[P_FEEDFORWARD_WINDOW], p[P_HORIZON] - horizon, reference_kappa,
+            )  # fmt: skip
+        else:
+            kdot, reference_kdot, feedforward_kdot = two_degree_of_freedom_rate(
+                kdot, path_x, path_y, path_heading, path_curvature, spacing, length, closed, foot, tx, ty, speed,
+                horizon, ff_time, reference_lead, gain, p[P_FEEDFORWARD_WINDOW], p[P_HORIZON] - horizon,
+            )  # fmt: skip
         if inverting:  # the lag inverted, added after the lead filter; the integrator holds the feedback alone
             kdot = clothoid_kdot - reference_kdot
             omega_n, zeta, dead_time = math.nan, 1.0, 0.0

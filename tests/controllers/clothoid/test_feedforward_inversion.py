@@ -103,3 +103,32 @@ def test_the_feedback_loop_and_its_floor_are_unchanged() -> None:
         controller.reset(path, 0.02)
     assert on.loop_settings(30.0) == off.loop_settings(30.0)
     assert on.lookahead_floor_m(30.0 / 3.6) == off.lookahead_floor_m(30.0 / 3.6) > 5.0
+
+
+def test_the_lag_model_reference_needs_the_inversion() -> None:
+    assert ClothoidConfig().lag_model_reference is False
+    with pytest.raises(WorkbenchInputError, match=r"lag_model_reference .*feedforward_inversion = true; got"):
+        ClothoidConfig(lag_model_reference=True)
+    ClothoidConfig(lag_model_reference=True, feedforward_inversion=True)
+
+
+def _reference(curvature: np.ndarray, s_m: float, measured: np.ndarray) -> float:
+    path_lag = np.array([[20.0, 1.5, 0.25, 0.9]])  # wn, zeta, delay, K
+    return sk.reference_curvature(
+        curvature, SPACING_M, float(S_GRID[-1]), False, s_m, 8.0, path_lag, measured, np.array([30.0]), 2.0,
+        np.empty(8),
+    )  # fmt: skip
+
+
+def test_the_reference_curvature_is_the_measured_lag_of_the_inverted_path_lag() -> None:
+    """kappa = a s^2: Km / Kp (kappa + c1 dkappa/dt + c2 d2kappa/dt2) Tp - Tm ahead, c1 = a_p - a_m,
+    c2 = b_p - b_m - a_m c1 (a = 2 zeta / wn, b = 1 / wn^2); without a measured lag the path's curvature there."""
+    a = 1e-5
+    curvature = a * S_GRID**2
+    measured = np.array([[10.0, 0.8, 0.05, 0.95]])
+    a_p, b_p, a_m, b_m = 2 * 1.5 / 20.0, 1 / 20.0**2, 2 * 0.8 / 10.0, 1 / 10.0**2
+    s = 40.4 + 8.0 * (0.25 - 0.05)  # 42 m: on the grid, where the interpolated quadratic is exact
+    c1, c2 = a_p - a_m, b_p - b_m - a_m * (a_p - a_m)
+    expected = 0.95 / 0.9 * (a * s**2 + c1 * 8.0 * 2 * a * s + c2 * 8.0**2 * 2 * a)
+    assert _reference(curvature, 40.4, measured) == pytest.approx(expected, rel=1e-9)
+    assert _reference(curvature, 40.0, np.zeros((0, 4))) == pytest.approx(a * 40.0**2, rel=1e-12)
