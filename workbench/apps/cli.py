@@ -836,7 +836,8 @@ def _optimise(args: argparse.Namespace) -> int:
 #: The leaderboard's columns `workbench tournament` prints (the report has them all).
 _LEADERBOARD_COLUMNS = (
     "rank", "controller", "trial", "score", "score_low", "score_high", "default_score", "failed_fraction",
-    "max_abs_cte_m", "rms_steer_rate_deg_s", "step_time_p99_us", "cpu_time_s", "not_distinguishable_from",
+    "max_abs_cte_on_path_m", "max_abs_cte_m", "rms_cte_m", "rms_steer_rate_deg_s", "step_time_median_us",
+    "step_time_p99_us", "cpu_time_s", "not_distinguishable_from",
 )  # fmt: skip
 
 

@@ -49,7 +49,7 @@ from workbench.apps.studies.runner import build_controller_config
 from workbench.apps.studies.spec import PlannedRun
 from workbench.apps.studies.store import RunStore, write_results
 from workbench.apps.studies.sweep import execute_runs
-from workbench.apps.studies.tournament_spec import TournamentSpec, case_id
+from workbench.apps.studies.tournament_spec import DEFAULT_OFF_PATH_M, TournamentSpec, case_id
 from workbench.base.errors import value_text
 from workbench.vehicles import VEHICLES
 from workbench.vehicles.presets import load_vehicle
@@ -70,22 +70,28 @@ class TournamentIsolationError(RuntimeError):
     """A training trial ran a test case: the test set was not held out (a defect, never an input error)."""
 
 
-def run_failure(row: Mapping[str, Any]) -> str:
+def run_failure(row: Mapping[str, Any], off_path_m: float = DEFAULT_OFF_PATH_M) -> str:
     """Why a run counts as failed in a tournament, "" when it did not: it did not complete (its status and
-    message), it left the track, or its steering limit-cycled."""
+    message), it left the track, it went more than off_path_m (m) off the path once on it (`max_abs_cte_on_path_m`),
+    or its steering limit-cycled."""
     if row["status"] != "completed":
         return f"did not complete ({row['status']}: {row['message']})"
     if row.get("left_track"):
         return f"left the track (least margin {value_text(row.get('min_track_margin_m'))} m)"
+    off = row.get("max_abs_cte_on_path_m")
+    if off is not None and off > off_path_m:
+        return f"left the path (max |CTE| once on it {value_text(off)} m > {off_path_m:g} m)"
     if row.get("limit_cycle"):
         hz, deg = (value_text(row.get(k)) for k in ("limit_cycle_hz", "limit_cycle_amplitude_deg"))
         return f"limit cycle ({hz} Hz, {deg} deg)"
     return ""
 
 
-def trial_objectives(rows: Sequence[Mapping[str, Any]], objectives: Sequence[str]) -> tuple[list[float] | None, str]:
-    """(each objective's mean over a trial's runs, "") or (None, why the trial failed)."""
-    failures = [(row, why) for row in rows if (why := run_failure(row))]
+def trial_objectives(
+    rows: Sequence[Mapping[str, Any]], objectives: Sequence[str], off_path_m: float = DEFAULT_OFF_PATH_M
+) -> tuple[list[float] | None, str]:
+    """(each objective's mean over a trial's runs, "") or (None, why the trial failed: `run_failure`)."""
+    failures = [(row, why) for row in rows if (why := run_failure(row, off_path_m))]
     if failures:
         row, why = failures[0]
         return None, f"{len(failures)} of {len(rows)} runs failed (e.g. {case_id(row)}: {why})"
@@ -254,7 +260,7 @@ def _tune(
         start = 0
         for trial, plan in zip(batch, plans, strict=True):
             trial_rows, start = batch_rows[start : start + len(plan)], start + len(plan)
-            values, reason = trial_objectives(trial_rows, spec.objectives)
+            values, reason = trial_objectives(trial_rows, spec.objectives, spec.off_path_m)
             if values is None:
                 study.tell(trial, state=optuna.trial.TrialState.FAIL)
             else:
@@ -272,9 +278,9 @@ def _tune(
             entry["params_json"] = json.dumps(trial.params, sort_keys=True, default=str)
             entry["cpu_time_s"] = float(sum(r.get("cpu_time_s") or 0.0 for r in trial_rows))
             entry["runs"] = len(trial_rows)
-            entry["failed_runs"] = sum(bool(run_failure(r)) for r in trial_rows)
+            entry["failed_runs"] = sum(bool(run_failure(r, spec.off_path_m)) for r in trial_rows)
             history.append(entry)
-            rows += [_annotated(r, TRAIN, TRIAL, trial.number) for r in trial_rows]
+            rows += [_annotated(r, spec, TRAIN, TRIAL, trial.number) for r in trial_rows]
     front = pareto_front(points)
     chosen = min(front, key=lambda t: (weighted(points[t], spec.objectives, spec.selection), t)) if front else None
     # the default (trial 0) and the chosen trial are judged under their own names: carried are the front's others
@@ -286,9 +292,11 @@ def _tune(
     return _Tuning(history, rows, params, chosen, carried, ran)
 
 
-def _annotated(row: Mapping[str, Any], set_name: str, config: str, trial: int, command: str | None = None) -> dict:
+def _annotated(
+    row: Mapping[str, Any], spec: TournamentSpec, set_name: str, config: str, trial: int, command: str | None = None
+) -> dict:
     """A runner's row with the tournament's columns: set, config, trial, case, failed, failure and command."""
-    failure = run_failure(row)
+    failure = run_failure(row, spec.off_path_m)
     return (
         {"set": set_name, "config": config, "trial": trial, "case": case_id(row)}
         | dict(row)
@@ -385,7 +393,7 @@ def run_tournament(
             for judged, plan in zip(configs, plans, strict=True):
                 for run, row in zip(plan, test_rows[start : start + len(plan)], strict=True):
                     command = run_command(run, judged.files[run.vehicle])
-                    rows.append(_annotated(row, TEST, judged.config, judged.trial, command))
+                    rows.append(_annotated(row, spec, TEST, judged.config, judged.trial, command))
                 start += len(plan)
     finally:
         if started_here:

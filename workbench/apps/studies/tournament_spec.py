@@ -3,10 +3,10 @@ test set they are judged on, the trial budget each gets alike, the objectives, a
 controller's chosen configuration and rank the controllers.
 
 Tables: [tournament] (controllers, vehicles, trials, batch_size, seed, objectives, selection, ranking,
-failure_score, front_points, inform_delays, max_runs, track_file, description), [train] and [test] (scenarios,
-speeds_kmh, conditions, seeds: a set's cases are their product with the vehicles; circuit_ranges: a file whose
-[circuits] table the set's generated circuits are drawn within, the run parameter of that name, which may be the
-spec itself when it carries the table), [circuits] (`workbench.simulation.circuit_ranges`), [search.NAME] (a
+failure_score, off_path_m, front_points, inform_delays, max_runs, track_file, description), [train] and [test]
+(scenarios, speeds_kmh, conditions, seeds: a set's cases are their product with the vehicles; circuit_ranges: a
+file whose [circuits] table the set's generated circuits are drawn within, the run parameter of that name, which
+may be the spec itself when it carries the table), [circuits] (`workbench.simulation.circuit_ranges`), [search.NAME] (a
 controller's search space: its own, `controllers.search_space.controller_search_space`, with the table's entries
 over it, key by key) and [fixed.NAME] (options fixed for every run of a controller). README.md ("Tournament") shows
 an annotated example.
@@ -58,6 +58,7 @@ TOURNAMENT_KEYS = (
     "selection",
     "ranking",
     "failure_score",
+    "off_path_m",
     "front_points",
     "inform_delays",
     "max_runs",
@@ -80,6 +81,11 @@ DEFAULT_RANKING = DEFAULT_SELECTION
 #: The ranking scalar of a failed run unless the spec states another: 30, the |CTE| (m) at which a run has left
 #: the path (`SimulationConfig.max_abs_cte_m`), worse than any run that stays on it.
 DEFAULT_FAILURE_SCORE = 30.0
+#: A run whose |CTE| once on the path (`max_abs_cte_on_path_m`) exceeds this (m) has left the path and fails, unless
+#: the spec states another bound: with its reference point 1 m off the path, the truck's 2.59 m outline reaches past
+#: the edge of a 3.5 m lane centred on the path (1 + 1.3 > 1.75 m). The simulator's own bound (30 m, the run stops)
+#: is for a run that has lost the path altogether, and a path without track widths has no track to leave.
+DEFAULT_OFF_PATH_M = 1.0
 #: The most front points carried to the test set per controller, and the default.
 MAX_FRONT_POINTS = 5
 #: Trials asked and run together unless the spec says: part of the spec, so any backend gives the same trials.
@@ -228,6 +234,7 @@ class TournamentSpec:
     selection: Mapping[str, float] | None = None
     ranking: Mapping[str, float] | None = None
     failure_score: float = DEFAULT_FAILURE_SCORE
+    off_path_m: float = DEFAULT_OFF_PATH_M
     front_points: int = MAX_FRONT_POINTS
     inform_delays: bool = True
     search_tables: Mapping[str, Mapping[str, Any]] = field(default_factory=dict)
@@ -300,6 +307,10 @@ class TournamentSpec:
             self, "ranking", MappingProxyType(_weights("ranking", self.ranking, OBJECTIVE_METRICS, DEFAULT_RANKING))
         )
         object.__setattr__(self, "failure_score", typed_value("tournament.failure_score", self.failure_score, float))
+        off_path = typed_value("tournament.off_path_m", self.off_path_m, float)
+        if not off_path > 0:
+            raise WorkbenchInputError(f"tournament.off_path_m must be > 0 m; got {value_text(self.off_path_m)}")
+        object.__setattr__(self, "off_path_m", off_path)
 
     def _check_controllers(self) -> None:
         controllers = self.controllers
@@ -485,8 +496,8 @@ class TournamentSpec:
     def ranking_text(self) -> str:
         """The ranking scalar of a test run in words."""
         return (
-            f"{weights_text(self.ranking)} per test run; a failed run (did not complete, left the track, limit "
-            f"cycle) scores {self.failure_score:g}"
+            f"{weights_text(self.ranking)} per test run; a failed run (did not complete, left the track, more than "
+            f"{self.off_path_m:g} m off the path once on it, limit cycle) scores {self.failure_score:g}"
         )
 
     def solve_budget_text(self) -> str:
@@ -588,6 +599,7 @@ def tournament_from_document(
 __all__ = [
     "DEFAULT_FAILURE_SCORE",
     "DEFAULT_OBJECTIVES",
+    "DEFAULT_OFF_PATH_M",
     "DEFAULT_RANKING",
     "DEFAULT_SELECTION",
     "MAX_FRONT_POINTS",

@@ -248,6 +248,9 @@ def test_trial_objectives_and_failures() -> None:
     off = ok | {"status": "left_path", "message": "|CTE| > 30 m"}
     assert run_failure(off) == "did not complete (left_path: |CTE| > 30 m)"
     assert run_failure(ok | {"left_track": True, "min_track_margin_m": -0.5}) == "left the track (least margin -0.5 m)"
+    wide = ok | {"max_abs_cte_on_path_m": 1.5}
+    assert run_failure(wide) == "left the path (max |CTE| once on it 1.5 m > 1 m)"
+    assert run_failure(wide, off_path_m=2.0) == "" and run_failure(ok | {"max_abs_cte_on_path_m": 1.0}) == ""
     cycle = ok | {"limit_cycle": True, "limit_cycle_hz": 2.5, "limit_cycle_amplitude_deg": 1.0}
     assert run_failure(cycle) == "limit cycle (2.5 Hz, 1.0 deg)"
     values, reason = trial_objectives([ok, cycle], ["rms_cte_m"])

@@ -110,12 +110,15 @@ softening_mps = 2.0
         ),
         (
             ("trials = 3", "trials = 3\nselection = {max_ltr = 1.0}"),
-            "unknown metric tournament.selection.max_ltr; allowed: rms_cte_m, max_abs_cte_on_path_m, rms_steer_rate_deg_s",
+            "unknown metric tournament.selection.max_ltr; allowed: rms_cte_m, max_abs_cte_on_path_m, "
+            "rms_steer_rate_deg_s",
         ),
         (
             ("trials = 3", "trials = 3\nranking = {max_abs_cte_m = -1.0}"),
             "tournament.ranking.max_abs_cte_m must be a weight >= 0; got -1",
         ),
+        (("trials = 3", "trials = 3\noff_path_m = 0.0"), "tournament.off_path_m must be > 0 m; got 0"),
+        (("trials = 3", "trials = 3\noff_path_m = nan"), "tournament.off_path_m"),
         (("speeds_kmh = [30]", "speeds_kmh = [-30]"), "test.speeds_kmh must be > 0 km/h; got -30"),
         (('scenarios = ["fig17"]', 'scenarios = ["nowhere"]'), "test.scenarios: unknown name 'nowhere'"),
         (("trials = 3", "trials = 3\nmax_runs = 10"), "the tournament plans up to 38 runs"),
