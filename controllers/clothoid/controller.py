@@ -340,14 +340,14 @@ class ClothoidConfig:
             )
         if self.feedforward_inversion and not self.path_feedforward:
             raise WorkbenchInputError(
-                "feedforward_inversion inverts the lag for the two-degree-of-freedom form's feed-forward and needs "
-                "path_feedforward = true; got path_feedforward = false: set path_feedforward = true or "
-                "feedforward_inversion = false"
+                f"feedforward_inversion = {value_text(self.feedforward_inversion)} inverts the lag for the "
+                "two-degree-of-freedom form's feed-forward and needs path_feedforward = true; got path_feedforward = "
+                "false: set path_feedforward = true or feedforward_inversion = false"
             )
         if self.lag_model_reference and not self.feedforward_inversion:
             raise WorkbenchInputError(
-                "lag_model_reference drives the measured lag with the inverted lag's feed-forward and needs "
-                "feedforward_inversion = true; got feedforward_inversion = false"
+                f"lag_model_reference = {value_text(self.lag_model_reference)} drives the measured lag with the "
+                "inverted lag's feed-forward and needs feedforward_inversion = true; got feedforward_inversion = false"
             )
         if self.max_lookahead_m < self.min_lookahead_m:
             raise WorkbenchInputError(
