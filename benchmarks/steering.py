@@ -70,6 +70,10 @@ VEHICLES = ("tractor-semitrailer", "dynamic-bicycle", "kinematic-bicycle", "comm
 GOAL_VEHICLES = ("tractor-semitrailer", "dynamic-bicycle")
 TRUCK = "tractor-semitrailer"
 CONDITION_NAMES = ("ideal", "automotive")
+#: Reported vehicles run under these conditions only: CommonRoad's multi-body car is a pure-Python plant, about 77 %
+#: of the whole benchmark's CPU when run under both (a Zandvoort lap 140-170 s), and it carries no goal; under
+#: `ideal` alone the full --check stays within 30 minutes on 2 cores.
+REPORTED_ONLY_CONDITIONS = {"commonroad-mb": ("ideal",)}
 NAMED_SCENARIOS = ("dlc", "figure8", "fig17", "zandvoort")
 DEVELOPMENT, HELD_OUT, NAMED = "development", "held-out", "named"
 #: The circuits one may look at while changing the controller.
@@ -165,7 +169,8 @@ def circuit_scenarios(sets: tuple[str, ...], quick: bool = False) -> list[tuple[
 def plan(vehicles: tuple[str, ...], conditions: tuple[str, ...], scenarios: tuple[str, ...], track: str | None,
          held_out: bool = True, quick: bool = False) -> list[Job]:  # fmt: skip
     """Every run, both controllers, the longest first. `held_out` False (or `quick`) leaves the held-out circuits
-    out; `quick` narrows to QUICK_SEEDS, QUICK_SCENARIOS and QUICK_VEHICLES. zandvoort needs `track`."""
+    out; `quick` narrows to QUICK_SEEDS, QUICK_SCENARIOS and QUICK_VEHICLES; a vehicle of REPORTED_ONLY_CONDITIONS
+    runs under those conditions only. zandvoort needs `track`."""
     sets = tuple(s for s in (DEVELOPMENT, HELD_OUT) if s in scenarios and (held_out or s != HELD_OUT))
     named = [s for s in NAMED_SCENARIOS if s in scenarios and (not quick or s in QUICK_SCENARIOS)]
     pairs = [(s, NAMED) for s in named if s != "zandvoort" or track] + circuit_scenarios(sets, quick)
@@ -174,6 +179,7 @@ def plan(vehicles: tuple[str, ...], conditions: tuple[str, ...], scenarios: tupl
         Job(v, c, s, scenario_set, controller, track if s == "zandvoort" else None)
         for v in chosen
         for c in conditions
+        if c in REPORTED_ONLY_CONDITIONS.get(v, (c,))
         for s, scenario_set in pairs
         for controller in ("clothoid", "nmpc")
     ]

@@ -61,6 +61,9 @@ def test_the_plan_leaves_the_held_out_circuits_out_when_asked(steering) -> None:
     quick = steering.plan(steering.VEHICLES, ("ideal", "automotive"), everything, "track.csv", quick=True)
     assert {j.scenario for j in quick} == {"dlc", "figure8"} | {f"circuit:{s}" for s in steering.QUICK_SEEDS}
     assert {j.vehicle for j in quick} == set(steering.GOAL_VEHICLES)
+    both = steering.plan(steering.VEHICLES, ("ideal", "automotive"), ("dlc",), None)
+    assert {(j.vehicle, j.conditions) for j in both if j.vehicle == "commonroad-mb"} == {("commonroad-mb", "ideal")}
+    assert {j.conditions for j in both if j.vehicle in steering.GOAL_VEHICLES} == {"ideal", "automotive"}
     no_track = steering.plan(vehicles, conditions, ("zandvoort", "dlc"), None)
     assert {j.scenario for j in no_track} == {"dlc"}
 
