@@ -4,26 +4,10 @@ circuits are refused, and the summary's arithmetic (gap to the NMPC closed, rati
 from __future__ import annotations
 
 import dataclasses
-import importlib.util
-import sys
-from pathlib import Path
 
 import pytest
 
 from workbench.vehicles import make_vehicle
-
-#: The benchmark is a script, not a package: loaded from its file (the repository's root is two levels up).
-SCRIPT = Path(__file__).resolve().parents[2] / "benchmarks" / "cte_breakdown.py"
-
-
-@pytest.fixture(scope="module")
-def breakdown():
-    spec = importlib.util.spec_from_file_location("benchmark_cte_breakdown", SCRIPT)
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = module  # dataclasses look their module up while being built
-    spec.loader.exec_module(module)
-    yield module
-    del sys.modules[spec.name]
 
 
 def _changed(vehicle_name: str, plant) -> dict[str, object]:

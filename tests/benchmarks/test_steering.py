@@ -3,26 +3,10 @@ held-out one left out by --no-held-out and --quick), and the goal arithmetic on 
 
 from __future__ import annotations
 
-import importlib.util
 import json
 import math
-import sys
-from pathlib import Path
 
 import pytest
-
-#: The benchmark is a script, not a package: loaded from its file (the repository's root is two levels up).
-SCRIPT = Path(__file__).resolve().parents[2] / "benchmarks" / "steering.py"
-
-
-@pytest.fixture(scope="module")
-def steering():
-    spec = importlib.util.spec_from_file_location("benchmark_steering", SCRIPT)
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = module  # dataclasses look their module up while being built
-    spec.loader.exec_module(module)
-    yield module
-    del sys.modules[spec.name]
 
 
 def _run(steering, controller: str, cte_m: float, *, vehicle: str = "tractor-semitrailer", scenario: str = "dlc",

@@ -12,6 +12,17 @@ import pandas as pd
 from workbench.apps.studies import TIMING_COLUMNS, PlannedRun, execute_run
 from workbench.apps.studies.runner import failed_row
 
+#: Small tight circuits (no trailer to make room for): 150-400 m laps of 12-20 m turns.
+SMALL_CIRCUITS = """[circuits]
+min_radius_m = 12.0
+max_radius_m = 20.0
+max_curvature_rate_1pm2 = 0.02
+offtracking_length_m = 0.0
+clearance_m = 14.0
+min_length_m = 150.0
+max_length_m = 400.0
+"""
+
 #: Pure pursuit and the clothoid controller on the kinematic car through the dlc at two speeds, started 0.3 m off
 #: the path; the clothoid runs with min_lookahead_m = 30 and max_lookahead_m = 20 fail (a combination: each value
 #: alone is planned in runs that complete): 10 runs, 2 errors.

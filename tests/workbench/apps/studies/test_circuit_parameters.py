@@ -8,22 +8,13 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
+from study_helpers import SMALL_CIRCUITS as SMALL
 from study_helpers import write_spec
 
 from workbench.apps.studies import load_spec
 from workbench.apps.studies.runner import simulate
 from workbench.base.errors import WorkbenchInputError
 
-#: Small tight circuits (no trailer to make room for): 150-400 m laps of 12-20 m turns.
-SMALL = """[circuits]
-min_radius_m = 12.0
-max_radius_m = 20.0
-max_curvature_rate_1pm2 = 0.02
-offtracking_length_m = 0.0
-clearance_m = 14.0
-min_length_m = 150.0
-max_length_m = 400.0
-"""
 #: Turns of 5-7 m: tighter than the tractor-semitrailer's lock.
 TIGHT = """[circuits]
 min_radius_m = 5.0

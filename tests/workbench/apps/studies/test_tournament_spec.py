@@ -6,7 +6,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-from study_helpers import write_spec
+from study_helpers import SMALL_CIRCUITS, write_spec
 
 from controllers import CONTROLLERS
 from controllers.search_space import controller_search_space
@@ -174,16 +174,6 @@ def test_the_cli_refuses_a_bad_spec_in_one_line(tmp_path: Path, capsys: pytest.C
     assert len(err.strip().splitlines()) == 1
 
 
-#: Small tight circuits (no trailer to make room for): 150-400 m laps of 12-20 m turns.
-SMALL_CIRCUITS = """[circuits]
-min_radius_m = 12.0
-max_radius_m = 20.0
-max_curvature_rate_1pm2 = 0.02
-offtracking_length_m = 0.0
-clearance_m = 14.0
-min_length_m = 150.0
-max_length_m = 400.0
-"""
 
 
 def test_a_set_draws_its_circuits_within_its_ranges_file(tmp_path: Path) -> None:
