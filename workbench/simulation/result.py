@@ -32,6 +32,8 @@ class Status(StrEnum):
     LEFT_PATH = "left_path"
     DIVERGED = "diverged"
     CONTROLLER_FAILED = "controller_failed"
+    #: The plant could not go on (`workbench.vehicles.base.PlantStepError`: an FMU plant's doStep failed).
+    PLANT_FAILED = "plant_failed"
 
 
 @dataclass(frozen=True, eq=False)

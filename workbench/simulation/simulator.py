@@ -5,9 +5,10 @@ steps the plant integrates `plant_rate_hz / controller_rate_hz` RK4 steps with t
 hold). One row of the trace is logged per controller step. The run ends when the vehicle reaches the end of an
 open path or completes the requested laps of a closed one; it stops early, keeping its partial trace and saying
 why, on a time-out, when the vehicle leaves the path (further than `max_abs_cte_m` from it, or beyond either end
-of an open path by more than `max_past_end_m`), when the plant state stops being finite, or when the controller
-fails. The logged CTE is the signed distance from the path, so beyond an open path's ends it is the distance to
-the end point, never the sideways offset from the end's tangent alone.
+of an open path by more than `max_past_end_m`), when the plant state stops being finite, when the plant fails a
+step (`PlantStepError`: an FMU plant's doStep), or when the controller fails. The logged CTE is the signed
+distance from the path, so beyond an open path's ends it is the distance to the end point, never the sideways
+offset from the end's tangent alone.
 """
 
 from __future__ import annotations
@@ -51,7 +52,7 @@ from workbench.simulation.step_kernel import (
     run_settings,
 )
 from workbench.simulation.track_margin import VehicleOutline
-from workbench.vehicles.base import VehicleModel
+from workbench.vehicles.base import PlantStepError, VehicleModel
 
 #: Spacing (m) of the points the speed profile is planned on (the paper plans on its waypoints).
 SPEED_PLAN_SPACING_M = 1.0
@@ -264,12 +265,17 @@ class Simulation:
                 rate = speed * path.speed_gradient(s_m) if cfg.speed_feedforward else 0.0
                 PISpeedController(speed_gains).step(float(path.speed(s_m)), speed, dt, rate)
             log.n = step + 1
-            if actuator is None:
-                state = advance(state, steer_cmd, accel_cmd, dt, substeps)
-                applied_cmd = steer_cmd
-            else:
-                for segment_substeps, applied_cmd in actuator.segments(steer_cmd):
-                    state = advance(state, applied_cmd, accel_cmd, dt * segment_substeps / substeps, segment_substeps)
+            try:
+                if actuator is None:
+                    state = advance(state, steer_cmd, accel_cmd, dt, substeps)
+                    applied_cmd = steer_cmd
+                else:
+                    for segment_substeps, applied_cmd in actuator.segments(steer_cmd):
+                        segment_s = dt * segment_substeps / substeps
+                        state = advance(state, applied_cmd, accel_cmd, segment_s, segment_substeps)
+            except PlantStepError as exc:  # a plant that cannot go on (an FMU's failed doStep) says why
+                status, message = Status.PLANT_FAILED, str(exc)
+                break
             if seen:
                 log.seen(measurement, applied_cmd, friction)
             t += dt

@@ -16,11 +16,14 @@ from workbench.vehicles.base import STANDARD_OUTPUTS, VehicleGeometry, VehicleMo
 from workbench.vehicles.commonroad_mb import CommonRoadMB, CommonRoadMBParams
 from workbench.vehicles.dynamic_bicycle import DynamicBicycle, DynamicBicycleParams
 from workbench.vehicles.kinematic_bicycle import KinematicBicycle, KinematicBicycleParams
-from workbench.vehicles.presets import MODEL_TYPES, list_presets, load_vehicle, preset_text
+from workbench.vehicles.presets import MODEL_TYPES, TEMPLATE_ONLY_TYPES, list_presets, load_vehicle, preset_text
 from workbench.vehicles.tractor_semitrailer import TractorSemitrailer, TractorSemitrailerParams
 
-#: name -> factory taking no arguments (the shipped preset of that name).
-VEHICLES: dict[str, Callable[[], VehicleModel]] = {name: partial(load_vehicle, name) for name in MODEL_TYPES}
+#: name -> factory taking no arguments (the shipped preset of that name); a model type that exists only as a user's
+#: vehicle file (`fmu`: TEMPLATE_ONLY_TYPES) has none.
+VEHICLES: dict[str, Callable[[], VehicleModel]] = {
+    name: partial(load_vehicle, name) for name in MODEL_TYPES if name not in TEMPLATE_ONLY_TYPES
+}
 
 
 def make_vehicle(

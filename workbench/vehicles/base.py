@@ -45,6 +45,11 @@ ROAD_FRICTION_RANGE: tuple[float, float] = (0.05, 1.5)
 MODELS_WITH_TYRES_TEXT = "dynamic-bicycle, tractor-semitrailer, commonroad-mb"
 
 
+class PlantStepError(WorkbenchInputError):
+    """A plant failed a step and cannot go on (an FMU plant's doStep returned an error): the message says when and
+    why. The simulator ends the run with status `plant_failed`; any other caller shows it as an error."""
+
+
 class VehicleModel(ABC):
     """A plant. Subclasses set `name`, `state_names`, `extra_output_names`, and in `__init__` `params` (a frozen
     dataclass with max_accel_mps2 and max_decel_mps2) and `_geometry`; they implement `advance` and `outputs`.

@@ -36,6 +36,8 @@ from workbench.base.typed_tables import check_keys, dataclass_from_table
 from workbench.vehicles.base import VehicleModel
 from workbench.vehicles.commonroad_mb import CommonRoadMB, CommonRoadMBParams
 from workbench.vehicles.dynamic_bicycle import DynamicBicycle, DynamicBicycleParams
+from workbench.vehicles.fmu_plant import FmuPlant
+from workbench.vehicles.fmu_plant_params import FmuPlantParams
 from workbench.vehicles.kinematic_bicycle import KinematicBicycle, KinematicBicycleParams
 from workbench.vehicles.tractor_semitrailer import TractorSemitrailer, TractorSemitrailerParams
 
@@ -45,7 +47,11 @@ MODEL_TYPES: dict[str, tuple[type[VehicleModel], type]] = {
     DynamicBicycle.name: (DynamicBicycle, DynamicBicycleParams),
     TractorSemitrailer.name: (TractorSemitrailer, TractorSemitrailerParams),
     CommonRoadMB.name: (CommonRoadMB, CommonRoadMBParams),
+    FmuPlant.name: (FmuPlant, FmuPlantParams),
 }
+#: Model types that exist only as a user's vehicle file (they wrap the user's own model, so nothing is shipped to
+#: run): `workbench vehicles --show NAME` prints the template workbench/presets/templates/NAME.toml.
+TEMPLATE_ONLY_TYPES: tuple[str, ...] = (FmuPlant.name,)
 #: The entry-point group in which an installed package registers vehicle models ("module:ModelClass").
 VEHICLE_ENTRY_POINTS = "lateral_workbench.vehicles"
 _TOP_KEYS = ("model", "parameters")
@@ -100,7 +106,10 @@ def list_presets() -> dict[str, str]:
 
 
 def preset_text(name: str) -> str:
-    """The TOML text of a preset (to copy and edit): a shipped file, or an installed model's defaults."""
+    """The TOML text of a preset (to copy and edit): a shipped file, an installed model's defaults, or the template
+    of a model type that exists only as a user's file (TEMPLATE_ONLY_TYPES)."""
+    if name in TEMPLATE_ONLY_TYPES:
+        return _preset_dir().joinpath("templates", f"{name}.toml").read_text(encoding="utf-8")
     if name not in list_presets():
         raise WorkbenchInputError(f"unknown vehicle preset {name!r}; choose one of {', '.join(list_presets())}")
     if name in INSTALLED_MODEL_TYPES:
@@ -116,21 +125,24 @@ def carries_payload(model_type: str) -> bool:
     return "payload_kg" in MODEL_TYPES[model_type][1].__dataclass_fields__
 
 
-def params_from_toml(text: str, source: str) -> tuple[str, Any]:
-    """Parse preset TOML text into (model type, params instance). `source` names the file in messages."""
+def params_from_toml(text: str, source: str, base_dir: Path | None = None) -> tuple[str, Any]:
+    """Parse preset TOML text into (model type, params instance). `source` names the file in messages; a relative
+    file path in it (an FMU's) is relative to `base_dir` (the vehicle file's folder)."""
     doc = check_keys(f"{source}: top level", parse_toml(text, source), _TOP_KEYS, _TOP_KEYS)
     model = check_keys(f"{source}: [model]", doc["model"], _MODEL_KEYS)
     kind = model.get("type")
     if kind not in MODEL_TYPES:
         raise WorkbenchInputError(f"{source}: [model] type must be one of {', '.join(MODEL_TYPES)}; got {kind!r}")
     try:
-        return kind, dataclass_from_table(MODEL_TYPES[kind][1], doc["parameters"], "[parameters]", required=True)
+        params = dataclass_from_table(MODEL_TYPES[kind][1], doc["parameters"], "[parameters]", base_dir, required=True)
+        return kind, params
     except WorkbenchInputError as exc:
         raise WorkbenchInputError(f"{source}: {exc}") from None
 
 
 def load_vehicle(name_or_file: str, payload_kg: float | None = None) -> VehicleModel:
     """Build a vehicle from a shipped preset name or a TOML file; payload_kg overrides the preset's payload."""
+    base_dir = None
     if name_or_file in list_presets():
         source = f"preset {name_or_file!r}"
         text = preset_text(name_or_file)
@@ -143,8 +155,12 @@ def load_vehicle(name_or_file: str, payload_kg: float | None = None) -> VehicleM
             )
         source = str(path)
         text = read_text(path, f"vehicle file {source}")
-    kind, params = params_from_toml(text, source)
-    model = MODEL_TYPES[kind][0](params)
+        base_dir = path.parent
+    kind, params = params_from_toml(text, source, base_dir)
+    try:
+        model = MODEL_TYPES[kind][0](params)
+    except WorkbenchInputError as exc:  # a model that checks more when built (an FMU against its mapping)
+        raise WorkbenchInputError(f"{source}: {exc}") from None
     return model if payload_kg is None else with_payload(model, payload_kg)
 
 
