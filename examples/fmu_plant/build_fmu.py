@@ -22,7 +22,8 @@ MODEL_FILE = HERE / "commonroad_st_plant.py"
 
 
 def build(out: Path, fmi_version: str = "2", slave: Path | None = None) -> Path:
-    """Build the FMU of `slave` (default: the example's slave for `fmi_version`) to the file `out`; its path."""
+    """Build the FMU of `slave` (default: the example's slave for `fmi_version`; another slave may import the
+    example's modules, which are packed beside it) to the file `out`; its path."""
     if fmi_version not in SLAVES:
         raise SystemExit(f"build_fmu: --fmi must be one of {', '.join(SLAVES)}; got {fmi_version!r}")
     if fmi_version == "2":
@@ -32,7 +33,9 @@ def build(out: Path, fmi_version: str = "2", slave: Path | None = None) -> Path:
     out = Path(out).resolve()
     out.parent.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory() as tmp:
-        built = FmuBuilder.build_FMU(slave or SLAVES[fmi_version], dest=tmp, project_files=[MODEL_FILE])
+        script = Path(slave or SLAVES[fmi_version])
+        extras = [MODEL_FILE] + ([SLAVES[fmi_version]] if script != SLAVES[fmi_version] else [])
+        built = FmuBuilder.build_FMU(script, dest=tmp, project_files=extras)
         shutil.move(str(built), out)
     return out
 

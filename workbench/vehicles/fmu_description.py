@@ -53,13 +53,13 @@ def read_fmu_interface(params: FmuPlantParams) -> FmuInterface:
                                   "the vehicle file's folder)")
     if not zipfile.is_zipfile(path):
         raise WorkbenchInputError(f"{where}: not an FMU (an FMU is a zip archive holding modelDescription.xml)")
+    version = _fmi_version(path, where)
+    if not version.startswith(FMI_VERSIONS):
+        raise WorkbenchInputError(f"{where}: FMI version {version!r}; the workbench steps FMI 2.0 and 3.0 FMUs")
     try:
         md = fmpy.read_model_description(str(path), validate=False)
     except Exception as exc:  # FMPy raises what its XML and zip readers raise: the file is not a usable FMU
         raise WorkbenchInputError(f"{where}: not a readable FMU ({type(exc).__name__}: {exc})") from None
-    version = str(md.fmiVersion)
-    if not version.startswith(FMI_VERSIONS):
-        raise WorkbenchInputError(f"{where}: FMI version {version!r}; the workbench steps FMI 2.0 and 3.0 FMUs")
     if md.coSimulation is None:
         kinds = [kind for kind, it in (("model exchange", md.modelExchange),) if it is not None]
         offered = f" (it offers {' and '.join(kinds)} only)" if kinds else ""
@@ -113,6 +113,20 @@ def read_fmu_interface(params: FmuPlantParams) -> FmuInterface:
         value_references=refs,
         description=str(md.description or md.modelName),
     )
+
+
+def _fmi_version(path: Path, where: str) -> str:
+    """The fmiVersion attribute of the FMU's modelDescription.xml (read before FMPy, which reads each version's
+    layout and fails on another's with messages that do not say so)."""
+    from xml.etree import ElementTree
+
+    try:
+        with zipfile.ZipFile(path) as archive, archive.open("modelDescription.xml") as xml:
+            for _, element in ElementTree.iterparse(xml, events=("start",)):
+                return str(element.get("fmiVersion"))
+    except (KeyError, OSError, zipfile.BadZipFile, ElementTree.ParseError) as exc:
+        raise WorkbenchInputError(f"{where}: not a readable FMU (no readable modelDescription.xml: {exc})") from None
+    raise WorkbenchInputError(f"{where}: not a readable FMU (an empty modelDescription.xml)")
 
 
 def _names_with(variables: dict, causalities: tuple[str, ...]) -> list[str]:
