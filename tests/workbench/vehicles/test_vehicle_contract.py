@@ -1,6 +1,7 @@
-"""The contract every registered vehicle meets (`workbench/vehicles/base.py`), parametrised over the registry:
-state and output layout, finite integration at rest and in motion, a straight line stays straight, standstill stays
-put, and steady cornering at low lateral acceleration agrees with the linear single track."""
+"""The contract every registered vehicle meets (`workbench/vehicles/base.py`), parametrised over the registry and a
+plant from an FMU (`fmu`: the example FMU of CommonRoad's single-track car, tests/conftest.py): state and output
+layout, finite integration at rest and in motion, a straight line stays straight, standstill stays put, and steady
+cornering at low lateral acceleration agrees with the linear single track."""
 
 from __future__ import annotations
 
@@ -11,7 +12,9 @@ import pytest
 
 from workbench.vehicles import STANDARD_OUTPUTS, VEHICLES, VehicleModel, make_vehicle
 
-NAMES = sorted(VEHICLES)
+#: The registry's vehicles, and a plant from an FMU (its vehicle file from the session's example FMU: FILES).
+NAMES = [*sorted(VEHICLES), "fmu"]
+FILES: dict[str, str] = {}
 G = 9.81
 DT, SUBSTEPS = 0.02, 20  # the simulator's defaults: 50 Hz controller, 1 kHz plant
 
@@ -37,9 +40,14 @@ def combos(speeds: tuple[float, ...], accels: tuple[float, ...]) -> list:
     ]
 
 
+@pytest.fixture(autouse=True, scope="module")
+def _fmu_vehicle_file(example_plant_fmus) -> None:
+    FILES["fmu"] = str(example_plant_fmus["2"])
+
+
 def vehicle(name: str) -> VehicleModel:
     if name not in _CACHE:
-        _CACHE[name] = make_vehicle(name)
+        _CACHE[name] = make_vehicle(vehicle_file=FILES[name]) if name in FILES else make_vehicle(name)
     return _CACHE[name]
 
 
@@ -139,6 +147,8 @@ def understeer_gradient_rad_per_mps2(model: VehicleModel) -> float:
         return p.understeer_gradient_rad_per_mps2  # (1 / k_f - 1 / k_r) / g; 0 for the preset (one tyre)
     if model.name == "tractor-semitrailer":  # the tractor: steer axle against drive group (kingpin load included)
         return (1.0 / p.front_cornering_coeff_per_rad - 1.0 / p.drive_cornering_coeff_per_rad) / G
+    if model.name == "fmu":  # the vehicle file's single track: CommonRoad's linear-tyre single track's (0)
+        return model.single_track().single_track.understeer_gradient_rad_per_mps2()
     return 0.0  # kinematic: no slip; CommonRoad MB vehicle 2: one tyre front and rear, neutral to first order
 
 
@@ -148,12 +158,15 @@ def understeer_gradient_rad_per_mps2(model: VehicleModel) -> float:
 #: times more nonlinear. Truck: the trailer's kingpin force and the tandem's lumping move it off the two-axle
 #: formula, 6e-4 measured at 10 m/s, 4e-4 at 20 m/s; 2e-3 allows 3x. MB: roll, load transfer and combined slip
 #: make it oversteer slightly, +0.4% at 10 m/s, +1.6% at 20 m/s; 3% allows that growth to 25 m/s, as "within a
-#: few percent" of the linear model is what a third-party multi-body car can be held to.
+#: few percent" of the linear model is what a third-party multi-body car can be held to. FMU (CommonRoad's single
+#: track, cornering stiffness proportional to axle load: neutral, K = 0): the linear model's small-angle terms,
+#: 4.2e-5 measured at 10 m/s, 1.0e-5 at 15 m/s, 3.2e-6 at 20 m/s; 2e-4 allows 5x the largest.
 STEADY = {
     "kinematic-bicycle": (3.0, 1e-12),
     "dynamic-bicycle": (6.0, 1e-3),
     "tractor-semitrailer": (20.0, 2e-3),
     "commonroad-mb": (8.0, 3e-2),
+    "fmu": (6.0, 2e-4),
 }
 
 
