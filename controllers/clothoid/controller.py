@@ -20,7 +20,8 @@ Added to the paper so that the loop keeps its margins on the vehicle it steers (
     is followed with hysteresis and at a limited rate, slowly against L / V (`lookahead_filter.py`); a geometric
     ceiling keeps the target within max_target_turn_deg of the path's turn (ClothoidConfig), never below the floor;
   - two degrees of freedom (`path_feedforward.py`): feedback on Eq. 3's kappa' less the path's own clothoid's,
-    and the path's curvature rate fed forward, so tracking needs no short lookaheads where the loop has no margin;
+    and the steering that inverts the identified lag of Eq. 5 along the path fed forward (added after the lead
+    filter), so tracking needs no short lookaheads where the loop has no margin;
   - the steered vehicle's own lead filter, curvature limits and lags (`vehicle_tuning.py`, made by `tuning
     schedule --design margins`; the config holds them); without them, no lead filter and no floor.
 
@@ -272,9 +273,10 @@ class ClothoidConfig:
         Flag(),
     )
     feedforward_window_m: float = option(
-        6.0,
-        "the window the path's curvature rate is averaged over for the feed-forward (with feedforward_inversion: "
-        "the window of the curvature's derivatives it inverts the lag with)",
+        2.0,
+        "the window of the path curvature's derivatives the feed-forward inverts the lag with (without "
+        "feedforward_inversion: the window its curvature rate is averaged over; 6 m keeps the truck's steering "
+        "calmer there)",
         Number(0.1, 100.0, "m"),
     )
     feedforward_time_s: float | None = option(
@@ -288,12 +290,14 @@ class ClothoidConfig:
         Number(0.0, 5.0, "s", none_means="from the vehicle's lags"),
     )
     feedforward_inversion: bool = option(
-        False,
-        "experimental: the feed-forward inverts the identified steering-to-path-curvature lag of Eq. 5 in full (the "
-        "path's curvature its dead time plus known_delay_s ahead, with its first and second time derivatives "
-        "weighted 2 zeta / wn and 1 / wn^2, over K; `path_feedforward.lag_inverse_curvature`) and is added to the "
-        "steering after the lead filter instead of integrated through it (feedforward_time_s is then unused); needs "
-        "path_feedforward; without a tuning, the path's curvature at the foot point",
+        True,
+        "the feed-forward inverts the identified steering-to-path-curvature lag of Eq. 5 in full (the path's "
+        "curvature its dead time plus known_delay_s ahead, with its first and second time derivatives weighted "
+        "2 zeta / wn and 1 / wn^2, over K; `path_feedforward.lag_inverse_curvature`) and is added to the steering "
+        "after the lead filter instead of integrated through it (feedforward_time_s is then unused); false: the "
+        "path's curvature rate at the lags' low-frequency delay ahead, integrated with the feedback; the form of "
+        "path_feedforward's feed-forward (no effect without it); without a tuning, the path's curvature at the foot "
+        "point",
         Flag(),
     )
     lag_model_reference: bool = option(
@@ -337,12 +341,6 @@ class ClothoidConfig:
                 f"delay_compensation 'model' predicts the measured kappa(0), initial_curvature 'yaw-rate'; got "
                 f"initial_curvature {self.initial_curvature!r} with known_delay_s = {value_text(self.known_delay_s)}: "
                 "set delay_compensation = 'arc' (the pose predicted on kappa(0)) or initial_curvature = 'yaw-rate'"
-            )
-        if self.feedforward_inversion and not self.path_feedforward:
-            raise WorkbenchInputError(
-                f"feedforward_inversion = {value_text(self.feedforward_inversion)} inverts the lag for the "
-                "two-degree-of-freedom form's feed-forward and needs path_feedforward = true; got path_feedforward = "
-                "false: set path_feedforward = true or feedforward_inversion = false"
             )
         if self.lag_model_reference and not self.feedforward_inversion:
             raise WorkbenchInputError(

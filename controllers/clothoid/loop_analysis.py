@@ -14,11 +14,11 @@ in deviations from it: lateral offset y, heading error psi, curvature kappa.
   Euler; the lead filter of Eq. 6 (Tustin). The controller's state-space is read off its own linear step function
   by unit probes.
 - The feed-forward (`path_feedforward.py`) is not in the loop: it is computed from the path and the speed alone,
-  an input added to the loop, not a feedback. By default its curvature rate is integrated with the feedback's and
-  passes through the lead filter; with `ClothoidConfig.feedforward_inversion` the lag's inverse is added to the
-  steering after the lead filter and the integrator holds the feedback alone. Either way L(z), its margins and the
-  lookahead floor are the same; what the feed-forward changes is how far the path's curvature is already steered
-  when the feedback acts (the curvature and rate limits, which bound the sum, are not in the linear loop).
+  an input added to the loop, not a feedback. By default (`ClothoidConfig.feedforward_inversion`) the lag's inverse
+  is added to the steering after the lead filter and the integrator holds the feedback alone; without it, its
+  curvature rate is integrated with the feedback's and passes through the lead filter. Either way L(z), its margins
+  and the lookahead floor are the same; what the feed-forward changes is how far the path's curvature is already
+  steered when the feedback acts (the curvature and rate limits, which bound the sum, are not in the linear loop).
 - The loop is broken at the steering sent: L(z) = -C(z) P(z), negative-feedback convention.
 
 Margins: phase margin at every gain crossover (the least reported); gain margin (how much the loop gain may rise,

@@ -23,9 +23,9 @@ tau_ff is the low-frequency delay of lead filter and path lag (Eq. 6 and Eq. 5),
 the path curvature lags the yaw-rate curvature that the controller measures as kappa(0) (a truck's tandem and
 trailer make it much longer than a car's).
 
-The lag inverted (`lag_inverse_curvature`, `ClothoidConfig.feedforward_inversion`, experimental, off by default).
-The feed-forward above is a first-order model of the lag (its low-frequency delay) and, integrated with the
-feedback, passes through the lead filter, whose high-frequency gain amplifies any sharpening of it. Instead, the
+The lag inverted (`lag_inverse_curvature`, `ClothoidConfig.feedforward_inversion`, the default). The feed-forward
+above is a first-order model of the lag (its low-frequency delay) and, integrated with the feedback, passes through
+the lead filter, whose high-frequency gain amplifies any sharpening of it. Instead, the
 steering that makes Eq. 5's output the path's curvature is computed from the path ahead (the curvature its dead time
 ahead, plus its time derivatives weighted by the second-order part) and added to the steering after the lead
 filter; the integrator then holds only the feedback's curvature, and the feedback's two-degree-of-freedom form

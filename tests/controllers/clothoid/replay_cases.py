@@ -72,6 +72,9 @@ class Case:
         return self.simulation().path
 
 
+#: The feed-forward's other form: the path's curvature rate integrated with the feedback over a 6 m window.
+RATE_FEEDFORWARD = {"feedforward_inversion": False, "feedforward_window_m": 6.0}
+
 CASES = (
     Case("truck_dlc", "dlc", "tractor-semitrailer"),
     Case(
@@ -79,7 +82,7 @@ CASES = (
         "figure8",
         "tractor-semitrailer",
         conditions="automotive",
-        options={"known_delay_s": 0.11, "delay_compensation": "arc"},
+        options={"known_delay_s": 0.11, "delay_compensation": "arc", **RATE_FEEDFORWARD},
     ),
     Case(
         "truck_figure8_delay_model",
@@ -130,6 +133,11 @@ CASES = (
         "dlc",
         "commonroad-mb",
         speed_kmh=40.0,
-        options={"max_lookahead_shrink_m_per_m": None, "lookahead_hysteresis_m": 0.0, "feedforward_time_s": 0.3},
+        options={
+            "max_lookahead_shrink_m_per_m": None,
+            "lookahead_hysteresis_m": 0.0,
+            "feedforward_time_s": 0.3,
+            **RATE_FEEDFORWARD,
+        },
     ),
 )

@@ -1,5 +1,5 @@
 """The lag-inverting feed-forward (`ClothoidConfig.feedforward_inversion`, `path_feedforward.lag_inverse_curvature`):
-its refusal without the two-degree-of-freedom form, the inversion against hand-computed values on paths whose
+the default, its place in the two-degree-of-freedom form, the inversion against hand-computed values on paths whose
 curvature is linear and quadratic in arc length, its wiring into the step, and that it leaves the feedback loop
 (and so the lookahead floor) alone."""
 
@@ -36,12 +36,25 @@ def _inverse(curvature: np.ndarray, s_m: float, **lag: float) -> tuple[float, fl
     )  # fmt: skip
 
 
-def test_off_by_default_and_refused_without_the_path_feedforward() -> None:
-    assert ClothoidConfig().feedforward_inversion is False
-    with pytest.raises(WorkbenchInputError, match=r"feedforward_inversion .*path_feedforward = true; got"):
-        ClothoidConfig(feedforward_inversion=True, path_feedforward=False)
+def test_on_by_default_and_the_form_of_the_path_feedforward() -> None:
+    """Default on; without the two-degree-of-freedom form there is no feed-forward to invert: the step keeps no
+    feed-forward and integrates Eq. 3's feedback from the steering measured."""
+    assert ClothoidConfig().feedforward_inversion is True
     with pytest.raises(WorkbenchInputError, match="feedforward_inversion"):
         ClothoidConfig(feedforward_inversion="yes")  # type: ignore[arg-type]
+    path = ClothoidChain().straight(20.0).clothoid_to(RATE_1PM2 * 150.0, 150.0).to_path("ramp")
+    config = ClothoidConfig(tuning=TRUCK_TUNING, path_feedforward=False)
+    controller = ClothoidController(TRUCK.geometry, config, vehicle=TRUCK)
+    controller.reset(path, 0.02)
+    i, speed, g = round(80.0 / path.spacing_m), 8.0, TRUCK.geometry
+    kappa = float(path.curvature_1pm[i])
+    steer = math.atan(g.wheelbase_m * kappa) * g.steering_ratio
+    m = Measurement(
+        0.0, float(path.x_m[i]), float(path.y_m[i]), speed, 0.0, float(path.heading_rad[i]), speed * kappa, steer
+    )
+    controller.step(m, path)
+    assert math.isnan(controller._state[sk.S_FEEDFORWARD_KAPPA])
+    assert abs(controller._state[sk.S_KAPPA_CMD] - kappa) < 0.05 * kappa  # one step of Eq. 3 from the steering
 
 
 def test_a_constant_curvature_rate_is_the_curvature_ahead_plus_the_lags_first_order_lead() -> None:
@@ -94,7 +107,9 @@ def test_the_step_sends_the_inverted_lag_of_the_vehicles_own_tuning() -> None:
 
 def test_the_feedback_loop_and_its_floor_are_unchanged() -> None:
     """The feed-forward depends on the path alone: the loop the floor is computed on is the same with it on."""
-    off = ClothoidController(TRUCK.geometry, ClothoidConfig(tuning=TRUCK_TUNING), vehicle=TRUCK)
+    off = ClothoidController(
+        TRUCK.geometry, ClothoidConfig(tuning=TRUCK_TUNING, feedforward_inversion=False), vehicle=TRUCK
+    )
     on = ClothoidController(
         TRUCK.geometry, ClothoidConfig(tuning=TRUCK_TUNING, feedforward_inversion=True), vehicle=TRUCK
     )
@@ -108,8 +123,8 @@ def test_the_feedback_loop_and_its_floor_are_unchanged() -> None:
 def test_the_lag_model_reference_needs_the_inversion() -> None:
     assert ClothoidConfig().lag_model_reference is False
     with pytest.raises(WorkbenchInputError, match=r"lag_model_reference .*feedforward_inversion = true; got"):
-        ClothoidConfig(lag_model_reference=True)
-    ClothoidConfig(lag_model_reference=True, feedforward_inversion=True)
+        ClothoidConfig(lag_model_reference=True, feedforward_inversion=False)
+    ClothoidConfig(lag_model_reference=True)
 
 
 def _reference(curvature: np.ndarray, s_m: float, measured: np.ndarray) -> float:
