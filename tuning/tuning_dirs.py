@@ -22,6 +22,7 @@ from tuning.filter_file import read_filter_file
 from tuning.limits_file import read_limits_file
 from workbench.base.errors import WorkbenchInputError, value_text
 from workbench.base.input_files import read_json
+from workbench.base.toml_text import toml_value
 from workbench.base.user_cache import private_cache_dir
 from workbench.vehicles.base import VehicleModel
 from workbench.vehicles.presets import MODEL_TYPES, params_from_toml, preset_text
@@ -84,17 +85,46 @@ def reference_params(vehicle: VehicleModel) -> Any:
 
 
 def canonical_vehicle_toml(vehicle: VehicleModel) -> str:
-    """The vehicle's reference parameters as a vehicle file (every field, in declaration order, floats by repr):
-    one text per vehicle, hashed for its identity and written as the cache's vehicle.toml."""
+    """The vehicle's reference parameters as a vehicle file (every field, in declaration order, numbers by repr; a
+    file a field names, a plant FMU, with its content's sha256 in a comment): one text per vehicle, hashed for its
+    identity and written as the cache's vehicle.toml."""
     params = reference_params(vehicle)
     lines = ["# canonical parameters (payload set to the preset's) of a vehicle tuned by tuning_for", "[model]"]
     lines += [f'type = "{vehicle.name}"', "", "[parameters]"]
     for f in dataclasses.fields(params):
         value = getattr(params, f.name)
-        lines.append(f"{f.name} = {value!r}")
+        if value is None or isinstance(value, str | Path):  # text, a file (an FMU's) or "none"
+            digest = _file_sha256(value) if isinstance(value, Path) else None
+            lines.append(f"{f.name} = {toml_value(value)}" + (f"  # sha256 {digest}" if digest else ""))
+        else:
+            lines.append(f"{f.name} = {value!r}")
     text = "\n".join(lines) + "\n"
     params_from_toml(text, "canonical vehicle file")  # it must read back as the same vehicle
     return text
+
+
+def _file_sha256(path: Path) -> str | None:
+    """sha256 (hex) of a file a vehicle's parameters name (a plant FMU: its content is the vehicle, so a changed
+    FMU is another vehicle); None when it is not a readable file. Computed once per file version (path, size and
+    modification time), as an FMU may be large."""
+    try:
+        stat = path.stat()
+    except OSError:
+        return None
+    return _sha256_of(str(path.resolve()), stat.st_size, stat.st_mtime_ns)
+
+
+@functools.cache
+def _sha256_of(path: str, size: int, mtime_ns: int) -> str | None:
+    """sha256 (hex) of the file at `path` (size and mtime_ns: the version cached)."""
+    digest = hashlib.sha256()
+    try:
+        with open(path, "rb") as handle:
+            for block in iter(lambda: handle.read(1 << 20), b""):
+                digest.update(block)
+    except OSError:
+        return None
+    return digest.hexdigest()
 
 
 def params_sha256(vehicle: VehicleModel) -> str:

@@ -16,7 +16,7 @@ from typing import ClassVar
 
 import numpy as np
 import pytest
-from conftest import FMU_EXAMPLE, fmu_example_builder, write_fmu_vehicle_file
+from fmu_plant_files import FMU_EXAMPLE, fmu_example_builder, write_fmu_vehicle_file
 
 from controllers import PurePursuit
 from workbench.apps.cli import main
