@@ -141,6 +141,14 @@ def tuning_for(vehicle: VehicleModel, options: PresetTuningOptions | None = None
     """The tuning the clothoid controller uses for `vehicle` (module docstring): the shipped files of the preset it
     equals (payload aside), else its own from the cache, generated there on first use. options: the tuning options
     (default `tuning.preset_tuning.PRESET_TUNING_OPTIONS`, those the shipped files were made with)."""
+    from tuning.tuning_dirs import read_vehicle_tuning
+
+    return read_vehicle_tuning(tuning_dir_for(vehicle, options))
+
+
+def tuning_dir_for(vehicle: VehicleModel, options: PresetTuningOptions | None = None) -> Path:
+    """The directory of the tuning `tuning_for` reads for `vehicle` (the shipped preset's, else the cache's,
+    generated there on first use), for a caller that copies the files (`workbench export-fmu` packs them)."""
     from tuning.preset_tuning import PRESET_TUNING_OPTIONS
     from tuning.tuning_dirs import (
         CACHE_ENV,
@@ -155,14 +163,15 @@ def tuning_for(vehicle: VehicleModel, options: PresetTuningOptions | None = None
     options = options or PRESET_TUNING_OPTIONS
     shipped = shipped_tuning_dir(vehicle, options)
     if shipped is not None:
-        return read_vehicle_tuning(shipped)
+        return shipped
     base = cache_dir()
     key = cache_key(vehicle, options)
     directory = base / key
     if (directory / MANIFEST_FILE).is_file():
         check_private_tree(directory, CACHE_ENV)
         try:
-            return read_vehicle_tuning(directory)
+            read_vehicle_tuning(directory)  # an entry that reads is used
+            return directory
         except WorkbenchInputError as exc:  # an edited or damaged entry: never used, made again
             print(f"lateral-workbench: the cached tuning cannot be used ({exc}): making it again", file=sys.stderr)
             _discard(directory)
@@ -194,7 +203,7 @@ def tuning_for(vehicle: VehicleModel, options: PresetTuningOptions | None = None
         file=sys.stderr,
         flush=True,
     )
-    return read_vehicle_tuning(directory)
+    return directory
 
 
 # ---- the controller with its vehicle's tuning ------------------------------------------------------------------

@@ -1,7 +1,8 @@
 """The `workbench` command line: list scenarios, vehicles and controllers; run a closed-loop simulation; compare
 controllers side by side (`compare`, and the paper's Figure 17 set-up, `fig17`); run parameter sweeps and tune
 controllers from a study spec (`sweep`, `optimise`), and tune and judge every controller alike on held-out cases
-(`tournament`; `workbench.apps.studies`).
+(`tournament`; `workbench.apps.studies`); and pack a controller, tuned for a vehicle and a path, as an FMI 2.0
+co-simulation FMU for the user's own simulation tool (`export-fmu`; `workbench.apps.fmu_export`).
 
 Every input file and output folder is checked before any work starts (`workbench.base.input_files`,
 `workbench.base.output_dir`): a missing or unreadable file, a folder where a file is wanted or a file where a folder is,
@@ -49,7 +50,9 @@ if TYPE_CHECKING:
     from workbench.simulation.plot_worker import PlotWorker
     from workbench.simulation.result import SimulationResult
     from workbench.simulation.run_config import SimulationConfig
+    from workbench.simulation.scenario import Scenario
     from workbench.simulation.simulator import Simulation
+    from workbench.vehicles.base import VehicleModel
 
 # Heavy modules (the simulator, the scenarios' paths, plotting, the controllers' solvers, the studies' backends)
 # are imported inside the command that needs them, so that `workbench --help` and `workbench scenarios` start
@@ -207,6 +210,51 @@ def _parser(command: str | None = None) -> argparse.ArgumentParser:
     tour.add_argument("spec", type=Path, metavar="SPEC.toml", help="the tournament spec (see README: Tournament)")
     tour.add_argument("--out", type=Path, required=True, metavar="DIR", help="output directory (rerun to resume)")
     _backend_options(tour, command in (None, "tournament"))
+
+    fmu = sub.add_parser(
+        "export-fmu",
+        help="pack a controller, tuned for a vehicle and a path, as an FMI 2.0 co-simulation FMU (PythonFMU)",
+    )
+    fmu.add_argument("controller", metavar="CONTROLLER", help="controller name (see `workbench controllers`)")
+    fmu.add_argument("--vehicle", metavar="NAME", help=f"vehicle model (default: {DEFAULT_VEHICLE})")
+    fmu.add_argument(
+        "--vehicle-file", type=Path, metavar="FILE.toml", help="a vehicle TOML file (see `workbench vehicles --show`)"
+    )
+    fmu.add_argument("--payload-kg", type=float, metavar="KG", help="payload of vehicles that carry one")
+    fmu.add_argument(
+        "--controller-config",
+        type=Path,
+        metavar="FILE.toml",
+        help="controller options: a TOML file with a [<controller name>] table; the files it names are packed",
+    )
+    fmu.add_argument(
+        "--set", action="append", default=[], metavar="KEY=VALUE", help="a controller option, over the config file"
+    )
+    fmu.add_argument(
+        "--path",
+        dest="scenario",
+        required=True,
+        metavar="WAYPOINTS",
+        help="the path the controller follows, packed in the FMU: a waypoint CSV file, a scenario name or "
+        "circuit:SEED",
+    )
+    fmu.add_argument("--track", type=Path, metavar="FILE", help="track CSV for the zandvoort scenario")
+    _circuit_ranges_option(fmu)
+    fmu.add_argument(
+        "--speed", type=float, default=30.0, metavar="KMH", help="target speed of the path's plan, km/h (default 30)"
+    )
+    fmu.add_argument(
+        "--lat-accel-g", type=float, default=0.3, metavar="G", help="speed-profile lateral bound (default 0.3 g)"
+    )
+    fmu.add_argument(
+        "--controller-rate-hz",
+        type=float,
+        default=50.0,
+        metavar="HZ",
+        help="controller rate (default 50 Hz): the FMU's step is its period",
+    )
+    fmu.add_argument("--out", type=Path, required=True, metavar="FILE.fmu", help="the FMU to write")
+    fmu.add_argument("--overwrite", action="store_true", help="replace an existing FILE.fmu")
     return parser
 
 
@@ -931,23 +979,13 @@ def _run_with(args: argparse.Namespace, plot_worker: PlotWorker | None) -> int:
     return 0
 
 
-def _run_stages(
-    args: argparse.Namespace, plot_worker: PlotWorker | None, out: OutputDir, progress: StageProgress
-) -> tuple[Simulation, SimulationResult, list[Path]]:
-    """`workbench run`'s work, each stage named on `progress`: build the run (refused here when it may simulate
-    more than the bounds of `run_size` without --allow-long-run), simulate, write."""
+def _vehicle_and_options(args: argparse.Namespace, warn: Callable[[str], None]) -> tuple[VehicleModel, object]:
+    """The vehicle (--vehicle, --vehicle-file, --payload-kg) and the controller's options (--controller-config,
+    --set; `read_controller_config`) of `run` and `export-fmu`; an unknown controller name is refused."""
     from controllers import make_controller
-    from tuning.own_tuning import tuned_controller
     from workbench.apps.controller_config import read_controller_config
-    from workbench.simulation.feasibility import refuse_infeasible
-    from workbench.simulation.known_delays import KnownDelays
-    from workbench.simulation.run_size import check_run_size, duration_text
-    from workbench.simulation.scenarios import ScenarioOptions, make_scenario
-    from workbench.simulation.simulator import Simulation
     from workbench.vehicles import make_vehicle
 
-    config = _run_config(args)
-    progress.stage("building the vehicle, the controller and the scenario")
     name = args.vehicle if args.vehicle is not None or args.vehicle_file else DEFAULT_VEHICLE
     vehicle = make_vehicle(name, payload_kg=args.payload_kg, vehicle_file=args.vehicle_file)
     if args.controller not in CONTROLLERS:
@@ -958,16 +996,70 @@ def _run_stages(
         CONTROLLERS[args.controller].config_type,
         args.set,
         vehicle.geometry,
-        warn=progress.warn,
+        warn=warn,
     )
+    return vehicle, options
+
+
+def _scenario(args: argparse.Namespace, vehicle: VehicleModel) -> Scenario:
+    """The scenario (or waypoint file) of `run` and `export-fmu`, sized for the vehicle (--track,
+    --circuit-ranges)."""
+    from workbench.simulation.scenarios import ScenarioOptions, make_scenario
+
+    options = ScenarioOptions(
+        vehicle_width_m=vehicle.geometry.width_m, track_file=args.track, circuit_ranges=_circuit_ranges(args)
+    )
+    return make_scenario(args.scenario, options)
+
+
+def _export_fmu(args: argparse.Namespace) -> int:
+    """`workbench export-fmu`: the controller `run` would build, with the path `run` would plan, as an FMU
+    (`workbench.apps.fmu_export`)."""
+    from workbench.apps.fmu_export import build_controller_fmu, check_fmu_target, named_files
+    from workbench.base.input_files import read_text
+    from workbench.simulation.simulator import SimulationConfig, plan_path_speed
+    from workbench.vehicles import preset_text
+
+    _check_inputs(args)
+    check_fmu_target(args.out, args.overwrite)
+    config = SimulationConfig(
+        speed_kmh=args.speed, max_lateral_accel_g=args.lat_accel_g, controller_rate_hz=args.controller_rate_hz
+    )
+    vehicle, options = _vehicle_and_options(args, warn_on_stderr)
+    path = plan_path_speed(_scenario(args, vehicle).path, config)
+    if args.vehicle_file is not None:
+        vehicle_text = read_text(args.vehicle_file, f"--vehicle-file {str(args.vehicle_file)!r}")
+    else:
+        vehicle_text = preset_text(vehicle.name)
+    files = named_files(args.controller_config, args.controller, args.set)
+    period_s = 1.0 / config.controller_rate_hz
+    build_controller_fmu(
+        args.out, args.controller, vehicle, vehicle_text, args.payload_kg, options, files, path, period_s
+    )
+    print(
+        f"wrote {args.out}: {args.controller} on {vehicle.name} along {path.name} ({path.length_m:.0f} m, planned "
+        f"at up to {args.speed:g} km/h), an FMI 2.0 co-simulation FMU stepping every {period_s:g} s"
+    )
+    return 0
+
+
+def _run_stages(
+    args: argparse.Namespace, plot_worker: PlotWorker | None, out: OutputDir, progress: StageProgress
+) -> tuple[Simulation, SimulationResult, list[Path]]:
+    """`workbench run`'s work, each stage named on `progress`: build the run (refused here when it may simulate
+    more than the bounds of `run_size` without --allow-long-run), simulate, write."""
+    from tuning.own_tuning import tuned_controller
+    from workbench.simulation.feasibility import refuse_infeasible
+    from workbench.simulation.known_delays import KnownDelays
+    from workbench.simulation.run_size import check_run_size, duration_text
+    from workbench.simulation.simulator import Simulation
+
+    config = _run_config(args)
+    progress.stage("building the vehicle, the controller and the scenario")
+    vehicle, options = _vehicle_and_options(args, progress.warn)
     delays = KnownDelays.from_conditions(config.conditions) if config.inform_delays else None
     controller = tuned_controller(args.controller, vehicle, options, delays)
-    scenario = make_scenario(
-        args.scenario,
-        ScenarioOptions(
-            vehicle_width_m=vehicle.geometry.width_m, track_file=args.track, circuit_ranges=_circuit_ranges(args)
-        ),
-    )
+    scenario = _scenario(args, vehicle)
     if args.scenario == TRACK_SCENARIO and scenario.name != TRACK_SCENARIO:  # another file given: named by it
         progress.warn(scenario.description)
     simulation = Simulation(scenario, vehicle, controller, config)
@@ -1082,6 +1174,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             return _optimise(args)
         elif args.command == "tournament":
             return _tournament(args)
+        elif args.command == "export-fmu":
+            return _export_fmu(args)
         else:
             return _run(args)
     except WorkbenchInputError as exc:
