@@ -381,6 +381,7 @@ WB_BASE = {
     "sweep": ("sweep", "spec.toml", "--out", "out", "--no-plots"),
     "optimise": ("optimise", "optimise.toml", "--out", "out"),
     "tournament": ("tournament", "tournament.toml", "--out", "out"),
+    "export-fmu": ("export-fmu", "pure-pursuit", "--path", "good.csv", "--out", "controller.fmu"),
 }
 TUNING_BASE = {
     "generate-data": ("generate-data", "--vehicle", "kinematic-bicycle", "--maneuver", "step", "--speed", "30", "--out",
@@ -398,12 +399,12 @@ TUNING_BASE = {
 
 #: Number options: (programs' commands having it, option, the bad values that do not apply to it, i.e. are valid).
 NUMBER_OPTIONS: tuple[tuple[str, tuple[str, ...], str, frozenset[str]], ...] = (
-    ("workbench", ("run", "compare", "fig17", "robustness"), "--speed", frozenset()),
-    ("workbench", ("run", "compare"), "--payload-kg", frozenset({"0"})),
+    ("workbench", ("run", "compare", "fig17", "robustness", "export-fmu"), "--speed", frozenset()),
+    ("workbench", ("run", "compare", "export-fmu"), "--payload-kg", frozenset({"0"})),
     ("workbench", ("run", "compare"), "--laps", frozenset()),
-    ("workbench", ("run", "compare"), "--controller-rate-hz", frozenset()),
+    ("workbench", ("run", "compare", "export-fmu"), "--controller-rate-hz", frozenset()),
     ("workbench", ("run", "compare"), "--plant-rate-hz", frozenset()),
-    ("workbench", ("run", "compare"), "--lat-accel-g", frozenset()),
+    ("workbench", ("run", "compare", "export-fmu"), "--lat-accel-g", frozenset()),
     ("workbench", ("run", "compare"), "--max-time-s", frozenset()),
     ("workbench", ("run", "compare", "fig17", "robustness"), "--seed", frozenset({"0"})),
     ("workbench", ("robustness",), "--max-cte", frozenset()),
@@ -429,11 +430,11 @@ NUMBER_OPTIONS: tuple[tuple[str, tuple[str, ...], str, frozenset[str]], ...] = (
 
 #: Input-file options: (program, commands, option, the kind's own broken files besides BROKEN_FILES).
 FILE_OPTIONS: tuple[tuple[str, tuple[str, ...], str, tuple[str, ...]], ...] = (
-    ("workbench", ("run", "compare"), "--vehicle-file", ()),
-    ("workbench", ("run", "compare"), "--controller-config", ("deep.toml", "not-toml.toml")),
+    ("workbench", ("run", "compare", "export-fmu"), "--vehicle-file", ()),
+    ("workbench", ("run", "compare", "export-fmu"), "--controller-config", ("deep.toml", "not-toml.toml")),
     ("workbench", ("run", "compare", "fig17", "robustness"), "--conditions", ("deep.toml", "not-toml.toml")),
-    ("workbench", ("paper", "run", "compare", "robustness"), "--track", ()),
-    ("workbench", ("run", "compare", "robustness"), "--circuit-ranges", ("deep.toml", "not-toml.toml")),
+    ("workbench", ("paper", "run", "compare", "robustness", "export-fmu"), "--track", ()),
+    ("workbench", ("run", "compare", "robustness", "export-fmu"), "--circuit-ranges", ("deep.toml", "not-toml.toml")),
     ("tuning", ("generate-data", "fit-lag", "rollover-limits", "steering-limits", "schedule"), "--vehicle-file", ()),
     ("tuning", ("design-lead", "margins"), "--lag", ("deep.json", "not-json.json")),
     ("tuning", ("margins",), "--lead", ("deep.json", "not-json.json")),
@@ -471,6 +472,7 @@ MEANINGFUL = {
     "workbench-robustness---conditions=empty.any": "as for run",
     "workbench-run---controller-config=empty.any": "no table: the defaults, with a warning naming none",
     "workbench-compare---controller-config=empty.any": "as for run",
+    "workbench-export-fmu---controller-config=empty.any": "as for run",
     "workbench-compare-controller-config=ctl-bad-file.toml": "a table for another controller only: not read",
     "workbench-compare-controller-config=ctl-bad-lag.toml": "a table for another controller only: not read",
     "workbench-compare-controller-config=ctl-bad-limits.toml": "a table for another controller only: not read",
@@ -534,6 +536,14 @@ def cases() -> list[Case]:
         for name in ("moon", "DLC", ""):
             add(Case(f"workbench-{command}-scenario-name={name or 'empty'}", "workbench",
                      _positional(WB_BASE[command], 1, name)))  # fmt: skip
+    for name in [*waypoints, "moon", "DLC", ""]:  # export-fmu's --path takes what a scenario takes
+        add(Case(f"workbench-export-fmu-path={name or 'empty'}", "workbench",
+                 _with(WB_BASE["export-fmu"], "--path", name)))  # fmt: skip
+    for name in ("stanly", "", "clothoid,stanley"):
+        add(Case(f"workbench-export-fmu-controller={name or 'empty'}", "workbench",
+                 _positional(WB_BASE["export-fmu"], 1, name)))  # fmt: skip
+    for name in ("controller.zip", "folder", "no-such-folder/controller.fmu"):
+        add(Case(f"workbench-export-fmu-out={name}", "workbench", _with(WB_BASE["export-fmu"], "--out", name)))
 
     # track files for the zandvoort scenario and the paper
     tracks = [n for n in names if n.startswith("track-")] + ["good.csv"]

@@ -14,11 +14,13 @@ from bad_input_catalogue import ACCEPTED, REFUSED, Case, cases, files
 
 CASES = cases()
 #: Where the slow work of a tuning command starts, after its inputs are checked (the commands look these up in
-#: their modules when they run): identifying a schedule's lags, a margins study, a rollover series.
+#: their modules when they run): identifying a schedule's lags, a margins study, a rollover series; and where
+#: `workbench export-fmu` starts packing and building the FMU.
 THE_WORK = (
     ("tuning.schedule", "identification_logs"),
     ("tuning.margins", "run_margins"),
     ("tuning.rollover", "rollover_limits"),
+    ("workbench.apps.fmu_export", "build_controller_fmu"),
 )
 
 

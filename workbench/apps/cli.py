@@ -253,6 +253,7 @@ def _parser(command: str | None = None) -> argparse.ArgumentParser:
         metavar="HZ",
         help="controller rate (default 50 Hz): the FMU's step is its period",
     )
+    _allow_infeasible_option(fmu)
     fmu.add_argument("--out", type=Path, required=True, metavar="FILE.fmu", help="the FMU to write")
     fmu.add_argument("--overwrite", action="store_true", help="replace an existing FILE.fmu")
     return parser
@@ -1013,11 +1014,13 @@ def _scenario(args: argparse.Namespace, vehicle: VehicleModel) -> Scenario:
 
 
 def _export_fmu(args: argparse.Namespace) -> int:
-    """`workbench export-fmu`: the controller `run` would build, with the path `run` would plan, as an FMU
-    (`workbench.apps.fmu_export`)."""
+    """`workbench export-fmu`: the controller `run` would build, with the path `run` would plan (a path the vehicle
+    cannot follow refused as `run` refuses it, unless --allow-infeasible), as an FMU (`workbench.apps.fmu_export`)."""
+    from tuning.own_tuning import tuned_controller
     from workbench.apps.fmu_export import build_controller_fmu, check_fmu_target, named_files
     from workbench.base.input_files import read_text
-    from workbench.simulation.simulator import SimulationConfig, plan_path_speed
+    from workbench.simulation.feasibility import refuse_infeasible
+    from workbench.simulation.simulator import Simulation, SimulationConfig
     from workbench.vehicles import preset_text
 
     _check_inputs(args)
@@ -1026,7 +1029,14 @@ def _export_fmu(args: argparse.Namespace) -> int:
         speed_kmh=args.speed, max_lateral_accel_g=args.lat_accel_g, controller_rate_hz=args.controller_rate_hz
     )
     vehicle, options = _vehicle_and_options(args, warn_on_stderr)
-    path = plan_path_speed(_scenario(args, vehicle).path, config)
+    controller = tuned_controller(args.controller, vehicle, options)
+    simulation = Simulation(_scenario(args, vehicle), vehicle, controller, config)  # plans the path as `run` does
+    if not args.allow_infeasible:
+        refuse_infeasible(simulation.path_warnings())
+    label = f"{simulation.scenario.name}: {controller.name} on {vehicle.name}"
+    for warning in simulation.warnings(label):
+        warn_on_stderr(warning)
+    path = simulation.path
     if args.vehicle_file is not None:
         vehicle_text = read_text(args.vehicle_file, f"--vehicle-file {str(args.vehicle_file)!r}")
     else:
