@@ -32,3 +32,8 @@ def steering() -> Iterator[ModuleType]:
 @pytest.fixture(scope="module")
 def breakdown() -> Iterator[ModuleType]:
     yield from _script("cte_breakdown.py")
+
+
+@pytest.fixture(scope="module")
+def fmu_plant() -> Iterator[ModuleType]:
+    yield from _script("fmu_plant.py")

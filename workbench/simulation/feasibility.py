@@ -100,7 +100,8 @@ class VehicleLimits:
     @classmethod
     def of(cls, vehicle: VehicleModel) -> VehicleLimits:
         """The limits of a vehicle model: its geometry (steering lock and rate), its single track's understeer and
-        grip (when it has tyres) and its static rollover threshold (the tractor-semitrailer's)."""
+        grip (when it has tyres) and its static rollover threshold (the tractor-semitrailer's; a plant from an FMU's
+        as its vehicle file states it)."""
         from workbench.vehicles.tractor_semitrailer import TractorSemitrailer  # loaded with any vehicle model
 
         geometry = vehicle.geometry
@@ -109,7 +110,11 @@ class VehicleLimits:
         if track is not None:
             understeer = track.understeer_gradient_rad_per_mps2()
             grip = (track.front_peak_force_n + track.rear_peak_force_n) / (track.mass_kg * G_MPS2)
+        from workbench.vehicles.fmu_plant import FmuPlant  # loaded with any vehicle model too
+
         rollover = vehicle.derived.rollover_threshold_g if isinstance(vehicle, TractorSemitrailer) else None
+        if isinstance(vehicle, FmuPlant):
+            rollover = vehicle.rollover_threshold_g
         rate = geometry.max_steer_wheel_rate_rad_s / geometry.steering_ratio
         return cls(
             vehicle.name, geometry.wheelbase_m, geometry.max_road_wheel_angle_rad, understeer, grip, rollover, rate
