@@ -1112,12 +1112,15 @@ def _scenarios(args: argparse.Namespace) -> None:
 
 def _vehicles(args: argparse.Namespace) -> None:
     from workbench.vehicles import VEHICLES, list_presets, preset_text
+    from workbench.vehicles.presets import TEMPLATE_ONLY_TYPES
 
     if args.show:
         print(preset_text(args.show), end="")
     else:
         for name, description in list_presets().items():
             print(f"{name:<20} {description}\n{'':<20} {VEHICLES[name]().describe()}")
+        for name in TEMPLATE_ONLY_TYPES:
+            print(f"{name:<20} your own model: `workbench vehicles --show {name}` prints a vehicle file to fill in")
 
 
 def _conditions(args: argparse.Namespace) -> None:

@@ -95,6 +95,8 @@ def test_the_template_is_the_example_vehicle_file_and_the_cli_shows_it(capsys) -
     assert preset_text("fmu") == (FMU_EXAMPLE / "commonroad_st.toml").read_text(encoding="utf-8")
     assert main(["vehicles", "--show", "fmu"]) in (0, None)
     assert 'type = "fmu"' in capsys.readouterr().out
+    assert main(["vehicles"]) in (0, None)
+    assert re.search(r"^fmu +your own model: `workbench vehicles --show fmu`", capsys.readouterr().out, re.M)
     assert "fmu" not in VEHICLES  # nothing shipped to run: only a user's file has an FMU
 
 
