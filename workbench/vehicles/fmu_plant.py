@@ -24,8 +24,8 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from workbench.base.errors import WorkbenchInputError
-from workbench.vehicles.base import STANDARD_OUTPUTS, VehicleModel
+from workbench.base.errors import WorkbenchInputError, require_in_range
+from workbench.vehicles.base import ROAD_FRICTION_RANGE, STANDARD_OUTPUTS, VehicleModel
 from workbench.vehicles.fmu_description import read_fmu_interface
 from workbench.vehicles.fmu_instance import FmuInstance
 from workbench.vehicles.fmu_plant_params import OPTIONAL_OUTPUTS, FmuPlantParams
@@ -103,6 +103,18 @@ class FmuPlant(VehicleModel):
     def rollover_threshold_g(self) -> float | None:
         """The static rollover threshold the vehicle file states (g), or None."""
         return self.params.rollover_threshold_g
+
+    def set_road_friction(self, scale: float) -> None:
+        """`VehicleModel.set_road_friction`: written to friction_parameter (road_friction x scale); a plant without
+        one accepts only 1.0, and the refusal says how to map one."""
+        if self.params.friction_parameter is None and scale != 1.0:
+            require_in_range("road_friction", scale, *ROAD_FRICTION_RANGE)
+            raise WorkbenchInputError(
+                f"road_friction {float(scale)!r} needs a friction parameter, and this fmu plant's vehicle file maps "
+                "none (friction_parameter = \"none\": only 1.0 is accepted); map a tunable FMU parameter that scales "
+                "the tyres' friction with friction_parameter and road_friction"
+            )
+        super().set_road_friction(scale)
 
     def _apply_road_friction(self, scale: float) -> None:
         p = self.params

@@ -233,5 +233,46 @@ def test_a_pickled_plant_opens_its_fmu_again(example_plant_fmus) -> None:
 def test_road_friction_needs_a_friction_parameter(example_plant_fmus) -> None:
     plant = load_vehicle(str(example_plant_fmus["2"]))
     plant.set_road_friction(1.0)
-    with pytest.raises(WorkbenchInputError, match=re.escape("road_friction 0.5 needs tyres")):
+    with pytest.raises(WorkbenchInputError, match=re.escape("road_friction 0.5 needs a friction parameter")):
         plant.set_road_friction(0.5)
+
+
+FRICTION_SLAVE = '''
+from commonroad_st_fmi2 import CommonRoadST
+from pythonfmu import Fmi2Causality, Fmi2Variability, Real
+
+
+class FrictionST(CommonRoadST):
+    """The example car with a tunable friction parameter `mu` that its output `mu_seen` reports after each step."""
+
+    def __init__(self, **kwargs):
+        super().__init__(**kwargs)
+        self.mu = 1.0
+        self.mu_seen = 0.0
+        self.register_variable(Real("mu", causality=Fmi2Causality.parameter, variability=Fmi2Variability.tunable))
+        self.register_variable(Real("mu_seen", causality=Fmi2Causality.output))
+
+    def do_step(self, current_time, step_size):
+        self.mu_seen = self.mu
+        return super().do_step(current_time, step_size)
+'''
+
+
+def test_road_friction_is_written_to_the_friction_parameter_between_steps(tmp_path) -> None:
+    import fmpy
+
+    slave = tmp_path / "friction_st.py"
+    slave.write_text(FRICTION_SLAVE, encoding="utf-8")
+    fmu = fmu_example_builder().build(tmp_path / "friction.fmu", "2", slave=slave)
+    changes = {"friction_parameter": '"mu"', "road_friction": "0.9"}
+    plant = load_vehicle(str(write_fmu_vehicle_file(fmu, tmp_path / "friction.toml", **changes)))
+    seen = [v.valueReference for v in fmpy.read_model_description(str(fmu)).modelVariables if v.name == "mu_seen"]
+    state = plant.initial_state(0.0, 0.0, 0.0, 10.0)
+    state = plant.advance(state, 0.0, 0.0, 0.02, 20)
+    assert plant._fmu.outputs(seen) == [0.9]  # the vehicle file's road_friction, at scale 1
+    plant.set_road_friction(0.5)
+    plant.advance(state, 0.0, 0.0, 0.02, 20)
+    assert plant._fmu.outputs(seen) == [pytest.approx(0.45, rel=1e-15)]
+    plant.initial_state(0.0, 0.0, 0.0, 10.0)  # a new run starts at the scale in force
+    plant.advance(plant.initial_state(0.0, 0.0, 0.0, 10.0), 0.0, 0.0, 0.02, 20)
+    assert plant._fmu.outputs(seen) == [pytest.approx(0.45, rel=1e-15)]
