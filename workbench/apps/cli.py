@@ -1018,10 +1018,8 @@ def _export_fmu(args: argparse.Namespace) -> int:
     cannot follow refused as `run` refuses it, unless --allow-infeasible), as an FMU (`workbench.apps.fmu_export`)."""
     from tuning.own_tuning import tuned_controller
     from workbench.apps.fmu_export import build_controller_fmu, check_fmu_target, named_files
-    from workbench.base.input_files import read_text
     from workbench.simulation.feasibility import refuse_infeasible
     from workbench.simulation.simulator import Simulation, SimulationConfig
-    from workbench.vehicles import preset_text
 
     _check_inputs(args)
     check_fmu_target(args.out, args.overwrite)
@@ -1037,15 +1035,9 @@ def _export_fmu(args: argparse.Namespace) -> int:
     for warning in simulation.warnings(label):
         warn_on_stderr(warning)
     path = simulation.path
-    if args.vehicle_file is not None:
-        vehicle_text = read_text(args.vehicle_file, f"--vehicle-file {str(args.vehicle_file)!r}")
-    else:
-        vehicle_text = preset_text(vehicle.name)
     files = named_files(args.controller_config, args.controller, args.set)
     period_s = 1.0 / config.controller_rate_hz
-    build_controller_fmu(
-        args.out, args.controller, vehicle, vehicle_text, args.payload_kg, options, files, path, period_s
-    )
+    build_controller_fmu(args.out, args.controller, vehicle, options, files, path, period_s)
     print(
         f"wrote {args.out}: {args.controller} on {vehicle.name} along {path.name} ({path.length_m:.0f} m, planned "
         f"at up to {args.speed:g} km/h), an FMI 2.0 co-simulation FMU stepping every {period_s:g} s"

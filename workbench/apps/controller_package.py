@@ -3,9 +3,10 @@ exported controller FMU carries (`fmu_export` writes them, `fmu_slave` reads the
 
 The folder holds
 
-    manifest.json     the controller's name, the payload (kg, or null), the controller period (s), the path's
-                      sample spacing (m), closure and name, and the workbench version that packed it
-    vehicle.toml      the vehicle file (a preset's own text for a preset)
+    manifest.json     the controller's name, the controller period (s), the path's sample spacing (m), closure
+                      and name, and the workbench version that packed it
+    vehicle.toml      the vehicle as a vehicle file: its model type and every parameter (the payload included);
+                      a file a parameter names (a plant FMU) copied under files/vehicle/
     controller.toml   one [NAME] table with every option of the controller's config; a file option names a copy
                       under files/<option>/ (a lead filter, limits, a lag, a tuning directory, a prediction vehicle)
     path.csv          the reference path the controller is reset on, as `workbench run` plans it: its samples
@@ -14,7 +15,7 @@ The folder holds
 
 The clothoid controller's vehicle tuning (`tuning.own_tuning.tuned_controller`) is packed as a tuning directory
 (`tuning_dir`), so the target never looks for a tuning of its own. Everything is read back through the readers a
-run uses (`make_vehicle`, `read_controller_config`, `tuned_controller`), so the packed controller is the run's.
+run uses (`load_vehicle`, `read_controller_config`, `tuned_controller`), so the packed controller is the run's.
 """
 
 from __future__ import annotations
@@ -68,8 +69,6 @@ def pack_controller(
     folder: Path,
     controller: str,
     vehicle: VehicleModel,
-    vehicle_text: str,
-    payload_kg: float | None,
     options: Any,
     named_files: dict[str, Path],
     path: ReferencePath,
@@ -84,11 +83,7 @@ def pack_controller(
     controller : str
         The registered controller's name.
     vehicle : VehicleModel
-        The vehicle, built from `vehicle_text` and `payload_kg` (for its own tuning).
-    vehicle_text : str
-        The vehicle file's text (a preset's text for a preset).
-    payload_kg : float or None
-        The payload (kg) the vehicle carries instead of its file's; None: the file's.
+        The vehicle (a model with a params dataclass, as every vehicle file builds), payload included.
     options : config_type
         The controller's config as `read_controller_config` built it (before the vehicle's own tuning).
     named_files : dict of str to Path
@@ -119,12 +114,11 @@ def pack_controller(
             continue
         lines.append(f"{toml_key(f.name)} = {toml_value(getattr(options, f.name))}")
     (folder / CONTROLLER_FILE).write_text("\n".join(lines) + "\n", encoding="utf-8")
-    (folder / VEHICLE_FILE).write_text(vehicle_text, encoding="utf-8")
+    _write_vehicle(folder, vehicle)
     _write_path(folder / PATH_FILE, path)
     manifest = {
         "format": PACKAGE_FORMAT,
         "controller": controller,
-        "payload_kg": payload_kg,
         "period_s": float(period_s),
         "path_name": path.name,
         "path_spacing_m": path.spacing_m,
@@ -132,6 +126,25 @@ def pack_controller(
         "workbench_version": installed_version(),
     }
     (folder / MANIFEST_FILE).write_text(json.dumps(manifest, indent=2) + "\n", encoding="utf-8")
+
+
+def _write_vehicle(folder: Path, vehicle: VehicleModel) -> None:
+    """The vehicle as a vehicle file in `folder`: its model type and every parameter, a file a parameter names (a
+    plant FMU) copied under files/vehicle/ and named relative to the file (read back by `load_vehicle`)."""
+    params = getattr(vehicle, "params", None)
+    if not dataclasses.is_dataclass(params):
+        raise WorkbenchInputError(
+            f"vehicle {vehicle.name!r} has no parameters dataclass to pack; a packed controller needs a vehicle that a "
+            "vehicle file builds"
+        )
+    lines = ["# the vehicle, packed by workbench export-fmu", "[model]", f"type = {toml_value(vehicle.name)}", ""]
+    lines.append("[parameters]")
+    for f in dataclasses.fields(params):
+        value = getattr(params, f.name)
+        if isinstance(value, Path):
+            value = _copy_named(folder, "vehicle", value)
+        lines.append(f"{toml_key(f.name)} = {toml_value(value)}")
+    (folder / VEHICLE_FILE).write_text("\n".join(lines) + "\n", encoding="utf-8")
 
 
 def _copy_named(folder: Path, option: str, source: Path) -> str:
@@ -193,7 +206,7 @@ def read_manifest(folder: Path) -> dict[str, Any]:
     file = folder / MANIFEST_FILE
     label = f"controller package manifest {str(file)!r}"
     manifest = parse_json(read_text(file, label), label, allow_nan=False)
-    keys = ("format", "controller", "payload_kg", "period_s", "path_name", "path_spacing_m", "path_closed")
+    keys = ("format", "controller", "period_s", "path_name", "path_spacing_m", "path_closed")
     missing = [k for k in keys if not isinstance(manifest, dict) or k not in manifest]
     if missing:
         raise WorkbenchInputError(f"{label} lacks {', '.join(missing)}")
@@ -205,12 +218,12 @@ def read_manifest(folder: Path) -> dict[str, Any]:
 
 
 def load_packed_controller(folder: Path) -> PackedController:
-    """Build the packed controller as `workbench run` would (the vehicle from its file and payload, the options
-    from controller.toml, `tuned_controller`) and reset it on the packed path."""
+    """Build the packed controller as `workbench run` would (the vehicle from its file, the options from
+    controller.toml, `tuned_controller`) and reset it on the packed path."""
     from controllers import CONTROLLERS
     from tuning.own_tuning import tuned_controller
     from workbench.apps.controller_config import read_controller_config
-    from workbench.vehicles import make_vehicle
+    from workbench.vehicles import load_vehicle
 
     manifest = read_manifest(folder)
     name = manifest["controller"]
@@ -218,7 +231,7 @@ def load_packed_controller(folder: Path) -> PackedController:
         raise WorkbenchInputError(
             f"the package's controller {name!r} is not installed here; installed: {', '.join(CONTROLLERS)}"
         )
-    vehicle = make_vehicle(None, payload_kg=manifest["payload_kg"], vehicle_file=folder / VEHICLE_FILE)
+    vehicle = load_vehicle(str(folder / VEHICLE_FILE))
     config_type = CONTROLLERS[name].config_type
     options = read_controller_config(folder / CONTROLLER_FILE, name, config_type, (), vehicle.geometry)
     controller = tuned_controller(name, vehicle, options)

@@ -1,7 +1,7 @@
 """`workbench export-fmu`: a controller, tuned for a vehicle and a path, as an FMI 2.0 co-simulation FMU built by
 PythonFMU, to be stepped by the user's own simulation tool.
 
-The FMU's resources hold the packed controller (`controller_package`: vehicle file, every controller option, the
+The FMU's resources hold the packed controller (`controller_package`: the vehicle, every controller option, the
 files its options name, the vehicle's own tuning, the path as planned); its script subclasses
 `fmu_slave.ControllerSlave`, which builds the controller from them when the FMU is instantiated. Building the FMU
 instantiates it once (PythonFMU writes modelDescription.xml from an instance), so a package that cannot be built
@@ -91,8 +91,6 @@ def build_controller_fmu(
     out: Path,
     controller: str,
     vehicle: VehicleModel,
-    vehicle_text: str,
-    payload_kg: float | None,
     options: Any,
     files: dict[str, Path],
     path: ReferencePath,
@@ -108,9 +106,7 @@ def build_controller_fmu(
     identifier = model_identifier(controller)
     with tempfile.TemporaryDirectory(prefix="workbench-fmu-") as work:
         folder = Path(work)
-        pack_controller(
-            folder / PACKAGE_DIR, controller, vehicle, vehicle_text, payload_kg, options, files, path, period_s
-        )
+        pack_controller(folder / PACKAGE_DIR, controller, vehicle, options, files, path, period_s)
         script = folder / f"{identifier.lower()}_fmu.py"
         script.write_text(_SCRIPT.format(controller=controller, identifier=identifier, package=PACKAGE_DIR))
         partial = out.with_name(f".{out.stem}.partial.fmu")

@@ -203,3 +203,28 @@ def test_an_existing_fmu_is_replaced_only_with_overwrite(tmp_path: Path, capsys)
     assert main([*argv, "--overwrite"]) == 0
     assert zipfile.is_zipfile(out)
     assert not list(tmp_path.glob(".*partial*"))  # no leftover beside it
+
+
+def test_a_controller_for_a_plant_fmu_packs_the_plant_fmu_its_vehicle_file_names(
+    example_plant_fmus: dict[str, Path], tmp_path: Path
+) -> None:
+    from workbench.apps.controller_package import VEHICLE_FILE, load_packed_controller
+    from workbench.vehicles import make_vehicle
+
+    vehicle_file = example_plant_fmus["2"]
+    out = tmp_path / "pp.fmu"
+    assert (
+        main(["export-fmu", "pure-pursuit", "--vehicle-file", str(vehicle_file), "--path", "dlc", "--out", str(out)])
+        == 0
+    )
+    folder = tmp_path / "unpacked"
+    with zipfile.ZipFile(out) as fmu:
+        fmu.extractall(folder)
+    package = folder / "resources" / "controller"
+    text = (package / VEHICLE_FILE).read_text()
+    plant = make_vehicle(vehicle_file=vehicle_file)
+    packed_plant = package / "files" / "vehicle" / plant.params.fmu_file.name
+    assert f'fmu_file = "files/vehicle/{packed_plant.name}"' in text
+    assert packed_plant.read_bytes() == plant.params.fmu_file.read_bytes()
+    packed = load_packed_controller(package)
+    assert packed.controller.geometry == plant.geometry
