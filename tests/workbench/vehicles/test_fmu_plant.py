@@ -91,6 +91,93 @@ def test_a_closed_loop_run_through_the_fmu_matches_commonroad_stepped_directly(e
     assert np.ptp(through_fmu.trace["y_m"]) > 3.0
 
 
+FOREIGN_SLAVE = '''
+import math
+
+from commonroad_st_plant import CommonRoadSTPlant
+from pythonfmu import Fmi2Causality, Fmi2Slave, Fmi2Variability, Real
+
+OUTPUTS = ("x_rear", "y_right", "psi_cw", "v_kmh", "vy_right", "yaw_rate_cw", "sw_deg_out", "ay_right")
+
+
+class ForeignST(Fmi2Slave):
+    """The example car with another tool's conventions: y, yaw and every lateral quantity positive to the right,
+    speeds in km/h, the steering-wheel angle in degrees (ratio 15), and a throttle and a brake (fractions of full
+    travel: full throttle 3 m/s^2, full brake 8 m/s^2) instead of an acceleration."""
+
+    def __init__(self, **kwargs):
+        super().__init__(**kwargs)
+        self.plant = CommonRoadSTPlant()
+        self.sw_deg = self.throttle = self.brake = 0.0
+        self.v0_kmh = 36.0
+        for name in ("sw_deg", "throttle", "brake"):
+            self.register_variable(Real(name, causality=Fmi2Causality.input))
+        self.register_variable(Real("v0_kmh", causality=Fmi2Causality.parameter, variability=Fmi2Variability.fixed))
+        for name in OUTPUTS:
+            setattr(self, name, 0.0)
+            self.register_variable(Real(name, causality=Fmi2Causality.output))
+
+    def _publish(self):
+        x, y, psi, vx, vy, r, delta, ay = self.plant.outputs()
+        values = (x, -y, -psi, vx * 3.6, -vy, -r, -math.degrees(delta * 15.0), -ay)
+        for name, value in zip(OUTPUTS, values):
+            setattr(self, name, value)
+
+    def exit_initialization_mode(self):
+        self.plant.start(self.v0_kmh / 3.6)
+        self._publish()
+
+    def do_step(self, current_time, step_size):
+        self.plant.delta_cmd = -math.radians(self.sw_deg) / 15.0
+        self.plant.accel_cmd = 3.0 * self.throttle - 8.0 * self.brake
+        self.plant.step(step_size)
+        self._publish()
+        return True
+'''
+#: The mapping of ForeignST's conventions onto the workbench's (its scales: FMU value = scale x workbench value).
+FOREIGN_MAPPING = {
+    "steering_input": '"sw_deg"',
+    "steering_input_is": '"steering_wheel_angle"',
+    "steering_input_scale": "-57.29577951308232",
+    "longitudinal_input_is": '"throttle_brake"',
+    "accel_input": '"none"',
+    "throttle_input": '"throttle"',
+    "brake_input": '"brake"',
+    "y_output": '"y_right"',
+    "y_output_scale": "-1.0",
+    "yaw_output": '"psi_cw"',
+    "yaw_output_scale": "-1.0",
+    "vx_output": '"v_kmh"',
+    "vx_output_scale": "3.6",
+    "vy_output": '"vy_right"',
+    "vy_output_scale": "-1.0",
+    "yaw_rate_output": '"yaw_rate_cw"',
+    "yaw_rate_output_scale": "-1.0",
+    "steering_output": '"sw_deg_out"',
+    "steering_output_is": '"steering_wheel_angle"',
+    "steering_output_scale": "-57.29577951308232",
+    "lat_accel_output": '"ay_right"',
+    "lat_accel_output_scale": "-1.0",
+    "speed_parameter": '"v0_kmh"',
+}
+
+
+def test_another_tools_units_and_signs_mapped_by_scales_give_the_same_run(example_plant_fmus, tmp_path) -> None:
+    """Signs flipped, degrees, km/h, throttle and brake: mapped by the vehicle file's scales and kinds, the FMU is
+    the same car, so the closed loop is the example's to rounding (the degree and km/h conversions)."""
+    slave = tmp_path / "foreign_st.py"
+    slave.write_text(FOREIGN_SLAVE, encoding="utf-8")
+    fmu = fmu_example_builder().build(tmp_path / "foreign.fmu", "2", slave=slave)
+    foreign = load_vehicle(str(write_fmu_vehicle_file(fmu, tmp_path / "foreign.toml", **FOREIGN_MAPPING)))
+    plain = load_vehicle(str(example_plant_fmus["2"]))
+    a = _dlc_run(foreign, offset_m=0.5, heading_error_rad=0.1)
+    b = _dlc_run(plain, offset_m=0.5, heading_error_rad=0.1)
+    assert a.status is b.status is Status.COMPLETED
+    assert a.trace["t_s"].size == b.trace["t_s"].size
+    for name in ("x_m", "y_m", "yaw_rad", "vx_mps", "steer_wheel_rad", "road_wheel_angle_rad", "lat_accel_mps2"):
+        np.testing.assert_allclose(a.trace[name], b.trace[name], rtol=0.0, atol=AGREEMENT, err_msg=name)
+
+
 def test_the_template_is_the_example_vehicle_file_and_the_cli_shows_it(capsys) -> None:
     assert preset_text("fmu") == (FMU_EXAMPLE / "commonroad_st.toml").read_text(encoding="utf-8")
     assert main(["vehicles", "--show", "fmu"]) in (0, None)
