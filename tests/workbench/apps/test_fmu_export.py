@@ -228,3 +228,68 @@ def test_a_controller_for_a_plant_fmu_packs_the_plant_fmu_its_vehicle_file_names
     assert packed_plant.read_bytes() == plant.params.fmu_file.read_bytes()
     packed = load_packed_controller(package)
     assert packed.controller.geometry == plant.geometry
+
+
+def test_the_files_a_controller_config_names_are_packed_and_read_back(tmp_path: Path) -> None:
+    from tuning.own_tuning import shipped_tuning_dir
+    from workbench.apps.controller_config import read_controller_config
+    from workbench.apps.controller_package import CONTROLLER_FILE, load_packed_controller
+    from workbench.vehicles import make_vehicle
+
+    vehicle = make_vehicle(VEHICLE)
+    lead = tmp_path / "filters" / "my_lead.json"
+    lead.parent.mkdir()
+    lead.write_bytes((shipped_tuning_dir(vehicle) / "lead.json").read_bytes())
+    config = tmp_path / "options.toml"
+    config.write_text('[clothoid]\nfilter_file = "filters/my_lead.json"\nprediction_time_s = 0.25\n')
+    out = tmp_path / "c.fmu"
+    argv = ["export-fmu", "clothoid", "--vehicle", VEHICLE, "--controller-config", str(config), "--path", "dlc"]
+    assert main([*argv, "--set", "lookahead_hysteresis_m=0.3", "--out", str(out)]) == 0
+    folder = tmp_path / "unpacked"
+    with zipfile.ZipFile(out) as fmu:
+        fmu.extractall(folder)
+    package = folder / "resources" / "controller"
+    options = (package / CONTROLLER_FILE).read_text()
+    assert 'filter_file = "files/filter_file/my_lead.json"' in options
+    assert (package / "files" / "filter_file" / "my_lead.json").read_bytes() == lead.read_bytes()
+    packed = load_packed_controller(package).controller.config
+    given = read_controller_config(config, "clothoid", type(packed), ["lookahead_hysteresis_m=0.3"], vehicle.geometry)
+    assert packed.lead_filter == given.lead_filter and packed.lead_filter is not None
+    assert packed.prediction_time_s == 0.25 and packed.lookahead_hysteresis_m == 0.3
+    assert packed.tuning is not None  # the vehicle's own tuning, packed beside the file given
+
+
+@pytest.mark.parametrize(
+    ("damage", "named"),
+    [
+        (
+            lambda p: (p / "manifest.json").write_text(
+                (p / "manifest.json").read_text().replace('"format": 1', '"format": 9')
+            ),
+            "format 9",
+        ),
+        (lambda p: (p / "manifest.json").write_text("{}"), "lacks format, controller"),
+        (lambda p: (p / "manifest.json").unlink(), "manifest.json"),
+        (lambda p: (p / "path.csv").write_text((p / "path.csv").read_text().replace("\n0,", "\nnan,", 1)), "finite"),
+        (lambda p: (p / "path.csv").write_text("a,b\n1,2\n"), "columns a,b"),
+        (
+            lambda p: (p / "manifest.json").write_text(
+                (p / "manifest.json").read_text().replace('"pure-pursuit"', '"stanly"')
+            ),
+            "stanly",
+        ),
+    ],
+)
+def test_a_damaged_package_is_refused_naming_what(damage, named, tmp_path: Path) -> None:
+    from workbench.apps.controller_package import load_packed_controller
+    from workbench.base.errors import WorkbenchInputError
+
+    out = tmp_path / "pp.fmu"
+    assert main(["export-fmu", "pure-pursuit", "--path", "dlc", "--out", str(out)]) == 0
+    with zipfile.ZipFile(out) as fmu:
+        fmu.extractall(tmp_path / "unpacked")
+    package = tmp_path / "unpacked" / "resources" / "controller"
+    load_packed_controller(package)  # whole, it builds
+    damage(package)
+    with pytest.raises(WorkbenchInputError, match=named):
+        load_packed_controller(package)
