@@ -9,6 +9,7 @@ import dataclasses
 import math
 import pickle
 import re
+import subprocess
 import sys
 import zipfile
 from pathlib import Path
@@ -185,6 +186,19 @@ def test_the_template_is_the_example_vehicle_file_and_the_cli_shows_it(capsys) -
     assert main(["vehicles"]) in (0, None)
     assert re.search(r"^fmu +your own model: `workbench vehicles --show fmu`", capsys.readouterr().out, re.M)
     assert "fmu" not in VEHICLES  # nothing shipped to run: only a user's file has an FMU
+
+
+def test_the_example_script_builds_both_fmi_versions(tmp_path) -> None:
+    """`python examples/fmu_plant/build_fmu.py [--fmi 3] --out FILE`, as the README runs it, in a fresh process."""
+    for version in ("2", "3"):
+        out = tmp_path / f"car{version}.fmu"
+        done = subprocess.run(
+            [sys.executable, str(FMU_EXAMPLE / "build_fmu.py"), "--fmi", version, "--out", str(out)],
+            capture_output=True, text=True, check=False, timeout=120,
+        )  # fmt: skip
+        assert done.returncode == 0, done.stderr
+        plant = load_vehicle(str(write_fmu_vehicle_file(out, tmp_path / f"car{version}.toml")))
+        assert plant.interface.fmi_major == int(version)
 
 
 def test_a_relative_fmu_path_is_relative_to_the_vehicle_file(example_plant_fmus, tmp_path) -> None:
