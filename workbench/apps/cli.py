@@ -253,7 +253,7 @@ def _parser(command: str | None = None) -> argparse.ArgumentParser:
         metavar="HZ",
         help="controller rate (default 50 Hz): the FMU's step is its period",
     )
-    _allow_infeasible_option(fmu)
+    _allow_infeasible_option(fmu, "pack")
     fmu.add_argument("--out", type=Path, required=True, metavar="FILE.fmu", help="the FMU to write")
     fmu.add_argument("--overwrite", action="store_true", help="replace an existing FILE.fmu")
     return parser
@@ -413,12 +413,13 @@ def _circuit_ranges(args: argparse.Namespace) -> CircuitRanges | None:
     return read_circuit_ranges(args.circuit_ranges)
 
 
-def _allow_infeasible_option(parser: argparse.ArgumentParser) -> None:
-    """--allow-infeasible, of run, compare and robustness (`feasibility.refuse_infeasible`)."""
+def _allow_infeasible_option(parser: argparse.ArgumentParser, verb: str = "run") -> None:
+    """--allow-infeasible, of run, compare, robustness and export-fmu (`feasibility.refuse_infeasible`); `verb`:
+    what the command does with the path."""
     parser.add_argument(
         "--allow-infeasible",
         action="store_true",
-        help="run a path a vehicle cannot follow at the planned speed (too tight for its lock, curvature changing "
+        help=f"{verb} a path a vehicle cannot follow at the planned speed (too tight for its lock, curvature changing "
         "faster than its steering, beyond its rollover threshold or grip), warning where; refused without it",
     )
 
