@@ -149,12 +149,15 @@ def _write_vehicle(folder: Path, vehicle: VehicleModel) -> None:
 
 def _copy_named(folder: Path, option: str, source: Path) -> str:
     """Copy the file or directory a file option names into files/<option>/; its path relative to `folder`. A
-    name that is no file (a vehicle preset's, for `vehicle_file`) is packed as it is."""
-    if not source.exists():
-        return str(source)
+    name that is no file (a vehicle preset's, which `vehicle_file` takes) is packed as that preset's file."""
     target = folder / FILES_DIR / option / source.name
     target.parent.mkdir(parents=True, exist_ok=True)
-    if source.is_dir():
+    if not source.exists():
+        from workbench.vehicles import preset_text
+
+        target = target.with_name(f"{source.name}.toml")
+        target.write_text(preset_text(source.name), encoding="utf-8")
+    elif source.is_dir():
         shutil.copytree(source, target, ignore=shutil.ignore_patterns("__pycache__"))
     else:
         shutil.copy2(source, target)

@@ -293,3 +293,22 @@ def test_a_damaged_package_is_refused_naming_what(damage, named, tmp_path: Path)
     damage(package)
     with pytest.raises(WorkbenchInputError, match=named):
         load_packed_controller(package)
+
+
+def test_a_prediction_vehicle_named_by_its_preset_is_packed_as_that_presets_file(tmp_path: Path) -> None:
+    from workbench.apps.controller_config import read_controller_config
+    from workbench.apps.controller_package import CONTROLLER_FILE, load_packed_controller
+    from workbench.vehicles import make_vehicle
+
+    out = tmp_path / "lmpc.fmu"
+    argv = ["export-fmu", "lmpc", "--vehicle", VEHICLE, "--set", f"vehicle_file={VEHICLE}", "--path", "dlc"]
+    assert main([*argv, "--out", str(out)]) == 0
+    with zipfile.ZipFile(out) as fmu:
+        fmu.extractall(tmp_path / "unpacked")
+    package = tmp_path / "unpacked" / "resources" / "controller"
+    assert f'vehicle_file = "files/vehicle_file/{VEHICLE}.toml"' in (package / CONTROLLER_FILE).read_text()
+    packed = load_packed_controller(package).controller.config
+    given = read_controller_config(
+        None, "lmpc", type(packed), [f"vehicle_file={VEHICLE}"], make_vehicle(VEHICLE).geometry
+    )
+    assert packed.prediction_vehicle == given.prediction_vehicle and packed.prediction_vehicle is not None
