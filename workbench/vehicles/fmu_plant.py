@@ -15,6 +15,11 @@ Inputs: the road-wheel command and the acceleration are clipped to the vehicle's
 then written as the mapping says (steering-wheel angle = road-wheel angle x steering_ratio; throttle and brake as
 fractions of the acceleration limits). Road friction: with `friction_parameter`, `set_road_friction(scale)` writes
 road_friction x scale to it between controller steps; without it only 1.0 is accepted.
+
+A plant with load transfer (`ltr_output`) also gives the rear axle's path curvature (`path_curvature_1pm`, what the
+rollover limits read): vx a_y / (vx^2 + vy^2)^(3/2) from the mapped outputs (`reference_point.py`'s curvature without
+its longitudinal-acceleration term, which the mapping does not carry; small at a near-constant speed), and the
+kinematic tan(road-wheel angle) / wheelbase at standstill.
 """
 
 from __future__ import annotations
@@ -32,6 +37,11 @@ from workbench.vehicles.fmu_plant_params import OPTIONAL_OUTPUTS, FmuPlantParams
 from workbench.vehicles.geometry import VehicleGeometry
 from workbench.vehicles.single_track import PredictionParams, SingleTrackParams
 
+#: The extra output a plant with load transfer (an `ltr` output) gains: the rear axle's path curvature (1/m), which
+#: the rollover limits of the tuning chain read (`tuning/rollover.py`).
+PATH_CURVATURE = "path_curvature_1pm"
+#: Below this speed (m/s) the path curvature is the kinematic tan(road-wheel angle) / wheelbase.
+_STANDSTILL_MPS = 1e-3
 #: The state entry holding the FMU's time (s), after the outputs.
 TIME_STATE = "fmu_time_s"
 #: Relative slack (of the communication step) within which a controller period counts as a multiple of it.
@@ -49,7 +59,9 @@ class FmuPlant(VehicleModel):
         self._geometry = VehicleGeometry.from_params(p, p.wheelbase_m)
         self.interface = read_fmu_interface(p)
         self.has_tyres = p.friction_parameter is not None  # type: ignore[misc]
-        self.extra_output_names = tuple(OPTIONAL_OUTPUTS[f] for f in p.output_fields() if f in OPTIONAL_OUTPUTS)
+        extras = tuple(OPTIONAL_OUTPUTS[f] for f in p.output_fields() if f in OPTIONAL_OUTPUTS)
+        self._with_curvature = p.ltr_output is not None
+        self.extra_output_names = extras + ((PATH_CURVATURE,) if self._with_curvature else ())
         self.state_names = (*STANDARD_OUTPUTS, *self.extra_output_names, TIME_STATE)
         refs = self.interface.value_references
         self._input_refs = [refs[name] for name in p.input_names()]
@@ -169,6 +181,10 @@ class FmuPlant(VehicleModel):
                 state.append(y0 + s * tx + c * ty)
             else:
                 state.append(value)
+        if self._with_curvature:  # a curve traced at (vx, vy) with lateral acceleration ay: a_x v_y is not known
+            speed = math.hypot(raw[3], raw[4])
+            standstill = speed <= _STANDSTILL_MPS
+            state.append(math.tan(road_wheel) / p.wheelbase_m if standstill else raw[3] * raw[7] / speed**3)
         state.append(self._fmu.time_s)
         return np.array(state, dtype=float)
 
