@@ -301,12 +301,12 @@ class ClothoidConfig:
         Flag(),
     )
     lag_model_reference: bool = option(
-        False,
-        "experimental, with feedforward_inversion: the feedback's reference pose starts at the path's pose (ahead by "
-        "the known delay only) on the curvature a vehicle following the path exactly would measure, the measured "
-        "(yaw-rate) lag driven by the inverted path lag (`step_kernel.reference_curvature`), instead of the path's "
-        "pose and curvature reference_lead_s ahead (reference_lead_s is then unused); without a tuning it changes "
-        "nothing",
+        True,
+        "with feedforward_inversion: the feedback's reference pose starts at the path's pose (ahead by the known "
+        "delay only) on the curvature a vehicle following the path exactly would measure, the measured (yaw-rate) "
+        "lag driven by the inverted path lag (`step_kernel.reference_curvature`), instead of the path's pose and "
+        "curvature reference_lead_s ahead (reference_lead_s is then unused; false: that); no effect without "
+        "feedforward_inversion or a tuning",
         Flag(),
     )
     tuning: VehicleTuning | None = option(  # noqa: RUF009  (option is a dataclasses.field)
@@ -341,11 +341,6 @@ class ClothoidConfig:
                 f"delay_compensation 'model' predicts the measured kappa(0), initial_curvature 'yaw-rate'; got "
                 f"initial_curvature {self.initial_curvature!r} with known_delay_s = {value_text(self.known_delay_s)}: "
                 "set delay_compensation = 'arc' (the pose predicted on kappa(0)) or initial_curvature = 'yaw-rate'"
-            )
-        if self.lag_model_reference and not self.feedforward_inversion:
-            raise WorkbenchInputError(
-                f"lag_model_reference = {value_text(self.lag_model_reference)} drives the measured lag with the "
-                "inverted lag's feed-forward and needs feedforward_inversion = true; got feedforward_inversion = false"
             )
         if self.max_lookahead_m < self.min_lookahead_m:
             raise WorkbenchInputError(

@@ -124,9 +124,12 @@ def reference_curvature(
     length s_m (`ClothoidConfig.lag_model_reference`): the measured lag driven by the steering that inverts the path
     lag, Km Gm(s) e^(-Tm s) / (Kp Gp(s) e^(-Tp s)) on the path's curvature, with Gm / Gp = (1 + a_p s + b_p s^2) /
     (1 + a_m s + b_m s^2) (a = 2 zeta / wn, b = 1 / wn^2) to second order in s: the curvature Tp - Tm ahead plus
-    (a_p - a_m) and (b_p - b_m - a_m (a_p - a_m)) times its first and second time derivatives, times Km / Kp
-    (`path_feedforward.previewed_curvature`). Without a measured lag: the path's curvature at s_m. rows: 8 floats
-    of scratch (the two lags' rows at this speed)."""
+    (a_p - a_m) and (b_p - b_m - a_m (a_p - a_m)) times its first and second time derivatives
+    (`path_feedforward.previewed_curvature`). The gains' ratio Km / Kp is taken as 1: in steady turning at a held
+    speed the yaw rate over speed is the path's curvature (rigid-body kinematics), so the reference must equal the
+    path's curvature on an arc; the two identified gains differ by their fits' errors (about 1 % on the loaded
+    truck), which would leave the feedback holding that error as a steady offset in every arc. Without a measured
+    lag: the path's curvature at s_m. rows: 8 floats of scratch (the two lags' rows at this speed)."""
     path_lag, measured_lag = rows[:4], rows[4:8]
     table_row(lag_speeds, lags, speed_mps * 3.6, False, path_lag)
     if measured_lags.shape[0] == 0:
@@ -139,7 +142,7 @@ def reference_curvature(
         path_curvature, spacing, length, closed, s_m, speed_mps, path_lag[2] - measured_lag[2], first,
         b_p - b_m - a_m * first, window_m,
     )[0]  # fmt: skip
-    return curvature * measured_lag[3] / path_lag[3]
+    return curvature
 
 
 @njit(cache=True)

@@ -120,11 +120,23 @@ def test_the_feedback_loop_and_its_floor_are_unchanged() -> None:
     assert on.lookahead_floor_m(30.0 / 3.6) == off.lookahead_floor_m(30.0 / 3.6) > 5.0
 
 
-def test_the_lag_model_reference_needs_the_inversion() -> None:
-    assert ClothoidConfig().lag_model_reference is False
-    with pytest.raises(WorkbenchInputError, match=r"lag_model_reference .*feedforward_inversion = true; got"):
-        ClothoidConfig(lag_model_reference=True, feedforward_inversion=False)
-    ClothoidConfig(lag_model_reference=True)
+def _one_step(**options: object) -> float:
+    """The steering command of one step on a clothoid ramp, the truck on the path at 8 m/s."""
+    path = ClothoidChain().straight(20.0).clothoid_to(RATE_1PM2 * 150.0, 150.0).to_path("ramp")
+    controller = ClothoidController(TRUCK.geometry, ClothoidConfig(tuning=TRUCK_TUNING, **options), vehicle=TRUCK)
+    controller.reset(path, 0.02)
+    i, speed, g = round(80.0 / path.spacing_m), 8.0, TRUCK.geometry
+    kappa = float(path.curvature_1pm[i])
+    steer = math.atan(g.wheelbase_m * kappa) * g.steering_ratio
+    x, y, heading = float(path.x_m[i]), float(path.y_m[i]), float(path.heading_rad[i])
+    return controller.step(Measurement(0.0, x, y, speed, 0.0, heading, speed * kappa, steer), path)
+
+
+def test_the_lag_model_reference_is_on_by_default_and_acts_only_with_the_inversion() -> None:
+    assert ClothoidConfig().lag_model_reference is True
+    assert _one_step(lag_model_reference=True) != _one_step(lag_model_reference=False)
+    without = {"feedforward_inversion": False}
+    assert _one_step(lag_model_reference=True, **without) == _one_step(lag_model_reference=False, **without)
 
 
 def _reference(curvature: np.ndarray, s_m: float, measured: np.ndarray) -> float:
@@ -136,14 +148,22 @@ def _reference(curvature: np.ndarray, s_m: float, measured: np.ndarray) -> float
 
 
 def test_the_reference_curvature_is_the_measured_lag_of_the_inverted_path_lag() -> None:
-    """kappa = a s^2: Km / Kp (kappa + c1 dkappa/dt + c2 d2kappa/dt2) Tp - Tm ahead, c1 = a_p - a_m,
-    c2 = b_p - b_m - a_m c1 (a = 2 zeta / wn, b = 1 / wn^2); without a measured lag the path's curvature there."""
+    """kappa = a s^2: kappa + c1 dkappa/dt + c2 d2kappa/dt2, Tp - Tm ahead, c1 = a_p - a_m, c2 = b_p - b_m - a_m c1
+    (a = 2 zeta / wn, b = 1 / wn^2); without a measured lag the path's curvature there."""
     a = 1e-5
     curvature = a * S_GRID**2
     measured = np.array([[10.0, 0.8, 0.05, 0.95]])
     a_p, b_p, a_m, b_m = 2 * 1.5 / 20.0, 1 / 20.0**2, 2 * 0.8 / 10.0, 1 / 10.0**2
     s = 40.4 + 8.0 * (0.25 - 0.05)  # 42 m: on the grid, where the interpolated quadratic is exact
     c1, c2 = a_p - a_m, b_p - b_m - a_m * (a_p - a_m)
-    expected = 0.95 / 0.9 * (a * s**2 + c1 * 8.0 * 2 * a * s + c2 * 8.0**2 * 2 * a)
+    expected = a * s**2 + c1 * 8.0 * 2 * a * s + c2 * 8.0**2 * 2 * a
     assert _reference(curvature, 40.4, measured) == pytest.approx(expected, rel=1e-9)
     assert _reference(curvature, 40.0, np.zeros((0, 4))) == pytest.approx(a * 40.0**2, rel=1e-12)
+
+
+def test_on_an_arc_the_reference_is_the_paths_curvature_whatever_the_two_fitted_gains() -> None:
+    """Steady turning: yaw rate / speed is the path's curvature, so the reference holds no steady offset even where
+    the measured lag's fitted gain differs from the path lag's (0.95 against 0.9 here)."""
+    arc = np.full(S_GRID.size, 0.04)
+    measured = np.array([[10.0, 0.8, 0.05, 0.95]])
+    assert _reference(arc, 60.0, measured) == pytest.approx(0.04, rel=1e-12)
