@@ -6,8 +6,9 @@ pythonfmu3 for FMI 3.0) against its own model (`commonroad_st_plant.CommonRoadST
 directly, on a steady turn at 10 m/s. "In a run" is what the simulator pays: `FmuPlant.advance` of one 50 Hz
 controller step (20 doSteps of 1 ms, the inputs set and the outputs read once), per plant step; "doStep alone" is
 one `fmi2DoStep`/`fmi3DoStep` of 1 ms. The FMI overhead is the median minus the native median. Goal: at most 25 us
-a plant step in a run with the PythonFMU FMU (FMI 2.0). A C FMU is not built here (no FMU of a C model ships with
-a dependency; reported as not measured).
+a plant step in a run with the PythonFMU FMU (FMI 2.0). Beside them a C FMU of the same model
+(benchmarks/fmu_plant_c/commonroad_st.c, built with the machine's C compiler against FMPy's FMI 2.0 headers; not
+measured without a compiler): its model step costs a fraction of a microsecond, so its time is FMI's own floor.
 
 Truck dlc end to end: the workbench's tractor-semitrailer preset wrapped in a PythonFMU FMU (each doStep one RK4
 step of its compiled model) and driven through its vehicle file, the clothoid controller with the truck's shipped
