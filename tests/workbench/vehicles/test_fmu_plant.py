@@ -377,3 +377,30 @@ def test_road_friction_is_written_to_the_friction_parameter_between_steps(tmp_pa
     plant.initial_state(0.0, 0.0, 0.0, 10.0)  # a new run starts at the scale in force
     plant.advance(plant.initial_state(0.0, 0.0, 0.0, 10.0), 0.0, 0.0, 0.02, 20)
     assert plant._fmu.outputs(seen) == [pytest.approx(0.45, rel=1e-15)]
+
+
+#: Vehicle-file values refused before the FMU is opened (`FmuPlantParams`), each with the words of its message.
+BAD_VALUES = {
+    "communication step": ({"communication_step_s": "0.5"}, "communication_step_s must be in [0.0001, 0.1] s; got 0.5"),
+    "half a single track": ({"mass_kg": '"none"'}, "the single track is given all together or not at all"),
+    "steering kind": ({"steering_input_is": '"handlebar"'}, "steering_input_is must be one of road_wheel_angle"),
+    "longitudinal kind": ({"longitudinal_input_is": '"pedal"'}, "longitudinal_input_is must be one of acceleration"),
+    "no throttle": ({"longitudinal_input_is": '"throttle_brake"'}, "'throttle_brake' needs throttle_input"),
+    "zero scale": ({"yaw_output_scale": "0.0"}, "yaw_output_scale must be a finite number other than 0; got 0.0"),
+    "one trailer coordinate": ({"trailer_x_output": '"x_rear"'}, "trailer_x_output and trailer_y_output are given"),
+    "payload without parameter": ({"payload_kg": "1000.0"}, "payload_parameter and payload_kg are given together"),
+    "text for a number": ({"wheelbase_m": '"2.5"'}, "'wheelbase_m' must be a number"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(BAD_VALUES))
+def test_bad_vehicle_file_values_are_refused_naming_them(example_plant_fmus, tmp_path, case) -> None:
+    changes, needle = BAD_VALUES[case]
+    fmu = Path(str(example_plant_fmus["2"]).replace(".toml", ".fmu"))
+    with pytest.raises(WorkbenchInputError, match=re.escape(needle)):
+        load_vehicle(str(write_fmu_vehicle_file(fmu, tmp_path / "bad.toml", **changes)))
+
+
+def test_a_payload_needs_a_payload_parameter(example_plant_fmus) -> None:
+    with pytest.raises(WorkbenchInputError, match="payload_parameter and payload_kg are given together"):
+        load_vehicle(str(example_plant_fmus["2"]), payload_kg=2000.0)
