@@ -404,3 +404,12 @@ def test_bad_vehicle_file_values_are_refused_naming_them(example_plant_fmus, tmp
 def test_a_payload_needs_a_payload_parameter(example_plant_fmus) -> None:
     with pytest.raises(WorkbenchInputError, match="payload_parameter and payload_kg are given together"):
         load_vehicle(str(example_plant_fmus["2"]), payload_kg=2000.0)
+
+
+def test_the_feasibility_check_takes_the_rollover_threshold_of_the_vehicle_file(example_plant_fmus, tmp_path) -> None:
+    from workbench.simulation.feasibility import VehicleLimits
+
+    fmu = Path(str(example_plant_fmus["2"]).replace(".toml", ".fmu"))
+    stated = load_vehicle(str(write_fmu_vehicle_file(fmu, tmp_path / "r.toml", rollover_threshold_g="0.35")))
+    assert VehicleLimits.of(stated).rollover_threshold_g == 0.35
+    assert VehicleLimits.of(load_vehicle(str(example_plant_fmus["2"]))).rollover_threshold_g is None
