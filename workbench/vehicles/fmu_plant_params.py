@@ -66,7 +66,7 @@ class FmuPlantParams:
     multiple, which needs an FMU that handles a variable step). Geometry and limits as `VehicleGeometry`, plus the
     acceleration limits the commands are clipped to. Prediction: steering_time_constant_s, and either the single
     track (SINGLE_TRACK_FIELDS, all or none; the rear axle is wheelbase_m - cg_to_front_axle_m) or lag_file (an
-    identified steering lag, `tuning identify`), or neither (a kinematic single track). rollover_threshold_g: the
+    identified steering lag, `tuning fit-lag`), or neither (a kinematic single track). rollover_threshold_g: the
     static rollover threshold the feasibility check uses (none: not checked). hitch_to_trailer_axle_m: a trailer's
     hitch to its axle (its outline), needed with trailer outputs. Inputs: steering_input (kind
     steering_input_is), accel_input or throttle_input and brake_input (kind longitudinal_input_is). Outputs:

@@ -413,3 +413,16 @@ def test_the_feasibility_check_takes_the_rollover_threshold_of_the_vehicle_file(
     stated = load_vehicle(str(write_fmu_vehicle_file(fmu, tmp_path / "r.toml", rollover_threshold_g="0.35")))
     assert VehicleLimits.of(stated).rollover_threshold_g == 0.35
     assert VehicleLimits.of(load_vehicle(str(example_plant_fmus["2"]))).rollover_threshold_g is None
+
+
+def test_an_identified_lag_file_is_what_the_mpcs_predict_with(example_plant_fmus, tmp_path) -> None:
+    from workbench.vehicles.steering_lag import SteeringLag, write_lag_file
+
+    lag = SteeringLag(omega_n_rad_s=7.29, zeta=0.753, source="tuning fit-lag")
+    write_lag_file(lag, tmp_path / "lag.json")
+    fmu = Path(str(example_plant_fmus["2"]).replace(".toml", ".fmu"))
+    plant = load_vehicle(str(write_fmu_vehicle_file(fmu, tmp_path / "car.toml", lag_file='"lag.json"')))
+    predicted = plant.single_track()
+    assert predicted.lag.omega_n_rad_s == 7.29 and predicted.lag.zeta == 0.753
+    assert predicted.default_kind() == "kinematic-lag"
+    assert load_vehicle(str(example_plant_fmus["2"])).single_track().default_kind() == "dynamic"
