@@ -16,7 +16,14 @@ from workbench.vehicles.base import STANDARD_OUTPUTS, VehicleGeometry, VehicleMo
 from workbench.vehicles.commonroad_mb import CommonRoadMB, CommonRoadMBParams
 from workbench.vehicles.dynamic_bicycle import DynamicBicycle, DynamicBicycleParams
 from workbench.vehicles.kinematic_bicycle import KinematicBicycle, KinematicBicycleParams
-from workbench.vehicles.presets import MODEL_TYPES, TEMPLATE_ONLY_TYPES, list_presets, load_vehicle, preset_text
+from workbench.vehicles.presets import (
+    MODEL_TYPES,
+    TEMPLATE_ONLY_TYPES,
+    list_presets,
+    load_vehicle,
+    preset_text,
+    template_only_text,
+)
 from workbench.vehicles.tractor_semitrailer import TractorSemitrailer, TractorSemitrailerParams
 
 #: name -> factory taking no arguments (the shipped preset of that name); a model type that exists only as a user's
@@ -41,6 +48,8 @@ def make_vehicle(
                 f"vehicle {name!r} requested but {vehicle_file} describes a {vehicle.name!r}; drop one of them"
             )
         return vehicle
+    if name in TEMPLATE_ONLY_TYPES:
+        raise WorkbenchInputError(template_only_text(name))
     if name not in VEHICLES:
         raise WorkbenchInputError(f"unknown vehicle {name!r}; choose one of {', '.join(VEHICLES)}")
     return load_vehicle(name, payload_kg)

@@ -120,6 +120,14 @@ def preset_text(name: str) -> str:
     return _preset_dir().joinpath(f"{name}.toml").read_text(encoding="utf-8")
 
 
+def template_only_text(name: str) -> str:
+    """The refusal of a template-only model type (TEMPLATE_ONLY_TYPES) asked for by name: it needs the user's file."""
+    return (
+        f"vehicle {name!r} is your own model and needs its vehicle file: `workbench vehicles --show {name} > "
+        f"my.toml` prints a template; fill it in and pass --vehicle-file my.toml"
+    )
+
+
 def carries_payload(model_type: str) -> bool:
     """Whether vehicles of this model type (a key of MODEL_TYPES) carry a payload (`payload_kg`)."""
     return "payload_kg" in MODEL_TYPES[model_type][1].__dataclass_fields__
@@ -148,6 +156,8 @@ def load_vehicle(name_or_file: str, payload_kg: float | None = None) -> VehicleM
         text = preset_text(name_or_file)
     else:
         path = Path(name_or_file)
+        if name_or_file in TEMPLATE_ONLY_TYPES and not os.path.lexists(path):
+            raise WorkbenchInputError(template_only_text(name_or_file))
         if not os.path.lexists(path):
             raise WorkbenchInputError(
                 f"unknown vehicle {name_or_file!r}: neither a preset ({', '.join(list_presets())}) "

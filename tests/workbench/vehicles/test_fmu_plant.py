@@ -186,6 +186,9 @@ def test_the_template_is_the_example_vehicle_file_and_the_cli_shows_it(capsys) -
     assert main(["vehicles"]) in (0, None)
     assert re.search(r"^fmu +your own model: `workbench vehicles --show fmu`", capsys.readouterr().out, re.M)
     assert "fmu" not in VEHICLES  # nothing shipped to run: only a user's file has an FMU
+    for build in (make_vehicle, load_vehicle):
+        with pytest.raises(WorkbenchInputError, match="'fmu' is your own model and needs its vehicle file"):
+            build("fmu")
 
 
 def test_the_example_script_builds_both_fmi_versions(tmp_path) -> None:
