@@ -22,6 +22,7 @@ from fmu_plant_files import FMU_EXAMPLE, fmu_example_builder, write_fmu_vehicle_
 from controllers import PurePursuit
 from workbench.apps.cli import main
 from workbench.base.errors import WorkbenchInputError
+from workbench.simulation.conditions import CONDITIONS
 from workbench.simulation.result import Status
 from workbench.simulation.scenarios import ScenarioOptions, make_scenario
 from workbench.simulation.simulator import Simulation, SimulationConfig
@@ -63,11 +64,13 @@ class DirectCommonRoadST(VehicleModel):
         return np.array([*out[:6], out[6] * self.params.steering_ratio, *out[6:]])
 
 
-def _dlc_run(vehicle: VehicleModel, speed_kmh: float = 60.0, offset_m: float = 0.0, heading_error_rad: float = 0.0):
+def _dlc_run(
+    vehicle: VehicleModel, speed_kmh: float = 60.0, offset_m: float = 0.0, heading_error_rad: float = 0.0, **config
+):
     scenario = make_scenario("dlc", ScenarioOptions(vehicle_width_m=vehicle.geometry.width_m))
     scenario = dataclasses.replace(scenario, initial_offset_m=offset_m, initial_heading_error_rad=heading_error_rad)
     controller = PurePursuit(vehicle.geometry)
-    return Simulation(scenario, vehicle, controller, SimulationConfig(speed_kmh=speed_kmh)).run()
+    return Simulation(scenario, vehicle, controller, SimulationConfig(speed_kmh=speed_kmh, **config)).run()
 
 
 #: Closed-loop agreement of the FMU plant with the model stepped directly (SI units: m, rad, m/s, m/s^2): the same
@@ -177,6 +180,19 @@ def test_another_tools_units_and_signs_mapped_by_scales_give_the_same_run(exampl
     assert a.trace["t_s"].size == b.trace["t_s"].size
     for name in ("x_m", "y_m", "yaw_rad", "vx_mps", "steer_wheel_rad", "road_wheel_angle_rad", "lat_accel_mps2"):
         np.testing.assert_allclose(a.trace[name], b.trace[name], rtol=0.0, atol=AGREEMENT, err_msg=name)
+
+
+def test_conditions_between_plant_and_controller_act_on_the_fmu_plant_as_on_the_model(example_plant_fmus) -> None:
+    """The automotive conditions (sensor noise and latency, a steering dead time whose segments split a controller
+    step into plant steps of whole milliseconds): through the FMU as with the model stepped directly."""
+    fmu_plant = load_vehicle(str(example_plant_fmus["2"]))
+    automotive = {"conditions": CONDITIONS["automotive"], "seed": 3}
+    through_fmu = _dlc_run(fmu_plant, **automotive)
+    direct = _dlc_run(DirectCommonRoadST(fmu_plant), **automotive)
+    assert through_fmu.status is direct.status is Status.COMPLETED
+    for name in ("x_m", "y_m", "steer_wheel_rad", "seen_y_m", "applied_steer_wheel_cmd_rad"):
+        np.testing.assert_allclose(through_fmu.trace[name], direct.trace[name], rtol=0.0, atol=AGREEMENT, err_msg=name)
+    assert np.max(np.abs(through_fmu.trace["seen_y_m"] - through_fmu.trace["y_m"])) > 1e-3  # the noise was there
 
 
 def test_the_template_is_the_example_vehicle_file_and_the_cli_shows_it(capsys) -> None:
