@@ -357,45 +357,71 @@ def test_road_friction_needs_a_friction_parameter(example_plant_fmus) -> None:
         plant.set_road_friction(0.5)
 
 
-FRICTION_SLAVE = '''
+PARAMETER_SLAVE = '''
 from commonroad_st_fmi2 import CommonRoadST
 from pythonfmu import Fmi2Causality, Fmi2Variability, Real
 
 
-class FrictionST(CommonRoadST):
-    """The example car with a tunable friction parameter `mu` that its output `mu_seen` reports after each step."""
+class ParameterST(CommonRoadST):
+    """The example car with a tunable friction parameter `mu` and a fixed payload parameter `load`, which its outputs
+    `mu_seen` and `load_seen` report after each step."""
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
-        self.mu = 1.0
-        self.mu_seen = 0.0
+        self.mu, self.load = 1.0, 0.0
+        self.mu_seen = self.load_seen = 0.0
         self.register_variable(Real("mu", causality=Fmi2Causality.parameter, variability=Fmi2Variability.tunable))
+        self.register_variable(Real("load", causality=Fmi2Causality.parameter, variability=Fmi2Variability.fixed))
         self.register_variable(Real("mu_seen", causality=Fmi2Causality.output))
+        self.register_variable(Real("load_seen", causality=Fmi2Causality.output))
 
     def do_step(self, current_time, step_size):
-        self.mu_seen = self.mu
+        self.mu_seen, self.load_seen = self.mu, self.load
         return super().do_step(current_time, step_size)
 '''
 
 
-def test_road_friction_is_written_to_the_friction_parameter_between_steps(tmp_path) -> None:
+@pytest.fixture(scope="module")
+def parameter_plant_file(tmp_path_factory) -> Path:
+    """A vehicle file of ParameterST mapping its friction (road_friction 0.9) and payload (500 kg) parameters."""
+    folder = tmp_path_factory.mktemp("parameter_st")
+    slave = folder / "parameter_st.py"
+    slave.write_text(PARAMETER_SLAVE, encoding="utf-8")
+    fmu = fmu_example_builder().build(folder / "parameter.fmu", "2", slave=slave)
+    changes = {
+        "friction_parameter": '"mu"',
+        "road_friction": "0.9",
+        "payload_parameter": '"load"',
+        "payload_kg": "500.0",
+    }
+    return write_fmu_vehicle_file(fmu, folder / "parameter.toml", **changes)
+
+
+def _seen(plant: FmuPlant, name: str) -> float:
+    """The value of the FMU's output `name` after the last step."""
     import fmpy
 
-    slave = tmp_path / "friction_st.py"
-    slave.write_text(FRICTION_SLAVE, encoding="utf-8")
-    fmu = fmu_example_builder().build(tmp_path / "friction.fmu", "2", slave=slave)
-    changes = {"friction_parameter": '"mu"', "road_friction": "0.9"}
-    plant = load_vehicle(str(write_fmu_vehicle_file(fmu, tmp_path / "friction.toml", **changes)))
-    seen = [v.valueReference for v in fmpy.read_model_description(str(fmu)).modelVariables if v.name == "mu_seen"]
+    variables = fmpy.read_model_description(str(plant.params.fmu_file)).modelVariables
+    return plant._fmu.outputs([v.valueReference for v in variables if v.name == name])[0]
+
+
+def test_road_friction_is_written_to_the_friction_parameter_between_steps(parameter_plant_file) -> None:
+    plant = load_vehicle(str(parameter_plant_file))
     state = plant.initial_state(0.0, 0.0, 0.0, 10.0)
     state = plant.advance(state, 0.0, 0.0, 0.02, 20)
-    assert plant._fmu.outputs(seen) == [0.9]  # the vehicle file's road_friction, at scale 1
+    assert _seen(plant, "mu_seen") == 0.9  # the vehicle file's road_friction, at scale 1
     plant.set_road_friction(0.5)
     plant.advance(state, 0.0, 0.0, 0.02, 20)
-    assert plant._fmu.outputs(seen) == [pytest.approx(0.45, rel=1e-15)]
-    plant.initial_state(0.0, 0.0, 0.0, 10.0)  # a new run starts at the scale in force
-    plant.advance(plant.initial_state(0.0, 0.0, 0.0, 10.0), 0.0, 0.0, 0.02, 20)
-    assert plant._fmu.outputs(seen) == [pytest.approx(0.45, rel=1e-15)]
+    assert _seen(plant, "mu_seen") == pytest.approx(0.45, rel=1e-15)
+    plant.advance(plant.initial_state(0.0, 0.0, 0.0, 10.0), 0.0, 0.0, 0.02, 20)  # a new run: the scale in force
+    assert _seen(plant, "mu_seen") == pytest.approx(0.45, rel=1e-15)
+
+
+def test_the_payload_is_written_to_the_payload_parameter(parameter_plant_file) -> None:
+    for payload_kg, expected in ((None, 500.0), (2000.0, 2000.0)):
+        plant = load_vehicle(str(parameter_plant_file), payload_kg)
+        plant.advance(plant.initial_state(0.0, 0.0, 0.0, 10.0), 0.0, 0.0, 0.02, 20)
+        assert _seen(plant, "load_seen") == expected
 
 
 #: Vehicle-file values refused before the FMU is opened (`FmuPlantParams`), each with the words of its message.
