@@ -13,8 +13,14 @@ Switches (each against `nominal`, the shipped defaults on the preset vehicle):
   - floor_lowered: the lookahead floor keeps 30 deg / 3 dB instead of 45 deg / 6 dB;
   - floor_off: no floor (the paper's 5 m lower end; margins not kept);
   - feedforward_off: Eq. 3 alone (`path_feedforward=false`);
-  - feedforward_window_2m: the feed-forward's path curvature rate averaged over 2 m instead of 6 m (a diagnosis of
-    how much of the error is the feed-forward's smoothing, not a proposed setting).
+  - feedforward_rate: the feed-forward's other form, the path's curvature rate (averaged over 6 m) at the lags'
+    low-frequency delay ahead, integrated through the lead filter, and the reference pose a first-order lead ahead
+    (`feedforward_inversion=false`, `feedforward_window_m=6`);
+  - reference_lead: the lag inverted as by default, the feedback's reference pose the first-order lead ahead
+    instead of on the curvature the lags give (`lag_model_reference=false`);
+  - nmpc_identified_lag: the clothoid controller as by default against the NMPC predicting with the identified lag
+    of Eq. 5 the clothoid controller is designed on (its `kinematic-lag` model, the lag at 30 km/h) instead of the
+    vehicle's single-track equivalent: how much of the gap is the model each is given, not the control law.
   - ideal_plant: no_actuator_lag + stiff_tyres + constant_speed together (what the controller's geometry and floor
     leave).
 Both controllers are built for the vehicle they drive: the clothoid controller with that plant's own tuning (its lags
@@ -70,10 +76,12 @@ HELD_OUT_FIRST_SEED = 9000
 SPEED_KMH = 30.0
 #: switch -> (plant changes, run-config changes, clothoid config changes).
 PLANT_SWITCHES = ("no_actuator_lag", "stiff_tyres", "constant_speed", "ideal_plant")
-CONTROLLER_SWITCHES = ("floor_lowered", "floor_off", "feedforward_off", "feedforward_window_2m")
-#: The feed-forward's curvature-rate window (m) of the feedforward_window_2m switch (the default: 6 m).
-SHORT_FEEDFORWARD_WINDOW_M = 2.0
-SWITCHES = ("nominal", *PLANT_SWITCHES, *CONTROLLER_SWITCHES)
+CONTROLLER_SWITCHES = ("floor_lowered", "floor_off", "feedforward_off", "feedforward_rate", "reference_lead")
+#: The feed-forward's curvature-rate window (m) in its rate form (the feedforward_rate switch).
+RATE_FEEDFORWARD_WINDOW_M = 6.0
+#: Switches of the NMPC's model (the clothoid controller runs as nominal).
+MODEL_SWITCHES = ("nmpc_identified_lag",)
+SWITCHES = ("nominal", *PLANT_SWITCHES, *CONTROLLER_SWITCHES, *MODEL_SWITCHES)
 #: The plant's actuator time constant (s) with its lag switched off (the smallest the presets allow).
 NO_LAG_TIME_CONSTANT_S = 1e-3
 #: Stiff tyres: cornering coefficients (1/rad) at the top of each model's allowed range, relaxation length (m).
@@ -108,9 +116,21 @@ def clothoid_config_for(switch: str, config):
         return dataclasses.replace(config, min_phase_margin_deg=0.0, min_gain_margin_db=0.0)
     if switch == "feedforward_off":
         return dataclasses.replace(config, path_feedforward=False)
-    if switch == "feedforward_window_2m":
-        return dataclasses.replace(config, feedforward_window_m=SHORT_FEEDFORWARD_WINDOW_M)
+    if switch == "feedforward_rate":
+        return dataclasses.replace(config, feedforward_inversion=False, feedforward_window_m=RATE_FEEDFORWARD_WINDOW_M)
+    if switch == "reference_lead":
+        return dataclasses.replace(config, lag_model_reference=False)
     return config
+
+
+def nmpc_config_for(switch: str, plant):
+    """The NMPC's config on `plant`: the default (None), or predicting with the plant's identified lag."""
+    if switch not in MODEL_SWITCHES:
+        return None
+    from controllers.mpc.nmpc import NMPCConfig
+    from tuning.own_tuning import tuning_for
+
+    return NMPCConfig(lag=tuning_for(plant).lag_at(SPEED_KMH))
 
 
 @dataclass
@@ -146,7 +166,8 @@ def run_one(job: tuple[str, str, str, str, str]) -> tuple[Run, dict[str, list[fl
         inform_delays=conditions != "ideal",
     )
     delays = KnownDelays.from_conditions(cfg.conditions) if cfg.inform_delays else None
-    controller = tuned_controller(controller_name, plant, delays=delays)
+    nmpc_config = nmpc_config_for(switch, plant) if controller_name == "nmpc" else None
+    controller = tuned_controller(controller_name, plant, nmpc_config, delays=delays)
     if controller_name == "clothoid" and switch in CONTROLLER_SWITCHES:
         from controllers import make_controller
 
@@ -183,8 +204,9 @@ def jobs_for(vehicles: list[str], scenarios: list[str], automotive: bool) -> lis
         for v in vehicles:
             for sc in names:
                 for sw in SWITCHES:
-                    out.append((v, sc, sw, "clothoid", conditions))
-                    if sw == "nominal" or sw in PLANT_SWITCHES:
+                    if sw not in MODEL_SWITCHES:
+                        out.append((v, sc, sw, "clothoid", conditions))
+                    if sw == "nominal" or sw in PLANT_SWITCHES or sw in MODEL_SWITCHES:
                         out.append((v, sc, sw, "nmpc", conditions))
     return out
 
@@ -244,7 +266,8 @@ def loop_rows(vehicle_name: str) -> list[dict[str, object]]:
 
 def summary(runs: list[Run]) -> list[dict[str, object]]:
     """Per vehicle, conditions and switch: the clothoid's max |CTE| against its nominal run's and the NMPC's, as the
-    median over the scenarios, and the share of the nominal gap to the NMPC the switch closes."""
+    median over the scenarios, and the share of the nominal gap to the NMPC the switch closes (a model switch: the
+    clothoid's nominal run against the switched NMPC's, and the share of the gap the NMPC loses with that model)."""
     by = {(r.vehicle, r.scenario, r.switch, r.controller, r.conditions): r for r in runs}
     out = []
     for vehicle, conditions in sorted({(r.vehicle, r.conditions) for r in runs}):
@@ -254,11 +277,14 @@ def summary(runs: list[Run]) -> list[dict[str, object]]:
             for sc in scenarios:
                 c0 = by[(vehicle, sc, "nominal", "clothoid", conditions)]
                 n0 = by[(vehicle, sc, "nominal", "nmpc", conditions)]
-                c = by[(vehicle, sc, sw, "clothoid", conditions)]
+                c = by.get((vehicle, sc, sw, "clothoid", conditions), c0)
                 n = by.get((vehicle, sc, sw, "nmpc", conditions), n0)
                 ratios.append(c.max_abs_cte_m / c0.max_abs_cte_m)
                 gap = c0.max_abs_cte_m - n0.max_abs_cte_m
-                closed.append((c0.max_abs_cte_m - c.max_abs_cte_m) / gap if gap > 1e-9 else math.nan)
+                change = (
+                    n.max_abs_cte_m - n0.max_abs_cte_m if sw in MODEL_SWITCHES else c0.max_abs_cte_m - c.max_abs_cte_m
+                )
+                closed.append(change / gap if gap > 1e-9 else math.nan)
                 vs_nmpc.append(c.max_abs_cte_m / n.max_abs_cte_m)
                 rms.append(c.rms_cte_m / c0.rms_cte_m)
                 cycles += c.limit_cycle
@@ -290,6 +316,13 @@ def figure(vehicle: str, scenario: str, traces: dict, runs: dict, path: Path) ->
     nmpc = traces[(vehicle, scenario, "nominal", "nmpc", "ideal")]
     r = runs[(vehicle, scenario, "nominal", "nmpc", "ideal")]
     axes[0].plot(nmpc["s"], np.abs(nmpc["cte"]), "k--", lw=1.2, label=f"NMPC, nominal ({r.max_abs_cte_m:.3f} m)")
+    for sw in MODEL_SWITCHES:
+        tr = traces.get((vehicle, scenario, sw, "nmpc", "ideal"))
+        if tr is not None:
+            r = runs[(vehicle, scenario, sw, "nmpc", "ideal")]
+            axes[0].plot(
+                tr["s"], np.abs(tr["cte"]), ":", color="0.4", lw=1.2, label=f"NMPC, {sw} ({r.max_abs_cte_m:.3f} m)"
+            )
     axes[0].set_ylabel("|CTE| (m)")
     axes[0].legend(fontsize=7, ncol=2)
     axes[0].set_title(f"{vehicle}, {scenario}, 30 km/h, ideal: the clothoid controller, one factor switched at a time")

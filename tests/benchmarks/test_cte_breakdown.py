@@ -45,9 +45,20 @@ def test_the_controller_switches(breakdown) -> None:
     off = breakdown.clothoid_config_for("floor_off", config)
     assert (off.min_phase_margin_deg, off.min_gain_margin_db) == (0.0, 0.0)
     assert breakdown.clothoid_config_for("feedforward_off", config).path_feedforward is False
-    assert breakdown.clothoid_config_for("feedforward_window_2m", config).feedforward_window_m == 2.0
+    rate = breakdown.clothoid_config_for("feedforward_rate", config)
+    assert (rate.feedforward_inversion, rate.feedforward_window_m) == (False, 6.0)
+    assert breakdown.clothoid_config_for("reference_lead", config).lag_model_reference is False
     assert config.path_feedforward is True and config.min_phase_margin_deg == 45.0
-    assert config.feedforward_window_m == 6.0
+    assert (config.feedforward_inversion, config.lag_model_reference, config.feedforward_window_m) == (True, True, 2.0)
+
+
+def test_the_model_switch_gives_the_nmpc_the_identified_lag(breakdown) -> None:
+    from tuning.own_tuning import tuning_for
+
+    truck = make_vehicle("tractor-semitrailer")
+    assert breakdown.nmpc_config_for("nominal", truck) is None
+    config = breakdown.nmpc_config_for("nmpc_identified_lag", truck)
+    assert config.lag == tuning_for(truck).lag_at(breakdown.SPEED_KMH)
 
 
 def test_the_held_out_circuits_are_refused(breakdown, capsys) -> None:
@@ -57,11 +68,11 @@ def test_the_held_out_circuits_are_refused(breakdown, capsys) -> None:
     assert "circuit:9003" in capsys.readouterr().err
 
 
-def test_the_plan_runs_the_nmpc_on_plant_switches_only(breakdown) -> None:
+def test_the_plan_runs_the_nmpc_on_plant_and_model_switches_only(breakdown) -> None:
     jobs = breakdown.jobs_for(["dynamic-bicycle"], ["dlc"], automotive=False)
     nmpc = {j[2] for j in jobs if j[3] == "nmpc"}
-    assert nmpc == {"nominal", *breakdown.PLANT_SWITCHES}
-    assert {j[2] for j in jobs if j[3] == "clothoid"} == set(breakdown.SWITCHES)
+    assert nmpc == {"nominal", *breakdown.PLANT_SWITCHES, *breakdown.MODEL_SWITCHES}
+    assert {j[2] for j in jobs if j[3] == "clothoid"} == set(breakdown.SWITCHES) - set(breakdown.MODEL_SWITCHES)
     with_automotive = breakdown.jobs_for(["dynamic-bicycle"], ["dlc"], automotive=True)
     assert {j[1] for j in with_automotive if j[4] == "automotive"} == set(breakdown.AUTOMOTIVE_SCENARIOS)
 
@@ -81,7 +92,12 @@ def test_the_summary_arithmetic(breakdown) -> None:
                  _run(breakdown, scenario, "stiff_tyres", "nmpc", nmpc)]  # fmt: skip
         # a controller switch: compared with the nominal NMPC run
         runs.append(_run(breakdown, scenario, "floor_off", "clothoid", nmpc))
+        # a model switch: the NMPC loses half the gap, the clothoid runs as nominal
+        runs.append(_run(breakdown, scenario, "nmpc_identified_lag", "nmpc", (clothoid + nmpc) / 2))
     table = {row["switch"]: row for row in breakdown.summary(runs)}
+    model = table["nmpc_identified_lag"]
+    assert model["median_max_cte_vs_nominal"] == pytest.approx(1.0)
+    assert model["median_gap_closed"] == pytest.approx(0.5)
     assert table["nominal"]["median_gap_closed"] == 0.0
     assert table["nominal"]["median_ratio_to_nmpc_same_run"] == pytest.approx(2.0)  # 2, 3, 5/3
     stiff = table["stiff_tyres"]
@@ -91,4 +107,9 @@ def test_the_summary_arithmetic(breakdown) -> None:
     assert stiff["median_gap_closed"] == pytest.approx(1.0)
     assert table["floor_off"]["median_gap_closed"] == pytest.approx(1.0)
     assert table["floor_off"]["median_ratio_to_nmpc_same_run"] == pytest.approx(1.0)
-    assert set(table) == {"nominal", "stiff_tyres", "floor_off"}  # switches not run are not summarised
+    assert set(table) == {
+        "nominal",
+        "stiff_tyres",
+        "floor_off",
+        "nmpc_identified_lag",
+    }  # switches not run are not summarised
