@@ -20,8 +20,8 @@ O(n m) time at worst, O(min(n, m)) memory (one rolling row, no recursion); bande
 squared distances (sqrt is monotone, so the same cells win) and takes one sqrt at the end, recomputing with hypot
 where squares would underflow or overflow (distances below 1e-140 or above 1e140 m).
 
-`discrete_frechet` is the checked public entry point; `frechet_kernel`, `frechet_below` (cut short above a limit)
-and `frechet_with_early_exit` are the compiled kernels for callers inside numba code (the lookahead search), which
+`discrete_frechet` is the checked public entry point; `frechet_kernel` and `frechet_below` (cut short above a
+limit) are the compiled kernels for callers inside numba code (the lookahead search), which
 must pass finite float64 arrays.
 """
 
@@ -158,15 +158,6 @@ def frechet_below(
         limit = np.inf
     d = _frechet_limited(px, py, qx, qy, limit)
     return np.inf if d < 0.0 else d
-
-
-@njit(cache=True)
-def frechet_with_early_exit(
-    px: np.ndarray, py: np.ndarray, qx: np.ndarray, qy: np.ndarray, threshold: float
-) -> bool:  # pragma: no cover - compiled
-    """Whether frechet_kernel(px, py, qx, qy) <= threshold, exactly, stopping at the first DP row whose every
-    cell exceeds the threshold (`frechet_below`); False for a NaN or negative threshold or an empty curve."""
-    return threshold >= 0.0 and frechet_below(px, py, qx, qy, threshold) <= threshold
 
 
 def _as_curve(name: str, curve: object) -> np.ndarray:

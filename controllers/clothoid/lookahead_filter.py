@@ -22,7 +22,8 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from controllers.config_checks import Number, check_number
+from controllers.config_checks import Number
+from workbench.base.errors import require_in_range
 
 #: A rate limit in metres of lookahead per metre travelled: None (unlimited) or a number in (0, 100].
 RATE_LIMIT = Number(0.0, 100.0, "m per m", low_open=True, none_means="unlimited")
@@ -43,7 +44,7 @@ class LookaheadFilterSettings:
     max_shrink_m_per_m: float | None = 0.5
 
     def __post_init__(self) -> None:
-        check_number("hysteresis_m", self.hysteresis_m, 0.0, 50.0, "m")
+        require_in_range("hysteresis_m", self.hysteresis_m, 0.0, 50.0, "m")
         require_rate("max_growth_m_per_m", self.max_growth_m_per_m)
         require_rate("max_shrink_m_per_m", self.max_shrink_m_per_m)
 
@@ -78,25 +79,3 @@ def filtered_lookahead(
     state[0] = min(max(target, floor_m), max(ceiling_m, floor_m))
     return state[0]
 
-
-class LookaheadFilter:
-    """The lookahead actually used, from the search's choice step by step (module docstring; `filtered_lookahead`
-    with its state here)."""
-
-    __slots__ = ("_rates", "_state", "settings")
-
-    def __init__(self, settings: LookaheadFilterSettings) -> None:
-        self.settings = settings
-        growth, shrink = settings.max_growth_m_per_m, settings.max_shrink_m_per_m
-        self._rates = (math.nan if growth is None else growth, math.nan if shrink is None else shrink)
-        self._state = np.full(2, np.nan)
-
-    def reset(self) -> None:
-        self._state[:] = np.nan
-
-    def step(self, choice_m: float, floor_m: float, ceiling_m: float, distance_m: float) -> float:
-        """The lookahead (m) for this step: choice_m filtered, within [floor_m, ceiling_m]; distance_m: travelled
-        since the last step (m)."""
-        return filtered_lookahead(
-            self._state, choice_m, floor_m, ceiling_m, distance_m, self.settings.hysteresis_m, *self._rates
-        )

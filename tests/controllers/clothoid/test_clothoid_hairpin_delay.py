@@ -20,11 +20,12 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from lookahead_follower import LookaheadFilter
 
 from controllers.base import Measurement
 from controllers.clothoid import ClothoidConfig
 from controllers.clothoid.lookahead import turn_limited_lookahead
-from controllers.clothoid.lookahead_filter import LookaheadFilter, LookaheadFilterSettings
+from controllers.clothoid.lookahead_filter import LookaheadFilterSettings
 from controllers.clothoid.loop_analysis import clothoid_law_gains
 from tuning.own_tuning import tuned_controller
 from workbench.base.clothoid_chain import ClothoidChain

@@ -12,7 +12,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
-from controllers.clothoid.frechet import discrete_frechet, frechet_below, frechet_kernel, frechet_with_early_exit
+from controllers.clothoid.frechet import discrete_frechet, frechet_below, frechet_kernel
 from workbench.base.errors import WorkbenchInputError
 
 # The kernel returns sqrt of one pairwise squared distance; references computed another way (hypot, scipy's
@@ -206,11 +206,17 @@ def test_huge_coordinates() -> None:
 # The compiled kernels directly.
 
 
+def within(px: np.ndarray, py: np.ndarray, qx: np.ndarray, qy: np.ndarray, threshold: float) -> bool:
+    """Whether frechet_kernel(px, py, qx, qy) <= threshold by `frechet_below`'s early exit (False for a NaN or
+    negative threshold or an empty curve): a threshold test built on it must agree with the full computation."""
+    return threshold >= 0.0 and frechet_below(px, py, qx, qy, threshold) <= threshold
+
+
 def test_kernel_contract_for_empty_curves() -> None:
     empty, one = np.empty(0), np.ones(1)
     assert math.isnan(frechet_kernel(empty, empty, one, one))
     assert math.isnan(frechet_kernel(one, one, empty, empty))
-    assert not frechet_with_early_exit(empty, empty, one, one, 1.0)
+    assert not within(empty, empty, one, one, 1.0)
 
 
 # ---------------------------------------------------------------------------------------------------------------
@@ -273,7 +279,7 @@ def check_early_exit_agrees(P: np.ndarray, Q: np.ndarray, threshold: float) -> N
     px, py = columns(P)
     qx, qy = columns(Q)
     d = frechet_kernel(px, py, qx, qy)
-    assert frechet_with_early_exit(px, py, qx, qy, threshold) == (d <= threshold)
+    assert within(px, py, qx, qy, threshold) == (d <= threshold)
     # the distance itself, bit for bit, unless cut short where it exceeds the limit (never for a limit outside
     # [1e-140, 1e140] m, where the cut would need other arithmetic)
     below = frechet_below(px, py, qx, qy, threshold)
@@ -290,7 +296,7 @@ def test_early_exit_agrees_with_full_computation(P: np.ndarray, Q: np.ndarray, t
     # At and around the distance itself, where an inconsistent arithmetic would show.
     for t in (d, np.nextafter(d, 0.0), np.nextafter(d, np.inf), 0.5 * d, 0.999 * d, 1.001 * d, 2.0 * d):
         check_early_exit_agrees(P, Q, float(t))
-    assert frechet_with_early_exit(px, py, qx, qy, d)
+    assert within(px, py, qx, qy, d)
 
 
 def test_early_exit_agrees_on_fixed_seeds_and_scales() -> None:
@@ -304,9 +310,9 @@ def test_early_exit_agrees_on_fixed_seeds_and_scales() -> None:
 
 def test_early_exit_rejects_negative_and_nan_thresholds() -> None:
     px, py = columns(random_walk(1, 10))
-    assert not frechet_with_early_exit(px, py, px, py, -1.0)
-    assert not frechet_with_early_exit(px, py, px, py, math.nan)
-    assert frechet_with_early_exit(px, py, px, py, 0.0)  # identical curves: distance 0 <= 0
+    assert not within(px, py, px, py, -1.0)
+    assert not within(px, py, px, py, math.nan)
+    assert within(px, py, px, py, 0.0)  # identical curves: distance 0 <= 0
 
 
 # ---------------------------------------------------------------------------------------------------------------

@@ -5,8 +5,9 @@ from __future__ import annotations
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from lookahead_follower import LookaheadFilter
 
-from controllers.clothoid.lookahead_filter import LookaheadFilter, LookaheadFilterSettings
+from controllers.clothoid.lookahead_filter import LookaheadFilterSettings
 from workbench.base.errors import WorkbenchInputError
 
 
