@@ -106,6 +106,13 @@ class ControllerRegistry(Mapping[str, "type[Controller]"]):
     def __contains__(self, name: object) -> bool:
         return name in self._entries
 
+    def require(self, name: str) -> None:
+        """Refuse a name no controller is registered under, naming the registered ones (imports nothing)."""
+        if name not in self._entries:
+            from workbench.base.errors import WorkbenchInputError
+
+            raise WorkbenchInputError(f"unknown controller {name!r}; choose one of {', '.join(self._entries)}")
+
     def __iter__(self) -> Iterator[str]:
         return iter(self._entries)
 
@@ -153,10 +160,7 @@ def make_controller(
 ) -> Controller:
     """Build the controller registered under `name` for a vehicle, with its default config unless one is given.
     `vehicle` (the steered `VehicleModel`) gives model-based controllers (the MPCs) their prediction parameters."""
-    if name not in CONTROLLERS:
-        from workbench.base.errors import WorkbenchInputError
-
-        raise WorkbenchInputError(f"unknown controller {name!r}; choose one of {', '.join(CONTROLLERS)}")
+    CONTROLLERS.require(name)
     return CONTROLLERS[name](geometry, config, vehicle=vehicle)
 
 

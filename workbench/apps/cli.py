@@ -626,8 +626,7 @@ def _compare(args: argparse.Namespace) -> int:
     out = OutputDir(args.out, "compare", args.overwrite)
     controllers = _names(args.controllers, "controllers")
     for name in controllers:
-        if name not in CONTROLLERS:
-            raise WorkbenchInputError(f"unknown controller {name!r}; choose one of {', '.join(CONTROLLERS)}")
+        CONTROLLERS.require(name)
     configs = _controller_configs(args.controller_configs, controllers)
     _check_inputs(args)
     overrides = _controller_overrides(args.set, controllers)
@@ -984,14 +983,12 @@ def _run_with(args: argparse.Namespace, plot_worker: PlotWorker | None) -> int:
 def _vehicle_and_options(args: argparse.Namespace, warn: Callable[[str], None]) -> tuple[VehicleModel, object]:
     """The vehicle (--vehicle, --vehicle-file, --payload-kg) and the controller's options (--controller-config,
     --set; `read_controller_config`) of `run` and `export-fmu`; an unknown controller name is refused."""
-    from controllers import make_controller
     from workbench.apps.controller_config import read_controller_config
     from workbench.vehicles import make_vehicle
 
     name = args.vehicle if args.vehicle is not None or args.vehicle_file else DEFAULT_VEHICLE
     vehicle = make_vehicle(name, payload_kg=args.payload_kg, vehicle_file=args.vehicle_file)
-    if args.controller not in CONTROLLERS:
-        make_controller(args.controller, vehicle.geometry)  # raises the unknown-name error
+    CONTROLLERS.require(args.controller)
     options = read_controller_config(
         args.controller_config,
         args.controller,
@@ -1084,7 +1081,7 @@ def _run_stages(
     return simulation, result, written
 
 
-def _scenarios(args: argparse.Namespace) -> None:
+def _scenarios(args: argparse.Namespace) -> int:
     from workbench.simulation.scenarios import ScenarioOptions, describe_scenarios, make_scenario
 
     _check_inputs(args)
@@ -1095,15 +1092,16 @@ def _scenarios(args: argparse.Namespace) -> None:
         if args.track is not None:
             raise WorkbenchInputError("--circuit-ranges prints the circuits' ranges and reads no --track: drop one")
         print(circuit_ranges_toml(read_circuit_ranges(path) if path else None), end="")
-        return
+        return 0
     options = ScenarioOptions(track_file=args.track)
     if args.track is not None:
         make_scenario(TRACK_SCENARIO, options)  # a track that cannot be used is refused, not described
     for name, description in describe_scenarios(options):
         print(f"{name:<12} {description}")
+    return 0
 
 
-def _vehicles(args: argparse.Namespace) -> None:
+def _vehicles(args: argparse.Namespace) -> int:
     from workbench.vehicles import VEHICLES, list_presets, preset_text
     from workbench.vehicles.presets import TEMPLATE_ONLY_TYPES
 
@@ -1114,9 +1112,10 @@ def _vehicles(args: argparse.Namespace) -> None:
             print(f"{name:<20} {description}\n{'':<20} {VEHICLES[name]().describe()}")
         for name in TEMPLATE_ONLY_TYPES:
             print(f"{name:<20} your own model: `workbench vehicles --show {name}` prints a vehicle file to fill in")
+    return 0
 
 
-def _conditions(args: argparse.Namespace) -> None:
+def _conditions(args: argparse.Namespace) -> int:
     from workbench.simulation.conditions import CONDITIONS, conditions_to_toml, load_conditions
 
     if args.show:
@@ -1124,21 +1123,21 @@ def _conditions(args: argparse.Namespace) -> None:
     else:
         for name, conditions in CONDITIONS.items():
             print(f"{name:<12} {conditions.describe()}")
+    return 0
 
 
-def _controllers(args: argparse.Namespace) -> None:
+def _controllers(args: argparse.Namespace) -> int:
     from workbench.apps.controller_config import config_template
 
     if args.show:
-        if args.show not in CONTROLLERS:
-            raise WorkbenchInputError(f"unknown controller {args.show!r}; choose one of {', '.join(CONTROLLERS)}")
+        CONTROLLERS.require(args.show)
         if args.search_space:
             from controllers.search_space import search_space_toml
 
             print(search_space_toml(args.show), end="")
         else:
             print(config_template(args.show, CONTROLLERS[args.show].config_type), end="")
-        return
+        return 0
     if args.search_space:
         raise WorkbenchInputError("--search-space needs --show NAME: the controller whose search space to print")
     for name in CONTROLLERS:
@@ -1147,6 +1146,24 @@ def _controllers(args: argparse.Namespace) -> None:
         except WorkbenchInputError as exc:  # an installed package's controller that cannot be used
             summary = f"(not usable: {exc})"
         print(f"{name:<14} {summary}")
+    return 0
+
+
+COMMANDS: dict[str, Callable[[argparse.Namespace], int]] = {
+    "scenarios": _scenarios,
+    "vehicles": _vehicles,
+    "controllers": _controllers,
+    "conditions": _conditions,
+    "run": _run,
+    "compare": _compare,
+    "fig17": _fig17,
+    "paper": _paper,
+    "sweep": _sweep,
+    "robustness": _robustness,
+    "optimise": _optimise,
+    "tournament": _tournament,
+    "export-fmu": _export_fmu,
+}
 
 
 def console() -> int:
@@ -1158,45 +1175,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else list(argv)
     args = _parser(_command_word(argv)).parse_args(argv)
     try:
-        if args.command == "scenarios":
-            _scenarios(args)
-        elif args.command == "vehicles":
-            _vehicles(args)
-        elif args.command == "controllers":
-            _controllers(args)
-        elif args.command == "conditions":
-            _conditions(args)
-        elif args.command == "compare":
-            return _compare(args)
-        elif args.command == "fig17":
-            return _fig17(args)
-        elif args.command == "paper":
-            return _paper(args)
-        elif args.command == "sweep":
-            return _sweep(args)
-        elif args.command == "robustness":
-            return _robustness(args)
-        elif args.command == "optimise":
-            return _optimise(args)
-        elif args.command == "tournament":
-            return _tournament(args)
-        elif args.command == "export-fmu":
-            return _export_fmu(args)
-        else:
-            return _run(args)
+        return COMMANDS[args.command](args)
     except WorkbenchInputError as exc:
         print(f"workbench: error: {exc}", file=sys.stderr)
         return EXIT_INPUT_ERROR
-    return 0
-
-
-def __getattr__(name: str) -> object:
-    """`workbench.apps.cli.Simulation` (tests patch its `run`): the simulator, imported on first use."""
-    if name == "Simulation":
-        from workbench.simulation.simulator import Simulation
-
-        return Simulation
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 if __name__ == "__main__":

@@ -20,7 +20,7 @@ import time
 import numpy as np
 from tqdm import tqdm
 
-from workbench.base.errors import WorkbenchInputError
+from workbench.base.errors import WorkbenchInputError, require_finite
 from workbench.base.path import ReferencePath
 from workbench.simulation.control_interface import (
     COMMAND_REJECTED,
@@ -34,7 +34,7 @@ from workbench.simulation.run_config import SimulationConfig
 from workbench.simulation.run_size import RunSize
 from workbench.simulation.scenarios import Scenario
 from workbench.simulation.sensing import ActuatorModel, SensorModel
-from workbench.simulation.speed_control import PISpeedController, PISpeedGains
+from workbench.simulation.speed_control import PISpeedGains
 from workbench.simulation.speed_profile import G_MPS2, SpeedLimits, TopSpeed, TopSpeedLimit, plan_speed_profile
 from workbench.simulation.step_kernel import (
     FOOT_AT_END,
@@ -226,7 +226,7 @@ class Simulation:
                 actuator.reset(float(steer_wheel))
             where = project_pose(x, y, samples, track_state, foot, settings)
             if where == PROJECTED_NOT_FINITE:
-                tracker.update(x, y)  # raises the tracker's own error
+                raise WorkbenchInputError(f"position must be finite to project onto {path.name}; got ({x}, {y})")
             if road_varies:  # the foot point's arc length on the path, within a lap on a closed one
                 friction = road.friction_at(float(foot[FOOT_S]))
                 vehicle.set_road_friction(friction)
@@ -260,10 +260,11 @@ class Simulation:
             accel_cmd = finish_step(
                 table, step, t, out, steer_cmd, speed, step_time, diagnostics, foot, samples, settings
             )
-            if accel_cmd != accel_cmd:  # NaN: a speed, reference or rate not finite; the Python controller says so
+            if accel_cmd != accel_cmd:  # NaN: the speed, its reference or the reference's rate is not finite
                 s_m = float(foot[FOOT_S])
                 rate = speed * path.speed_gradient(s_m) if cfg.speed_feedforward else 0.0
-                PISpeedController(speed_gains).step(float(path.speed(s_m)), speed, dt, rate)
+                speeds = (float(path.speed(s_m)), speed, rate)
+                require_finite("the speed reference, the speed and the reference's rate (m/s, m/s, m/s^2)", speeds)
             log.n = step + 1
             try:
                 if actuator is None:

@@ -331,7 +331,7 @@ def test_a_path_tighter_than_the_vehicle_turns_is_named_before_the_run(tmp_path:
     def stop(*_args, **_kwargs):
         raise WorkbenchInputError("stopped before simulating")
 
-    monkeypatch.setattr("workbench.apps.cli.Simulation.run", stop)
+    monkeypatch.setattr("workbench.simulation.simulator.Simulation.run", stop)
     angles = np.linspace(0.0, 2 * np.pi, 60)  # a 1 m circle: the car turns no tighter than a 1.42 m radius
     pd.DataFrame({"x": 1.0 * np.cos(angles), "y": 1.0 * np.sin(angles)}).to_csv(tmp_path / "tight.csv", index=False)
     args = [*QUICK_RUN[:1], str(tmp_path / "tight.csv"), *QUICK_RUN[2:], "--out", str(tmp_path / "o")]
@@ -350,7 +350,7 @@ def test_run_refuses_a_path_the_vehicle_cannot_follow_unless_allowed(tmp_path: P
         runs.append(1)
         raise WorkbenchInputError("stopped before simulating")
 
-    monkeypatch.setattr("workbench.apps.cli.Simulation.run", stop)
+    monkeypatch.setattr("workbench.simulation.simulator.Simulation.run", stop)
     arc = [(3.0 * np.sin(a), 3.0 - 3.0 * np.cos(a)) for a in np.linspace(0.0, np.pi, 13)[1:-1]]
     points = [(x, 0.0) for x in range(-20, 1)] + arc + [(x, 6.0) for x in range(0, -21, -1)]
     pd.DataFrame(points, columns=["x", "y"]).to_csv(tmp_path / "r3.csv", index=False)

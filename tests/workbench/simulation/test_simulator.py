@@ -196,6 +196,35 @@ def test_diverging_plant_stops_with_a_clear_message_and_keeps_the_trace() -> Non
     assert np.all(np.isfinite(result.to_pandas().drop(columns=["ctrl_lookahead_m"]).to_numpy()))
 
 
+
+class _BadOutputs(KinematicBicycle):
+    """A plant whose outputs turn non-finite past x = 10 m: `column` (0 x, 3 vx) becomes `value`."""
+
+    def __init__(self, column: int, value: float) -> None:
+        super().__init__()
+        self.column, self.value = column, value
+
+    def outputs(self, state, steer, accel):
+        out = super().outputs(state, steer, accel)
+        if out[0] > 10.0:
+            out = np.array(out, dtype=float)
+            out[self.column] = self.value
+        return out
+
+
+@pytest.mark.parametrize(
+    ("column", "value", "needle"),
+    [
+        (0, math.nan, r"position must be finite to project onto straight; got \(nan, 0\.0\)"),
+        (3, math.inf, r"the speed reference, the speed and the reference's rate .* entry 1 is inf"),
+    ],
+)
+def test_a_non_finite_position_or_speed_is_refused_naming_the_value(column: int, value: float, needle: str) -> None:
+    vehicle = _BadOutputs(column, value)
+    scenario = _scenario(ClothoidChain().straight(100.0).to_path("straight"))
+    with pytest.raises(WorkbenchInputError, match=needle):
+        Simulation(scenario, vehicle, _Failing(vehicle.geometry, "nan", after=10**9)).run()
+
 def test_going_past_the_start_of_an_open_path_is_leaving_it() -> None:
     """A vehicle circling at full lock from the start passes behind it: before, the CTE was measured sideways from
     the start's tangent only and the run went on to its time-out, reported on the path."""
