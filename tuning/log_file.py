@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import math
 import os
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -150,10 +150,6 @@ class VehicleLog:
             yaw_rate_rad_s=values.get(YAW_RATE_COLUMN),
             resampled=resampled,
         )
-
-    def without_positions(self) -> VehicleLog:
-        """The same log without x_m, y_m (to use the yaw rate instead)."""
-        return replace(self, x_m=None, y_m=None)
 
 
 def read_log(path: str | Path) -> VehicleLog:

@@ -6,11 +6,14 @@ of Autoware's lateral MPC. Both predict with `PredictionModel`, whose parameters
 (`prediction_params_for`) and, optionally, the steering lag identified by `tuning fit-lag`.
 
 Modules: prediction_model (parameters, model kinds, ODEs), ocp (the optimal control problem), nlp_solver (IPOPT),
-rti (real-time iteration), sparse_qp (the OSQP QP), lmpc (LTV-MPC), plan (warm start and fallback), common (the
-shared controller step), codegen (compiled CasADi functions), status (solve status codes).
+rti (real-time iteration), sparse_qp (the OSQP QP), lmpc (LTV-MPC), plan (warm start and fallback), config (the
+shared options), controller (the shared controller step and its delay compensation), delay_segments (its compiled
+parts), pose_filter (the optional pose filter), prediction_vehicle (which vehicle is predicted with), preview (the
+path along the horizon), codegen (compiled CasADi functions), status (solve status codes).
 """
 
-from controllers.mpc.common import MPCConfig, MPCController
+from controllers.mpc.config import MPCConfig
+from controllers.mpc.controller import MPCController
 from controllers.mpc.lmpc import LMPCConfig, LMPCController
 from controllers.mpc.nmpc import NMPCConfig, NMPCController
 from controllers.mpc.prediction_model import (

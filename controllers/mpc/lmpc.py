@@ -21,19 +21,19 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass
-from typing import Any, ClassVar
+from typing import ClassVar
 
 import casadi as ca
 import numpy as np
 
 from controllers.config_checks import Number, Whole, option
 from controllers.mpc.codegen import FastFunction, compile_function
-from controllers.mpc.common import MPC_SEARCH_SPACE, MPCConfig, MPCController
+from controllers.mpc.config import MPC_SEARCH_SPACE, MPCConfig
+from controllers.mpc.controller import MPCController
 from controllers.mpc.ocp import TrackingOCP
 from controllers.mpc.sparse_qp import OsqpSettings
 from controllers.mpc.status import SolveResult
 from controllers.search_space import Tunable
-from workbench.vehicles.geometry import VehicleGeometry
 
 
 class LtvSolver:
@@ -128,17 +128,15 @@ class LMPCController(MPCController):
 
     name: ClassVar[str] = "lmpc"
     config_type: ClassVar[type] = LMPCConfig
+    config: LMPCConfig
     search_space: ClassVar[tuple[Tunable, ...]] = MPC_SEARCH_SPACE
 
-    def __init__(self, geometry: VehicleGeometry, config: Any | None = None, vehicle: object | None = None) -> None:
-        super().__init__(geometry, config, vehicle)
-
     def _build_solver(self) -> None:
-        cfg: LMPCConfig = self.config
+        cfg = self.config
         settings = OsqpSettings(
             eps_abs=cfg.qp_tolerance,
             eps_rel=cfg.qp_tolerance,
             max_iter=cfg.qp_max_iterations,
-            time_limit_s=cfg.max_solve_time_s or 0.02,
+            time_limit_s=self._solve_budget_s(),
         )
         self.solver = LtvSolver(self.ocp, settings, codegen=cfg.codegen)

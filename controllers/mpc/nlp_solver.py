@@ -26,6 +26,7 @@ import time
 import casadi as ca
 import numpy as np
 
+from controllers.mpc.config import DEFAULT_PERIOD_S
 from controllers.mpc.ocp import TrackingOCP
 from controllers.mpc.plan import interp_rows
 from controllers.mpc.status import IPOPT_STATUS, SolveResult, SolveStatus
@@ -39,7 +40,7 @@ class IpoptSolver:
         ocp: TrackingOCP,
         max_iterations: int = 100,
         tolerance: float = 1e-6,
-        max_solve_time_s: float = 0.02,
+        max_solve_time_s: float = DEFAULT_PERIOD_S,
         exact_hessian: bool = False,
         codegen: bool = True,
     ) -> None:

@@ -13,21 +13,21 @@ Two solvers:
           compiled to C (`rti.py`, `codegen.py`); iterates to convergence on the first step only.
   "ipopt" the full NLP to convergence with IPOPT (expanded SX graphs, warm start of primal and dual variables),
           a converged reference that is slower (`nlp_solver.py`).
-A failed or late solve is never used nor hidden: the controller replays its previous plan (`common.py`).
+A failed or late solve is never used nor hidden: the controller replays its previous plan (`controller.py`).
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any, ClassVar
+from typing import ClassVar
 
 from controllers.config_checks import Choice, Flag, Number, Whole, option
-from controllers.mpc.common import MPC_SEARCH_SPACE, MPCConfig, MPCController
+from controllers.mpc.config import MPC_SEARCH_SPACE, MPCConfig
+from controllers.mpc.controller import MPCController
 from controllers.mpc.nlp_solver import IpoptSolver
 from controllers.mpc.rti import RtiSolver
 from controllers.mpc.sparse_qp import OsqpSettings
 from controllers.search_space import Tunable
-from workbench.vehicles.geometry import VehicleGeometry
 
 SOLVERS = ("rti", "ipopt")
 
@@ -65,14 +65,12 @@ class NMPCController(MPCController):
 
     name: ClassVar[str] = "nmpc"
     config_type: ClassVar[type] = NMPCConfig
+    config: NMPCConfig
     search_space: ClassVar[tuple[Tunable, ...]] = MPC_SEARCH_SPACE
 
-    def __init__(self, geometry: VehicleGeometry, config: Any | None = None, vehicle: object | None = None) -> None:
-        super().__init__(geometry, config, vehicle)
-
     def _build_solver(self) -> None:
-        cfg: NMPCConfig = self.config
-        budget = cfg.max_solve_time_s or self._default_budget()
+        cfg = self.config
+        budget = self._solve_budget_s()
         if cfg.solver == "ipopt":
             self.solver = IpoptSolver(
                 self.ocp, cfg.max_iterations, cfg.tolerance, budget, cfg.exact_hessian, cfg.codegen
@@ -82,7 +80,3 @@ class NMPCController(MPCController):
                 eps_abs=cfg.qp_tolerance, eps_rel=cfg.qp_tolerance, max_iter=cfg.qp_max_iterations, time_limit_s=budget
             )
             self.solver = RtiSolver(self.ocp, settings, codegen=cfg.codegen, first_iterations=cfg.first_iterations)
-
-    @staticmethod
-    def _default_budget() -> float:
-        return 0.02  # the default controller period (50 Hz); reset() sets the actual sample time

@@ -59,7 +59,7 @@ def test_the_clothoid_controller_refuses_a_delay_its_config_cannot_predict_over(
 
 @pytest.mark.parametrize("name", ["nmpc", "lmpc"])
 def test_an_mpc_under_a_noisy_pose_is_told_its_delays_and_filters_the_pose(name: str) -> None:
-    from controllers.mpc.common import INFORMED_POSE_FILTER_CUTOFF_HZ
+    from controllers.mpc.pose_filter import INFORMED_POSE_FILTER_CUTOFF_HZ
 
     cls = CONTROLLERS[name]
     config = cls.config_type()

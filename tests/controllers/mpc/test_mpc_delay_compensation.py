@@ -11,7 +11,7 @@ import pytest
 
 from controllers.base import Measurement
 from controllers.mpc import LMPCConfig, LMPCController, NMPCConfig, NMPCController
-from controllers.mpc.common import _delay_segments
+from controllers.mpc.delay_segments import delay_segments
 from tuning.own_tuning import tuned_controller
 from workbench.base.clothoid_chain import ClothoidChain
 from workbench.base.errors import WorkbenchInputError
@@ -148,7 +148,7 @@ def test_segments_follow_the_buffer() -> None:
     """The commanded angle over the window: linear between the buffered commands, held before the first and after
     the last, segments breaking at the buffered times and never longer than asked."""
     times, commands = np.array([0.0, 0.02, 0.04]), np.array([0.1, 0.2, 0.0])
-    durations, rates, first = _delay_segments(times, commands, -0.03, 0.1, 0.02)
+    durations, rates, first = delay_segments(times, commands, -0.03, 0.1, 0.02)
     assert first == 0.1
     assert np.sum(durations) == pytest.approx(0.1, abs=1e-15) and np.max(durations) <= 0.02 + 1e-15
     np.testing.assert_allclose(durations, [0.015, 0.015, 0.02, 0.02, 0.015, 0.015], atol=1e-15)

@@ -1,4 +1,4 @@
-"""The MPCs' pose filter (`pose_filter_cutoff_hz`, `yaw_rate_latency_s`; `controllers.mpc.common.PoseFilter`), which
+"""The MPCs' pose filter (`pose_filter_cutoff_hz`, `yaw_rate_latency_s`; `pose_filter.PoseFilter`), which
 keeps pose noise from reaching the steering command: off by default and then changing nothing; its response (a
 first-order low-pass at the cutoff on the measured pose, exact on the motion the rates describe, the yaw rate
 aligned with the pose); its option checks; and, closed loop, the loaded truck under the automotive conditions,
@@ -14,7 +14,7 @@ from scipy.signal import lfilter
 
 from controllers.base import Measurement
 from controllers.mpc import LMPCConfig, LMPCController, MPCConfig, NMPCConfig, NMPCController
-from controllers.mpc.common import PoseFilter
+from controllers.mpc.pose_filter import PoseFilter
 from tuning.own_tuning import tuned_controller
 from workbench.base.clothoid_chain import ClothoidChain
 from workbench.base.errors import WorkbenchInputError
