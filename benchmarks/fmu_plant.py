@@ -23,9 +23,6 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import importlib.util
-import json
-import os
-import platform
 import sys
 import tempfile
 import time
@@ -34,6 +31,7 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 
 import numpy as np
+from benchmark_report import exit_code, machine, write_results
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = ROOT / "examples" / "fmu_plant"
@@ -399,23 +397,14 @@ def main() -> int:
         print(f"{e.name:<74} {times}  {goal}{note}")
     differences = ", ".join(f"{k} {v:.3g}" for k, v in comparison.items())
     print(f"truck dlc, FMU against native, largest difference: {differences}")
-    load = os.getloadavg() if hasattr(os, "getloadavg") else None
     document = {
-        "machine": {
-            "python": sys.version.split()[0],
-            "platform": platform.platform(),
-            "cpus": os.cpu_count(),
-            "load_average": load,
-        },
+        "machine": machine(),
         "created_unix_s": time.time(),
         "entries": [asdict(e) for e in entries],
         "truck_dlc_fmu_vs_native_max_difference": comparison,
     }
-    args.out.parent.mkdir(parents=True, exist_ok=True)
-    args.out.write_text(json.dumps(document, indent=2) + "\n")
-    print(f"wrote {args.out}")
-    missed = [e.name for e in entries if e.goal_met is False]
-    return 1 if (args.check and missed) else 0
+    write_results(args.out, document)
+    return exit_code(entries, args.check)
 
 
 if __name__ == "__main__":

@@ -9,9 +9,7 @@ names its goal, and `--check` exits non-zero when a goal is missed.
 from __future__ import annotations
 
 import argparse
-import json
 import os
-import platform
 import resource
 import statistics
 import subprocess
@@ -24,6 +22,7 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
+from benchmark_report import exit_code, machine, write_results
 
 from controllers import CONTROLLERS
 from controllers.base import Controller, Measurement
@@ -367,16 +366,13 @@ def main(argv: list[str] | None = None) -> int:
         )
     print(f"peak memory (max RSS of this process) {peak_mb:.0f} MB")
     document = {
-        "machine": {"python": sys.version.split()[0], "platform": platform.platform(), "cpus": os.cpu_count()},
+        "machine": machine(),
         "created_unix_s": time.time(),
         "entries": [asdict(e) for e in entries],
         "peak_rss_mb": peak_mb,
     }
-    args.out.parent.mkdir(parents=True, exist_ok=True)
-    args.out.write_text(json.dumps(document, indent=2) + "\n")
-    print(f"wrote {args.out}")
-    missed = [e.name for e in entries if e.goal_met is False]
-    return 1 if (args.check and missed) else 0
+    write_results(args.out, document)
+    return exit_code(entries, args.check)
 
 
 if __name__ == "__main__":

@@ -13,15 +13,15 @@ or less; `--check` exits 1 when one is missed.
 from __future__ import annotations
 
 import argparse
-import json
 import os
-import platform
 import statistics
 import subprocess
 import sys
 import time
 from dataclasses import asdict, dataclass
 from pathlib import Path
+
+from benchmark_report import exit_code, machine, write_results
 
 ROOT = Path(__file__).resolve().parents[1]
 DEFAULT_TRACK = ROOT.parent / "shared" / "tracks" / "Zandvoort_track.csv"
@@ -103,23 +103,12 @@ def main(argv: list[str] | None = None) -> int:
         if e.returncode:
             goal += f" (exit code {e.returncode})"
         print(f"{e.name:<40} {e.median_s:9.3f} {e.min_s:7.3f} {e.overhead_s:14.3f}  {goal}")
-    load = os.getloadavg() if hasattr(os, "getloadavg") else None
-    document = {
-        "machine": {
-            "python": sys.version.split()[0],
-            "platform": platform.platform(),
-            "cpus": os.cpu_count(),
-            "load_average": load,
-        },
-        "created_unix_s": time.time(),
-        "runs": args.runs,
-        "entries": [asdict(e) for e in entries],
-    }
-    args.out.parent.mkdir(parents=True, exist_ok=True)
-    args.out.write_text(json.dumps(document, indent=2) + "\n")
-    print(f"wrote {args.out}" + (f" (load average {load[0]:.1f} on {os.cpu_count()} CPUs)" if load else ""))
-    missed = [e.name for e in entries if e.goal_met is False]
-    return 1 if (args.check and missed) else 0
+    host = machine()
+    entries_out = [asdict(e) for e in entries]
+    document = {"machine": host, "created_unix_s": time.time(), "runs": args.runs, "entries": entries_out}
+    load = host["load_average"]
+    write_results(args.out, document, f" (load average {load[0]:.1f} on {host['cpus']} CPUs)" if load else "")
+    return exit_code(entries, args.check)
 
 
 if __name__ == "__main__":

@@ -17,8 +17,8 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 #: FMI version -> the slave's source file.
 SLAVES = {"2": HERE / "commonroad_st_fmi2.py", "3": HERE / "commonroad_st_fmi3.py"}
-#: The plant model every slave imports, packed into the FMU beside it.
-MODEL_FILE = HERE / "commonroad_st_plant.py"
+#: The plant model and the slaves' shared part, which every slave imports, packed into the FMU beside it.
+MODEL_FILES = [HERE / "commonroad_st_plant.py", HERE / "plant_slave.py"]
 
 
 def build(out: Path, fmi_version: str = "2", slave: Path | None = None) -> Path:
@@ -34,7 +34,7 @@ def build(out: Path, fmi_version: str = "2", slave: Path | None = None) -> Path:
     out.parent.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory() as tmp:
         script = Path(slave or SLAVES[fmi_version])
-        extras = [MODEL_FILE] + ([SLAVES[fmi_version]] if script != SLAVES[fmi_version] else [])
+        extras = MODEL_FILES + ([SLAVES[fmi_version]] if script != SLAVES[fmi_version] else [])
         built = FmuBuilder.build_FMU(script, dest=tmp, project_files=extras)
         shutil.move(str(built), out)
     return out

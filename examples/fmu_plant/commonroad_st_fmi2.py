@@ -5,38 +5,24 @@ Inputs: `delta_cmd` (front road-wheel angle command, rad, positive left) and `ac
 yaw counter-clockwise). Each `doStep` integrates its communication step with the inputs held.
 """
 
-from commonroad_st_plant import OUTPUT_NAMES, CommonRoadSTPlant
+from commonroad_st_plant import OUTPUT_NAMES
+from plant_slave import PlantSlave
 from pythonfmu import Fmi2Causality, Fmi2Slave, Fmi2Variability, Real
 
 
-class CommonRoadST(Fmi2Slave):
+class CommonRoadST(PlantSlave, Fmi2Slave):
     author = "lateral-workbench example"
     description = "CommonRoad single-track car (vehiclemodels.vehicle_dynamics_st) with a steering actuator"
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
-        self.plant = CommonRoadSTPlant()
-        self.delta_cmd = 0.0
-        self.accel_cmd = 0.0
-        self.v0 = 10.0
-        for name in OUTPUT_NAMES:
-            setattr(self, name, 0.0)
+        self._init_plant()
         self.register_variable(Real("delta_cmd", causality=Fmi2Causality.input))
         self.register_variable(Real("accel_cmd", causality=Fmi2Causality.input))
         self.register_variable(Real("v0", causality=Fmi2Causality.parameter, variability=Fmi2Variability.fixed))
         for name in OUTPUT_NAMES:
             self.register_variable(Real(name, causality=Fmi2Causality.output))
 
-    def _publish(self):
-        for name, value in zip(OUTPUT_NAMES, self.plant.outputs(), strict=True):
-            setattr(self, name, value)
-
-    def exit_initialization_mode(self):
-        self.plant.start(self.v0)
-        self._publish()
-
     def do_step(self, current_time, step_size):
-        self.plant.delta_cmd, self.plant.accel_cmd = self.delta_cmd, self.accel_cmd
-        self.plant.step(step_size)
-        self._publish()
+        self._advance(step_size)
         return True

@@ -12,6 +12,8 @@ import pytest
 
 #: The benchmarks' folder (the repository's root is two levels up).
 BENCHMARKS = Path(__file__).resolve().parents[2] / "benchmarks"
+if str(BENCHMARKS) not in sys.path:  # the scripts import their shared module (benchmark_report) as when run
+    sys.path.insert(0, str(BENCHMARKS))
 
 
 def _script(file_name: str) -> Iterator[ModuleType]:
