@@ -8,37 +8,28 @@ options' (`tuning.preset_tuning.PRESET_TUNING_OPTIONS`). The full chain on this 
 
 from __future__ import annotations
 
-import dataclasses
 import json
 import shutil
 from pathlib import Path
 
 import pytest
 from fmu_plant_files import write_fmu_vehicle_file
+from quick_tuning import QUICK
 
 from tuning import preset_tuning
 from tuning.own_tuning import cache_key, tuning_for
-from tuning.preset_tuning import PRESET_TUNING_OPTIONS
-from tuning.tuning_dirs import CACHE_ENV, VEHICLE_FILE, params_sha256
+from tuning.tuning_dirs import VEHICLE_FILE, params_sha256
 from workbench.apps.cli import main
 from workbench.vehicles import load_vehicle
 from workbench.vehicles.presets import params_from_toml
 
-QUICK = dataclasses.replace(PRESET_TUNING_OPTIONS, schedule_speeds_kmh=(40.0,), limits_speeds_kmh=(10.0, 50.0, 100.0))
+pytestmark = pytest.mark.usefixtures("private_cache")  # no test reads or writes the user's cache
 
 
-@pytest.fixture(autouse=True)
-def _private_cache(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
-    """No test reads or writes the user's cache."""
-    cache = tmp_path / "cache"
-    monkeypatch.setenv(CACHE_ENV, str(cache))
-    return cache
-
-
-def test_an_fmu_plant_is_tuned_on_first_use_into_the_cache(example_plant_fmus, _private_cache, capsys) -> None:
+def test_an_fmu_plant_is_tuned_on_first_use_into_the_cache(example_plant_fmus, private_cache, capsys) -> None:
     plant = load_vehicle(str(example_plant_fmus["2"]))
     tuning = tuning_for(plant, QUICK)
-    directory = _private_cache / cache_key(plant, QUICK)
+    directory = private_cache / cache_key(plant, QUICK)
     assert str(directory) in tuning.source
     assert "no clothoid-controller tuning yet for this fmu" in capsys.readouterr().err
     assert tuning.filter_schedule.speeds_kmh == (40.0,)
