@@ -1,7 +1,8 @@
-"""Checks of controller options: each refuses a value with WorkbenchInputError naming the option, the value received
-(numbers as numbers: `nan`, `1e+308`, never `np.float64(nan)`) and what is allowed.
+"""Controller options declared with their rules: each config field's unit, allowed values and meaning in one place,
+checked by the base layer's checks (`workbench.base.errors`: each refuses a value with WorkbenchInputError naming
+the option, the value received, numbers as numbers, and what is allowed).
 
-The controllers' config dataclasses check every field with these, one field at a time and before any value derived
+The controllers' config dataclasses check every field by its rule, one field at a time and before any value derived
 from several fields is computed, so that a bad value is reported as itself (`frechet_point_spacing_m = 0` is "must
 be > 0", not a ZeroDivisionError). Booleans are not numbers here (`True` is refused where a number is asked for).
 
@@ -14,88 +15,22 @@ checks every field by its rule, and `workbench controllers --show NAME` prints t
 from __future__ import annotations
 
 import dataclasses
-import math
-import numbers
-import os
-from collections.abc import Callable, Iterable
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
-import numpy as np
-
-from workbench.base.errors import WorkbenchInputError, is_number, value_text
-
-
-def shown_all(values: object) -> str:
-    """A sequence as a message shows it: `[5.0, 10.0]`, each entry by `value_text`."""
-    return "[" + ", ".join(value_text(v) for v in values) + "]"  # type: ignore[union-attr]
-
-
-def check_number(
-    name: str, value: object, low: float, high: float, unit: str = "", *, low_open: bool = False, note: str = ""
-) -> None:
-    """A finite number in [low, high] ((low, high] when `low_open`); `note` is added to what is allowed."""
-    interval = f"{'(' if low_open else '['}{low:g}, {high:g}]" + (f" {unit}" if unit else "")
-    allowed = f"a finite number in {interval}" + (f" ({note})" if note else "")
-    if not is_number(value) or not math.isfinite(value):
-        raise WorkbenchInputError(f"{name} must be {allowed}; got {value_text(value)}")
-    if value < low or (low_open and value == low) or value > high:
-        raise WorkbenchInputError(f"{name} must be {allowed}; got {value_text(value)}")
-
-
-def check_optional_number(
-    name: str,
-    value: object,
-    low: float,
-    high: float,
-    unit: str = "",
-    *,
-    low_open: bool = False,
-    none_means: str = "off",
-) -> None:
-    """None, or what `check_number` allows; `none_means` says what None does."""
-    if value is not None:
-        check_number(name, value, low, high, unit, low_open=low_open, note=f"or None: {none_means}")
-
-
-def check_whole(name: str, value: object, low: int, high: int) -> None:
-    """A whole number (not a boolean, not a float) in [low, high]."""
-    if not isinstance(value, numbers.Integral) or isinstance(value, bool | np.bool_) or not low <= value <= high:
-        raise WorkbenchInputError(f"{name} must be a whole number in [{low}, {high}]; got {value_text(value)}")
-
-
-def check_bool(name: str, value: object) -> None:
-    """True or False."""
-    if not isinstance(value, bool | np.bool_):
-        raise WorkbenchInputError(f"{name} must be true or false; got {value_text(value)}")
-
-
-def check_choice(name: str, value: object, allowed: Iterable[str]) -> None:
-    """One of the names in `allowed`."""
-    allowed = tuple(allowed)
-    if not isinstance(value, str) or value not in allowed:
-        raise WorkbenchInputError(f"{name} must be one of {', '.join(allowed)}; got {value_text(value)}")
-
-
-def check_optional_instance(name: str, value: object, cls: type) -> None:
-    """None, or an instance of `cls` (an object a file was read into at the boundary, never a path)."""
-    if value is not None and not isinstance(value, cls):
-        raise WorkbenchInputError(f"{name} must be a {cls.__name__} or None; got {value_text(value)}")
-
-
-def check_optional_path(name: str, value: object) -> None:
-    """None, or a file path (text or a path object, not empty)."""
-    if value is None:
-        return
-    if isinstance(value, os.PathLike):
-        value = os.fspath(value)
-    if not isinstance(value, str) or not value:
-        raise WorkbenchInputError(f"{name} must be a file path or None; got {value_text(value)}")
-
+from workbench.base.errors import (
+    range_text,
+    require_bool,
+    require_choice,
+    require_in_range,
+    require_instance_or_none,
+    require_whole,
+)
 
 # ----------------------------------------------------------------------------------------------- option rules
-# A config field's rule says what it allows and checks it (the messages above); its field's metadata holds the rule
-# with the field's unit and meaning (`option`), so that what `workbench controllers --show NAME` prints as the
+# A config field's rule says what it allows and checks it (`workbench.base.errors`); its field's metadata holds
+# the rule with the field's unit and meaning (`option`), so that what `workbench controllers --show NAME` prints as the
 # allowed range is what the config's validation refuses outside of.
 
 #: The unit written for an option that is no physical quantity (a choice, a switch, a ratio, a count of things).
@@ -119,12 +54,12 @@ class Number:
         if self.none_means is not None:
             if value is not None:
                 note = f"{self.note}; or None: {self.none_means}" if self.note else f"or None: {self.none_means}"
-                check_number(name, value, self.low, self.high, unit, low_open=self.low_open, note=note)
+                require_in_range(name, value, self.low, self.high, unit, low_open=self.low_open, note=note)
             return
-        check_number(name, value, self.low, self.high, unit, low_open=self.low_open, note=self.note)
+        require_in_range(name, value, self.low, self.high, unit, low_open=self.low_open, note=self.note)
 
     def allowed(self) -> str:
-        text = f"{'(' if self.low_open else '['}{self.low:g}, {self.high:g}]" + (f" ({self.note})" if self.note else "")
+        text = range_text(self.low, self.high, low_open=self.low_open, note=self.note)
         return text + (f', or "none": {self.none_means}' if self.none_means is not None else "")
 
 
@@ -137,7 +72,7 @@ class Whole:
     unit: str = NO_UNIT
 
     def check(self, name: str, value: object) -> None:
-        check_whole(name, value, self.low, self.high)
+        require_whole(name, value, self.low, self.high)
 
     def allowed(self) -> str:
         return f"a whole number in [{self.low}, {self.high}]"
@@ -154,7 +89,7 @@ class Choice:
         return self.names() if callable(self.names) else self.names
 
     def check(self, name: str, value: object) -> None:
-        check_choice(name, value, self.choices())
+        require_choice(name, value, self.choices())
 
     def allowed(self) -> str:
         return "one of " + ", ".join(f'"{n}"' for n in self.choices())
@@ -167,7 +102,7 @@ class Flag:
     unit: str = NO_UNIT
 
     def check(self, name: str, value: object) -> None:
-        check_bool(name, value)
+        require_bool(name, value)
 
     def allowed(self) -> str:
         return "true or false"
@@ -183,7 +118,7 @@ class Instance:
     unit: str = NO_UNIT
 
     def check(self, name: str, value: object) -> None:
-        check_optional_instance(name, value, self.cls)
+        require_instance_or_none(name, value, self.cls)
 
     def allowed(self) -> str:
         return f'a {self.cls.__name__}, or "none": {self.none_means}'

@@ -19,7 +19,6 @@ gets the vehicle's tuning (`ClothoidConfig.tuning`), so the controller itself re
 
 from __future__ import annotations
 
-import dataclasses
 import hashlib
 import json
 import os
@@ -29,7 +28,7 @@ import sys
 import tempfile
 import time
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Protocol, Self, TypeVar, runtime_checkable
 
 from workbench.base.errors import WorkbenchInputError
 from workbench.base.user_cache import check_private_tree
@@ -209,13 +208,26 @@ def tuning_dir_for(vehicle: VehicleModel, options: PresetTuningOptions | None = 
 # ---- the controller with its vehicle's tuning ------------------------------------------------------------------
 
 
-def with_vehicle_tuning(config: object, vehicle: VehicleModel) -> object:
-    """`config` with the vehicle's own tuning (`tuning_for`) when it is a ClothoidConfig without one; any other
-    config as it is."""
-    # A ClothoidConfig exists only once its module is imported: a run of another controller does not import it.
-    clothoid = sys.modules.get("controllers.clothoid.controller")
-    if clothoid is not None and isinstance(config, clothoid.ClothoidConfig) and config.tuning is None:
-        return dataclasses.replace(config, tuning=tuning_for(vehicle))
+#: A controller's config, returned as it came or with the vehicle's tuning.
+ConfigT = TypeVar("ConfigT")
+
+
+@runtime_checkable
+class TunableConfig(Protocol):
+    """A controller config that takes its vehicle's own tuning (`ClothoidConfig`): its tuning (None: not given) and
+    the config with one. A protocol, so that telling such a config from another imports no controller's module."""
+
+    @property
+    def tuning(self) -> VehicleTuning | None: ...
+
+    def with_tuning(self, tuning: VehicleTuning) -> Self: ...
+
+
+def with_vehicle_tuning(config: ConfigT, vehicle: VehicleModel) -> ConfigT:
+    """`config` with the vehicle's own tuning (`tuning_for`) when it takes one (`TunableConfig`) and has none; any
+    other config as it is."""
+    if isinstance(config, TunableConfig) and config.tuning is None:
+        return config.with_tuning(tuning_for(vehicle))
     return config
 
 

@@ -17,10 +17,9 @@ from typing import Any
 
 from controllers.clothoid.filter_schedule import FilterSchedule
 from controllers.clothoid.vehicle_tuning import VehicleTuning
-from controllers.config_checks import shown_all
 from tuning.filter_file import read_filter_file
 from tuning.limits_file import read_limits_file
-from workbench.base.errors import WorkbenchInputError, value_text
+from workbench.base.errors import WorkbenchInputError, shown_all, value_text
 from workbench.base.input_files import read_json
 from workbench.base.toml_text import toml_value
 from workbench.base.user_cache import private_cache_dir

@@ -21,9 +21,11 @@ from workbench.base.errors import WorkbenchInputError, require_in_range
 PARAM_KEYS = ("omega_z_rad_s", "psi", "omega_p_rad_s")
 SPEED_RANGE_KMH = (0.0, 300.0)
 
-#: The default filter until `tuning` has identified the user's vehicle: Eq. 6 designed by `from_lag` (zeros on the
-#: lag's poles, triple pole at 3 wn = 13.32 rad/s) for the lag of this repository's loaded tractor-semitrailer preset
-#: at 30 km/h, which a fit of Eq. 5 gave as omega_n = 4.44 rad/s, zeta = 0.80.
+#: A reference filter, not the controller's default (an untuned controller runs no lead filter, a tuned one its
+#: vehicle's schedule): the base the lead-filter scaling of studies scales when the run gives no filter and the
+#: vehicle has no tuning (`workbench.apps.studies.lead_filter_scaling`). Eq. 6 designed by `from_lag` (zeros on the
+#: lag's poles, triple pole at 3 wn = 13.32 rad/s) for a lag of omega_n = 4.44 rad/s, zeta = 0.80, a fit of Eq. 5 to
+#: the loaded tractor-semitrailer preset at 30 km/h.
 DEFAULT_FILTER = LeadFilterParams.from_lag(4.44, 0.80)
 
 

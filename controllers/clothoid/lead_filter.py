@@ -38,12 +38,6 @@ PSI_MAX = 5.0
 POLE_RATIO_RANGE = (1.0, 100.0)
 
 
-def _require_psi(name: str, value: float) -> None:
-    """Damping of a complex pair: a finite number in (0, PSI_MAX]."""
-    if isinstance(value, bool) or not isinstance(value, int | float) or not 0 < value <= PSI_MAX:
-        raise WorkbenchInputError(f"{name} must be a finite number in (0, {PSI_MAX}]; got {value_text(value)}")
-
-
 @dataclass(frozen=True)
 class LeadFilterParams:
     """Parameters of Eq. 6: omega_z_rad_s (wz) and psi (damping) of the zero pair, omega_p_rad_s (wp) of the
@@ -55,7 +49,7 @@ class LeadFilterParams:
 
     def __post_init__(self) -> None:
         require_in_range("omega_z_rad_s", self.omega_z_rad_s, *OMEGA_RANGE_RAD_S, "rad/s")
-        _require_psi("psi", self.psi)
+        require_in_range("psi", self.psi, 0.0, PSI_MAX, low_open=True)
         require_in_range("omega_p_rad_s", self.omega_p_rad_s, *OMEGA_RANGE_RAD_S, "rad/s")
         ratio = self.omega_p_rad_s / self.omega_z_rad_s
         low, high = POLE_RATIO_RANGE
@@ -75,7 +69,7 @@ class LeadFilterParams:
         pole_ratio times faster. `tuning` will offer a proper loop-shaping design (bandwidth against
         high-frequency gain and steering-rate limits); this is the simple starting point."""
         require_in_range("omega_n_rad_s", omega_n_rad_s, *OMEGA_RANGE_RAD_S, "rad/s")
-        _require_psi("zeta", zeta)
+        require_in_range("zeta", zeta, 0.0, PSI_MAX, low_open=True)
         require_in_range("pole_ratio", pole_ratio, *POLE_RATIO_RANGE)
         return cls(omega_n_rad_s, zeta, pole_ratio * omega_n_rad_s)
 

@@ -46,31 +46,27 @@ from scipy import signal
 
 from controllers.clothoid.clothoid_fit import fit_kernel
 from controllers.clothoid.lead_filter import DiscreteLeadFilter, LeadFilterParams
-from workbench.base.errors import WorkbenchInputError, require_in_range, require_positive, value_text
+from controllers.clothoid.loop_requirements import (
+    DELAY_COMPENSATIONS,
+    DELAY_UNCERTAINTY_S,
+    REQUIRED_DELAYED_GAIN_MARGIN_DB,
+    REQUIRED_DELAYED_PHASE_MARGIN_DEG,
+    REQUIRED_GAIN_MARGIN_DB,
+    REQUIRED_PHASE_MARGIN_DEG,
+    UNCERTAIN_DELAY_MARGIN_FRACTION,
+    predicts_with_model,
+)
+from workbench.base.errors import (
+    WorkbenchInputError,
+    require_choice,
+    require_in_range,
+    require_positive,
+    value_text,
+)
 from workbench.vehicles.steering_lag import SteeringLag
 
-#: Design requirement the controller keeps at every lookahead it may pick (issue 15): phase margin (deg), and gain
-#: margin (dB) both ways (rise and reduction).
-REQUIRED_PHASE_MARGIN_DEG = 45.0
-REQUIRED_GAIN_MARGIN_DB = 6.0
-#: With a known delay compensated by the lags' model (`LoopSettings.nominal`), the margins above are the nominal
-#: loop's, which sets the response; the loop with its delay and the predictor, broken at the steering sent, keeps
-#: at least these (deg, dB both ways): what a gain or delay the model does not know may change before the loop
-#: goes unstable. A Smith predictor's loop has less than its nominal one (Normey-Rico & Camacho, "Control of
-#: Dead-time Processes", 2007, ch. 5); 30 deg is the usual least phase margin (Skogestad & Postlethwaite,
-#: "Multivariable Feedback Control", 2005, sec. 2.4.3).
-REQUIRED_DELAYED_PHASE_MARGIN_DEG = 30.0
-REQUIRED_DELAYED_GAIN_MARGIN_DB = 3.0
-#: How far (s) the plant's dead time may differ from the known one, either way, with the loop kept stable and half
-#: those margins: a Smith predictor is as sensitive to a delay told too long as too short (the measured response
-#: and the model's change then count the same steering twice, or neither), and a few tens of milliseconds of it
-#: unsettle a fast loop (the dynamic bicycle at 30 km/h and 5.5 m: unstable 40 ms either way).
-DELAY_UNCERTAINTY_S = 0.05
-UNCERTAIN_DELAY_MARGIN_FRACTION = 0.5
 #: kappa(0) choices the analysis models (the controller's "steering" is not).
 INITIAL_CURVATURES = ("yaw-rate", "command")
-#: How the pose is predicted over the known delay (`ClothoidConfig.delay_compensation`).
-DELAY_COMPENSATIONS = ("model", "arc")
 #: Finite-difference step of the clothoid-law gains (m, rad and 1/m x 1 m).
 _PROBE = 1e-4
 #: Spacing (m) of the check above a bisected floor.
@@ -107,10 +103,7 @@ class LoopSettings:
         require_in_range("prediction_time_s", self.prediction_time_s, 0.0, 2.0, "s")
         require_in_range("measurement_delay_s", self.measurement_delay_s, -self.known_delay_s, 2.0, "s")
         require_in_range("known_delay_s", self.known_delay_s, 0.0, 2.0, "s")
-        if self.delay_compensation not in DELAY_COMPENSATIONS:
-            raise WorkbenchInputError(
-                f"delay_compensation must be one of {', '.join(DELAY_COMPENSATIONS)}; got {self.delay_compensation!r}"
-            )
+        require_choice("delay_compensation", self.delay_compensation, DELAY_COMPENSATIONS)
         if self.initial_curvature not in INITIAL_CURVATURES:
             raise WorkbenchInputError(
                 f"initial_curvature must be one of {', '.join(INITIAL_CURVATURES)} for the analysis; got "
@@ -124,8 +117,8 @@ class LoopSettings:
 
     @property
     def predicts_with_model(self) -> bool:
-        """Whether the pose is predicted over a known delay with the lags' model."""
-        return self.delay_compensation == "model" and self.known_delay_s > 0.0
+        """Whether the pose is predicted over a known delay with the lags' model (`loop_requirements`)."""
+        return predicts_with_model(self.delay_compensation, self.known_delay_s)
 
     @property
     def nominal(self) -> LoopSettings:

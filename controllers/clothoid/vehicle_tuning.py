@@ -16,8 +16,7 @@ import numpy as np
 from controllers.clothoid.curvature_limits import CurvatureLimits
 from controllers.clothoid.filter_schedule import FilterSchedule
 from controllers.clothoid.speed_tables import table_row
-from controllers.config_checks import shown_all
-from workbench.base.errors import WorkbenchInputError, value_text
+from workbench.base.errors import WorkbenchInputError, shown_all, value_text
 from workbench.vehicles.steering_lag import SteeringLag
 
 #: The parameters of a lag the tables hold, in their order (`VehicleTuning.lag_tables`).

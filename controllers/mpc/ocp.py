@@ -20,11 +20,10 @@ from dataclasses import dataclass
 import casadi as ca
 import numpy as np
 
-from controllers.config_checks import check_whole
 from controllers.mpc.codegen import CompiledFunction, FastFunction, compile_function
 from controllers.mpc.prediction_model import PredictionModel
 from controllers.mpc.sparse_qp import OsqpSettings, SparseMPCQP
-from workbench.base.errors import WorkbenchInputError, require_in_range, require_positive
+from workbench.base.errors import WorkbenchInputError, require_in_range, require_positive, require_whole
 
 
 @dataclass(frozen=True)
@@ -58,7 +57,7 @@ class TrackingOCP:
         min_speed_mps: float = 3.0,
         terminal_weight: np.ndarray | None = None,
     ) -> None:
-        check_whole("horizon_steps", horizon_steps, 2, 500)
+        require_whole("horizon_steps", horizon_steps, 2, 500)
         horizon_steps = int(horizon_steps)
         require_in_range("step_s", step_s, 1e-3, 1.0, "s")
         require_in_range("max_lat_accel_mps2", max_lat_accel_mps2, 0.0, 50.0, "m/s^2 (0: no limit)")

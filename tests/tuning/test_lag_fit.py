@@ -145,7 +145,7 @@ def test_the_zeta_bound_and_its_acceptance() -> None:
     assert LagFitOptions(fit_delay=True).zeta_upper_bound == DELAY_FIT_MAX_ZETA
     assert LagFitOptions(fit_delay=True).accepts_zeta_at_bound
     assert not LagFitOptions(fit_delay=True, max_zeta=10.0).accepts_zeta_at_bound
-    with pytest.raises(WorkbenchInputError, match="max_zeta must be in"):
+    with pytest.raises(WorkbenchInputError, match="max_zeta must be a finite number in"):
         LagFitOptions(max_zeta=20.0)
 
 

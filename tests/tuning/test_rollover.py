@@ -74,5 +74,5 @@ def test_a_vehicle_without_roll_is_refused() -> None:
 def test_bad_speeds(truck) -> None:
     with pytest.raises(WorkbenchInputError, match="speeds must increase strictly"):
         rollover_limits(truck, [60.0, 40.0])
-    with pytest.raises(WorkbenchInputError, match="speed_kmh must be in"):
+    with pytest.raises(WorkbenchInputError, match="speed_kmh must be a finite number in"):
         rollover_limit(truck, 0.0)

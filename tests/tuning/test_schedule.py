@@ -95,5 +95,5 @@ def test_the_margins_design_records_both_lags_and_the_floors(margins_result, tmp
 def test_design_and_loop_options_are_checked(truck) -> None:
     with pytest.raises(WorkbenchInputError, match="design must be one of cancel, margins"):
         identify_schedule(truck, [30.0], design="loop")
-    with pytest.raises(WorkbenchInputError, match="controller_rate_hz must be in"):
+    with pytest.raises(WorkbenchInputError, match="controller_rate_hz must be a finite number in"):
         identify_schedule(truck, [30.0], design="margins", controller_rate_hz=0.0)

@@ -31,7 +31,7 @@ def test_the_limits_are_the_controllers_default_rule_at_the_speeds_asked() -> No
         "steering lock",
         "lateral acceleration",
     ]
-    with pytest.raises(WorkbenchInputError, match="max_lateral_accel_g must be in"):
+    with pytest.raises(WorkbenchInputError, match="max_lateral_accel_g must be a finite number in"):
         steering_limits(car.geometry, speeds, 0.0)
 
 

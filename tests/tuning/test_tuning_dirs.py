@@ -12,6 +12,7 @@ import shutil
 from pathlib import Path
 
 import pytest
+from quick_tuning import QUICK
 
 import tuning.preset_tuning as preset_tuning
 from controllers.clothoid.curvature_limits import CurvatureLimits
@@ -43,16 +44,7 @@ from workbench.vehicles.presets import params_from_toml
 from workbench.vehicles.steering_lag import SteeringLag
 
 PRESETS = tuple(list_presets())
-#: Few speeds of a fast plant, so that generating a user vehicle's tuning takes seconds.
-QUICK = dataclasses.replace(PRESET_TUNING_OPTIONS, schedule_speeds_kmh=(40.0,), limits_speeds_kmh=(10.0, 50.0, 100.0))
-
-
-@pytest.fixture(autouse=True)
-def _private_cache(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
-    """No test reads or writes the user's cache."""
-    cache = tmp_path / "cache"
-    monkeypatch.setenv(CACHE_ENV, str(cache))
-    return cache
+pytestmark = pytest.mark.usefixtures("private_cache")  # no test reads or writes the user's cache
 
 
 @pytest.mark.parametrize("name", PRESETS)
@@ -148,21 +140,21 @@ def test_no_two_presets_share_a_filter() -> None:
 
 
 @pytest.mark.parametrize("name", PRESETS)
-def test_tuning_for_a_preset_is_its_shipped_files(name: str, _private_cache: Path, capsys) -> None:
+def test_tuning_for_a_preset_is_its_shipped_files(name: str, private_cache: Path, capsys) -> None:
     # (stale files would make tuning_for generate a tuning, for minutes: the staleness test says what to run)
     assert not preset_tuning.stale_reasons(name, shipped_tuning_root() / name), "stale; see the staleness test"
     tuning = tuning_for(make_vehicle(name))
     assert tuning == read_vehicle_tuning(shipped_tuning_root() / name)
     assert str(shipped_tuning_root() / name) in tuning.source
-    assert not _private_cache.exists() and capsys.readouterr().err == ""  # nothing generated
+    assert not private_cache.exists() and capsys.readouterr().err == ""  # nothing generated
 
 
 @pytest.mark.parametrize("payload_kg", [0.0, 5000.0, 25000.0])
-def test_the_trucks_payload_does_not_change_its_tuning(payload_kg: float, _private_cache: Path) -> None:
+def test_the_trucks_payload_does_not_change_its_tuning(payload_kg: float, private_cache: Path) -> None:
     truck = make_vehicle("tractor-semitrailer", payload_kg=payload_kg)
     assert params_sha256(truck) == params_sha256(make_vehicle("tractor-semitrailer"))
     assert tuning_for(truck) == read_vehicle_tuning(shipped_tuning_root() / "tractor-semitrailer")
-    assert not _private_cache.exists()
+    assert not private_cache.exists()
 
 
 def test_lag_at_interpolates_between_the_identified_speeds_and_clamps() -> None:
@@ -269,11 +261,11 @@ def _longer_car(tmp_path: Path) -> Path:
 
 
 def test_another_vehicle_is_tuned_once_into_the_cache(
-    tmp_path: Path, _private_cache: Path, monkeypatch, capsys
+    tmp_path: Path, private_cache: Path, monkeypatch, capsys
 ) -> None:
     car = make_vehicle(vehicle_file=_longer_car(tmp_path))
     first = tuning_for(car, QUICK)
-    directory = _private_cache / cache_key(car, QUICK)
+    directory = private_cache / cache_key(car, QUICK)
     assert str(directory) in first.source
     err = capsys.readouterr().err
     assert "no clothoid-controller tuning yet" in err and str(directory) in err and "done in" in err
@@ -284,7 +276,7 @@ def test_another_vehicle_is_tuned_once_into_the_cache(
     assert params_from_toml((directory / VEHICLE_FILE).read_text(), "x")[1] == car.params
     assert first.filter_schedule.speeds_kmh == (40.0,)
     assert first.filter_schedule.params != read_filter_file(shipped_tuning_root() / "kinematic-bicycle" / LEAD_FILE)
-    assert [p.name for p in _private_cache.iterdir()] == [directory.name]  # no temporary directory left
+    assert [p.name for p in private_cache.iterdir()] == [directory.name]  # no temporary directory left
     # the second call reads the cache: nothing is generated
     monkeypatch.setattr(preset_tuning, "write_tuning_files", _must_not_generate)
     assert tuning_for(car, QUICK) == first
@@ -329,7 +321,7 @@ def test_an_unwritable_cache_gives_the_same_clear_error(tmp_path: Path, monkeypa
 
 
 def test_options_are_validated() -> None:
-    with pytest.raises(WorkbenchInputError, match="max_lead_gain must be in"):
+    with pytest.raises(WorkbenchInputError, match="max_lead_gain must be a finite number in"):
         dataclasses.replace(PRESET_TUNING_OPTIONS, max_lead_gain=0.5)
     with pytest.raises(WorkbenchInputError, match="speeds must increase strictly"):
         PresetTuningOptions((30.0, 20.0), True, 6.0, 1.0, 0.1, (10.0,), 0.4)
@@ -337,9 +329,9 @@ def test_options_are_validated() -> None:
         dataclasses.replace(PRESET_TUNING_OPTIONS, fit_delay=1)
     with pytest.raises(WorkbenchInputError, match="design must be one of cancel, margins"):
         dataclasses.replace(PRESET_TUNING_OPTIONS, design="loop")
-    with pytest.raises(WorkbenchInputError, match="controller_rate_hz must be in"):
+    with pytest.raises(WorkbenchInputError, match="controller_rate_hz must be a finite number in"):
         dataclasses.replace(PRESET_TUNING_OPTIONS, controller_rate_hz=0.0)
-    with pytest.raises(WorkbenchInputError, match="prediction_time_s must be in"):
+    with pytest.raises(WorkbenchInputError, match="prediction_time_s must be a finite number in"):
         dataclasses.replace(PRESET_TUNING_OPTIONS, prediction_time_s=-0.1)
 
 
@@ -376,26 +368,26 @@ def test_an_edited_tuning_directory_is_refused(tmp_path: Path) -> None:
         read_vehicle_tuning(directory)
 
 
-def test_an_edited_cache_entry_is_made_again_never_used(tmp_path: Path, _private_cache: Path, monkeypatch, capsys):
+def test_an_edited_cache_entry_is_made_again_never_used(tmp_path: Path, private_cache: Path, monkeypatch, capsys):
     car = make_vehicle(vehicle_file=_longer_car(tmp_path))
     first = tuning_for(car, QUICK)
-    directory = _private_cache / cache_key(car, QUICK)
+    directory = private_cache / cache_key(car, QUICK)
     limits = directory / LIMITS_FILE
     limits.write_text(limits.read_text() + "\n")  # any change, even one that reads the same
     capsys.readouterr()
     assert tuning_for(car, QUICK) == first  # made again, the same
     assert "the cached tuning cannot be used" in capsys.readouterr().err
-    assert sorted(p.name for p in _private_cache.iterdir()) == [directory.name]  # the old entry is gone
+    assert sorted(p.name for p in private_cache.iterdir()) == [directory.name]  # the old entry is gone
     read_vehicle_tuning(directory)  # and the new one matches its manifest
 
 
-def test_a_cache_others_may_write_is_refused(tmp_path: Path, _private_cache: Path) -> None:
-    _private_cache.mkdir()
-    _private_cache.chmod(0o777)
+def test_a_cache_others_may_write_is_refused(tmp_path: Path, private_cache: Path) -> None:
+    private_cache.mkdir()
+    private_cache.chmod(0o777)
     with pytest.raises(UnsafeCacheError, match="is writable by others"):
         tuning_for(make_vehicle(vehicle_file=_longer_car(tmp_path)), QUICK)
 
 
-def test_the_cache_is_made_private(tmp_path: Path, _private_cache: Path) -> None:
+def test_the_cache_is_made_private(tmp_path: Path, private_cache: Path) -> None:
     tuning_for(make_vehicle(vehicle_file=_longer_car(tmp_path)), QUICK)
-    assert _private_cache.stat().st_mode & 0o777 == 0o700
+    assert private_cache.stat().st_mode & 0o777 == 0o700

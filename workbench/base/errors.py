@@ -1,4 +1,5 @@
-"""The one exception type for bad input: files, names, parameters and values a user can correct.
+"""The one exception type for bad input (files, names, parameters and values a user can correct) and the checks
+that raise it, for every layer: numbers in a range, whole numbers, flags, choices, objects of a type.
 
 Every message names the value received and what is allowed, so the CLI can print it as it is. Numbers in messages
 are written as Python writes its own numbers (`value_text`): a numpy scalar prints as `nan` or `1e+308`, never as
@@ -9,6 +10,7 @@ from __future__ import annotations
 
 import math
 import numbers
+from collections.abc import Iterable
 
 import numpy as np
 
@@ -51,11 +53,57 @@ def require_positive(name: str, value: float) -> None:
         raise WorkbenchInputError(f"{name} must be a finite number > 0; got {value_text(value)}")
 
 
-def require_in_range(name: str, value: float, low: float, high: float, unit: str = "") -> None:
-    """Raise WorkbenchInputError unless low <= value <= high (and finite)."""
-    if is_number(value) and math.isfinite(value) and low <= value <= high:
+def bound_text(value: float) -> str:
+    """A range's bound as a message shows it: the shortest form that reads back as the same number (`5`, `0.001`,
+    `1e+09`, `0.123456789`)."""
+    short = f"{float(value):g}"
+    return short if float(short) == float(value) else value_text(value)
+
+
+def shown_all(values: Iterable[object]) -> str:
+    """A sequence as a message shows it: `[5.0, 10.0]`, each entry by `value_text`."""
+    return "[" + ", ".join(value_text(v) for v in values) + "]"
+
+
+def range_text(low: float, high: float, unit: str = "", *, low_open: bool = False, note: str = "") -> str:
+    """What `require_in_range` allows: `[low, high] unit` (`(low, high]` when `low_open`), then `(note)`."""
+    interval = f"{'(' if low_open else '['}{bound_text(low)}, {bound_text(high)}]" + (f" {unit}" if unit else "")
+    return interval + (f" ({note})" if note else "")
+
+
+def require_in_range(
+    name: str, value: object, low: float, high: float, unit: str = "", *, low_open: bool = False, note: str = ""
+) -> None:
+    """Raise WorkbenchInputError unless `value` is a finite number (not a boolean) in [low, high] ((low, high] when
+    `low_open`). The message names `name`, the value and the range with its unit; `note` is added to what is
+    allowed ("0: off", "or None: ...")."""
+    if is_number(value) and math.isfinite(value) and low <= value <= high and not (low_open and value == low):  # type: ignore[arg-type,operator]
         return  # the message is built only for a value refused (parameters are checked on every controller step)
-    bounds = f"[{value_text(low)}, {value_text(high)}]" + (f" {unit}" if unit else "")
-    if not is_number(value) or not math.isfinite(value):
-        raise WorkbenchInputError(f"{name} must be a finite number in {bounds}; got {value_text(value)}")
-    raise WorkbenchInputError(f"{name} must be in {bounds}; got {value_text(value)}".replace("  ", " "))
+    allowed = range_text(low, high, unit, low_open=low_open, note=note)
+    raise WorkbenchInputError(f"{name} must be a finite number in {allowed}; got {value_text(value)}")
+
+
+def require_whole(name: str, value: object, low: int, high: int) -> None:
+    """Raise WorkbenchInputError unless `value` is a whole number (not a boolean, not a float) in [low, high]."""
+    if not isinstance(value, numbers.Integral) or isinstance(value, bool | np.bool_) or not low <= value <= high:
+        raise WorkbenchInputError(f"{name} must be a whole number in [{low}, {high}]; got {value_text(value)}")
+
+
+def require_bool(name: str, value: object) -> None:
+    """Raise WorkbenchInputError unless `value` is True or False."""
+    if not isinstance(value, bool | np.bool_):
+        raise WorkbenchInputError(f"{name} must be true or false; got {value_text(value)}")
+
+
+def require_choice(name: str, value: object, allowed: Iterable[str]) -> None:
+    """Raise WorkbenchInputError unless `value` is one of the names in `allowed`."""
+    allowed = tuple(allowed)
+    if not isinstance(value, str) or value not in allowed:
+        raise WorkbenchInputError(f"{name} must be one of {', '.join(allowed)}; got {value_text(value)}")
+
+
+def require_instance_or_none(name: str, value: object, cls: type) -> None:
+    """Raise WorkbenchInputError unless `value` is None or an instance of `cls` (an object a file was read into at
+    the boundary, never a path)."""
+    if value is not None and not isinstance(value, cls):
+        raise WorkbenchInputError(f"{name} must be a {cls.__name__} or None; got {value_text(value)}")

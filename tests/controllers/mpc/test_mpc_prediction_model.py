@@ -79,7 +79,7 @@ def test_unusable_vehicle_descriptions_are_rejected() -> None:
         prediction_params_for(3)
     with pytest.raises(WorkbenchInputError, match="unknown vehicle 'bus'"):
         prediction_params_for("bus")
-    with pytest.raises(WorkbenchInputError, match="wheelbase_m must be in"):
+    with pytest.raises(WorkbenchInputError, match="wheelbase_m must be a finite number in"):
         PredictionParams(
             wheelbase_m=40.0, steering_ratio=15.0, max_road_wheel_angle_rad=0.5, max_road_wheel_rate_rad_s=1
         )

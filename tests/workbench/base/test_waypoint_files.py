@@ -331,7 +331,7 @@ def test_binary_file_is_not_csv(tmp_path: Path) -> None:
 @pytest.mark.parametrize(
     ("args", "message"),
     [
-        (([45.0], [7.0], 95.0, 7.0), r"origin latitude must be in \[-90\.0, 90\.0\] deg; got 95\.0"),
+        (([45.0], [7.0], 95.0, 7.0), r"origin latitude must be a finite number in \[-90, 90\] deg; got 95\.0"),
         (([45.0], [7.0], 45.0, float("nan")), r"origin longitude must be a finite number"),
         (([45.0, float("nan")], [7.0, 7.0], 45.0, 7.0), r"latitude must be finite .*entry 1 is nan"),
         (

@@ -44,7 +44,10 @@ def test_a_spec_carrying_the_table_is_read_for_its_circuits_table_only(tmp_path)
         ('[circuits]\nmin_radius_m = "30"\n', r"'min_radius_m' must be a number; got '30' \(a file's numbers"),
         ("[circuits]\nmin_turns = 3.5\n", r"'min_turns' must be a whole number; got 3.5"),
         ("[circuits]\nclearance_m = true\n", r"'clearance_m' must be a number; got True"),
-        ("[circuits]\nmin_radius_m = 1.0\n", r"CircuitRanges.min_radius_m must be in \[5.0, 500.0\] m; got 1.0"),
+        (
+            "[circuits]\nmin_radius_m = 1.0\n",
+            r"CircuitRanges.min_radius_m must be a finite number in \[5, 500\] m; got 1.0",
+        ),
         ("[circuits]\nmin_radius_m = 70.0\n", r"min_radius_m must not exceed max_radius_m; got 70.0 and 60.0 m"),
         ("circuits = 3\n", r"\[circuits\] must be a table; got 3"),
         ("[study]\nseed = 1\n", r"no \[circuits\] table \(it has study\); give one with any of min_radius_m, "),

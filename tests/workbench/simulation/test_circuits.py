@@ -148,7 +148,7 @@ def test_the_track_is_sized_for_the_vehicle_and_its_off_tracking():
     assert expected == pytest.approx(6.93, abs=0.01)
     assert np.all(scenario.path.width_left_m == expected) and np.all(scenario.path.width_right_m == expected)
     assert generate_circuit(3).path.width_left_m is None  # no vehicle: no track
-    with pytest.raises(WorkbenchInputError, match=r"vehicle_width_m must be in \[0.5, 4.0\] m; got 5.0"):
+    with pytest.raises(WorkbenchInputError, match=r"vehicle_width_m must be a finite number in \[0.5, 4\] m; got 5.0"):
         generate_circuit(3, vehicle_width_m=5.0)
     assert scenario.name == "circuit:3" and "seed 3" in scenario.description
     assert scenario.path.closed

@@ -320,8 +320,8 @@ def test_closed_loop_must_not_repeat_its_first_point() -> None:
 @pytest.mark.parametrize(
     ("kwargs", "match"),
     [
-        ({"initial_speed_mps": 25.0}, r"initial_speed_mps must be in \[1\.0, 20\.0\] m/s; got 25\.0"),
-        ({"final_speed_mps": 0.0}, r"final_speed_mps must be in \[1\.0, 20\.0\] m/s; got 0\.0"),
+        ({"initial_speed_mps": 25.0}, r"initial_speed_mps must be a finite number in \[1, 20\] m/s; got 25\.0"),
+        ({"final_speed_mps": 0.0}, r"final_speed_mps must be a finite number in \[1, 20\] m/s; got 0\.0"),
         ({"final_speed_mps": float("nan")}, r"final_speed_mps .*got nan"),
         (
             {"closed": True, "initial_speed_mps": 5.0},

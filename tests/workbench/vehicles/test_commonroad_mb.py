@@ -68,5 +68,5 @@ def test_a_spin_out_ends_in_a_non_finite_state_not_an_exception() -> None:
 def test_bad_parameters_are_rejected() -> None:
     with pytest.raises(WorkbenchInputError, match="vehicle_id must be 1, 2 or 3"):
         CommonRoadMB(CommonRoadMBParams(vehicle_id=4))
-    with pytest.raises(WorkbenchInputError, match=r"max_step_s must be in \[1e-05, 0.01\] s"):
+    with pytest.raises(WorkbenchInputError, match=r"max_step_s must be a finite number in \[1e-05, 0.01\] s"):
         CommonRoadMB(CommonRoadMBParams(max_step_s=0.1))

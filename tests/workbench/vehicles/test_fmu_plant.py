@@ -426,7 +426,10 @@ def test_the_payload_is_written_to_the_payload_parameter(parameter_plant_file) -
 
 #: Vehicle-file values refused before the FMU is opened (`FmuPlantParams`), each with the words of its message.
 BAD_VALUES = {
-    "communication step": ({"communication_step_s": "0.5"}, "communication_step_s must be in [0.0001, 0.1] s; got 0.5"),
+    "communication step": (
+        {"communication_step_s": "0.5"},
+        "communication_step_s must be a finite number in [0.0001, 0.1] s; got 0.5",
+    ),
     "half a single track": ({"mass_kg": '"none"'}, "the single track is given all together or not at all"),
     "steering kind": ({"steering_input_is": '"handlebar"'}, "steering_input_is must be one of road_wheel_angle"),
     "longitudinal kind": ({"longitudinal_input_is": '"pedal"'}, "longitudinal_input_is must be one of acceleration"),

@@ -15,7 +15,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from tuning import lag_fit
-from workbench.base.errors import WorkbenchInputError
+from workbench.base.errors import WorkbenchInputError, range_text
 from workbench.vehicles.steering_lag import (
     DELAY_BOUNDS,
     GAIN_BOUNDS,
@@ -51,7 +51,7 @@ def test_round_trip(wn: float, zeta: float, delay: float, gain: float, nrmse: fl
         ('{"format": "steering-lag/1", "zeta": 0.8}', "missing keys ['omega_n_rad_s']"),
         ('{"format": "steering-lag/1", "omega_n_rad_s": 4, "zeta": 0.8, "wn": 3}', "unknown keys ['wn']"),
         ('{"format": "lead-filter/1", "omega_n_rad_s": 4, "zeta": 0.8}', "format must be 'steering-lag/1'"),
-        ('{"format": "steering-lag/1", "omega_n_rad_s": -4, "zeta": 0.8}', "omega_n_rad_s must be in"),
+        ('{"format": "steering-lag/1", "omega_n_rad_s": -4, "zeta": 0.8}', "omega_n_rad_s must be a finite number in"),
         ('{"format": "steering-lag/1", "omega_n_rad_s": 4, "zeta": 0.8, "speed_range_mps": [9]}', "[low, high]"),
         ('{"format": "steering-lag/1", "omega_n_rad_s": 4, "zeta": 0.8, "steady_state_gain": 0}', "steady_state_gain"),
     ],
@@ -123,7 +123,7 @@ def test_bounds_are_refused_naming_the_value_and_the_range(name: str, value: flo
     with pytest.raises(WorkbenchInputError) as info:
         SteeringLag(**kwargs)
     message = str(info.value)
-    assert message.startswith(name) and f"[{bounds[0]}, {bounds[1]}]" in message and repr(value) in message
+    assert message.startswith(name) and range_text(*bounds) in message and repr(value) in message
     edge = {"omega_n_rad_s": 4.0, "zeta": 0.8, name: bounds[0 if value < bounds[0] else 1]}
     assert getattr(SteeringLag(**edge), name) == edge[name]  # the bounds themselves are accepted
 

@@ -66,9 +66,12 @@ def test_a_bad_controller_config_stops_the_sweep_before_any_run(
 @pytest.mark.parametrize(
     ("grid", "message"),
     [
-        ("speed_kmh = [20, 0]", "grid.speed_kmh = 0.0: speed_kmh must be in [0.001, 400.0] km/h"),
+        ("speed_kmh = [20, 0]", "grid.speed_kmh = 0.0: speed_kmh must be a finite number in [0.001, 400] km/h"),
         ("laps = [0]", "grid.laps = 0: laps must be a whole number >= 1; got 0"),
-        ("initial_offset_m = [1000]", "grid.initial_offset_m = 1000.0: initial_offset_m must be in [-50.0, 50.0] m"),
+        (
+            "initial_offset_m = [1000]",
+            "grid.initial_offset_m = 1000.0: initial_offset_m must be a finite number in [-50, 50] m",
+        ),
     ],
 )
 def test_a_value_every_run_would_refuse_stops_the_sweep_before_any_run(

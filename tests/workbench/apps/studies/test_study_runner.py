@@ -67,7 +67,8 @@ def test_an_exception_is_an_error_row_with_its_message() -> None:
     assert all(row[k] is None for k in ROW_METRICS if k != "completed")
     assert row["clothoid.min_lookahead_m"] == 30.0
     # a value the scenario refuses, and a payload the vehicle refuses
-    assert "initial_offset_m must be in" in execute_run(_run(values=(("initial_offset_m", 80.0),)))["message"]
+    offset = execute_run(_run(values=(("initial_offset_m", 80.0),)))
+    assert "initial_offset_m must be a finite number in" in offset["message"]
     truck = _run(vehicle="tractor-semitrailer", values=(("payload_kg", -5.0),))
     assert execute_run(truck)["status"] == "error"
 
