@@ -49,6 +49,15 @@ from controllers.clothoid.filter_schedule import FilterSchedule
 from controllers.clothoid.lead_filter import DiscreteLeadFilter
 from controllers.clothoid.lookahead import MAX_CURVE_POINTS, candidate_count
 from controllers.clothoid.lookahead_filter import RATE_LIMIT
+from controllers.clothoid.loop_requirements import (
+    DELAY_COMPENSATIONS,
+    DELAY_UNCERTAINTY_S,
+    REQUIRED_DELAYED_GAIN_MARGIN_DB,
+    REQUIRED_DELAYED_PHASE_MARGIN_DEG,
+    REQUIRED_GAIN_MARGIN_DB,
+    REQUIRED_PHASE_MARGIN_DEG,
+    predicts_with_model,
+)
 from controllers.clothoid.path_feedforward import FeedforwardTiming
 from controllers.clothoid.vehicle_tuning import VehicleTuning
 from controllers.config_checks import Choice, Flag, Instance, Number, check_options, option
@@ -63,7 +72,6 @@ if TYPE_CHECKING:  # the loop analysis (python-control, ~0.9 s to import) only w
 
 LOOKAHEAD_MODES = ("adaptive", "fixed", "speed")
 INITIAL_CURVATURE = ("yaw-rate", "command", "steering")
-DELAY_COMPENSATIONS = ("model", "arc")
 HEADINGS = ("course", "yaw")
 THRESHOLD_MODES = ("excess", "absolute")
 SEARCH_STARTS = ("last", "ends")
@@ -160,30 +168,30 @@ class ClothoidConfig:
         RATE_LIMIT,
     )
     min_phase_margin_deg: float = option(
-        45.0,
+        REQUIRED_PHASE_MARGIN_DEG,
         "the phase margin the lookahead floor keeps (`loop_analysis.py`; 0 here and in min_gain_margin_db: no floor; "
         "with a known delay compensated by the lags' model, the delay-free loop's)",
         Number(0.0, 89.0, "deg"),
     )
     min_gain_margin_db: float = option(
-        6.0,
+        REQUIRED_GAIN_MARGIN_DB,
         "the gain margin the lookahead floor keeps (as min_phase_margin_deg)",
         Number(0.0, 40.0, "dB"),
     )
     min_delayed_phase_margin_deg: float = option(
-        30.0,
+        REQUIRED_DELAYED_PHASE_MARGIN_DEG,
         'with delay_compensation "model" and a known delay, the phase margin the loop with its delay and the '
         "predictor keeps besides, for dead times within known_delay_uncertainty_s of the known one "
         "(`loop_analysis.DelayRobustness`)",
         Number(0.0, 89.0, "deg"),
     )
     min_delayed_gain_margin_db: float = option(
-        3.0,
+        REQUIRED_DELAYED_GAIN_MARGIN_DB,
         "the gain margin kept as min_delayed_phase_margin_deg is",
         Number(0.0, 40.0, "dB"),
     )
     known_delay_uncertainty_s: float = option(
-        0.05,
+        DELAY_UNCERTAINTY_S,
         "how far the vehicle's dead time may be from known_delay_s (either way) with the min_delayed_* margins kept",
         Number(0.0, 1.0, "s"),
     )
@@ -328,10 +336,14 @@ class ClothoidConfig:
         Instance(CurvatureLimits, "the tuning's, else limits from the geometry (`CurvatureLimits.default_for`)"),
     )
 
+    def with_tuning(self, tuning: VehicleTuning) -> ClothoidConfig:
+        """These options with the steered vehicle's own tuning (`tuning.own_tuning.with_vehicle_tuning`)."""
+        return replace(self, tuning=tuning)
+
     @property
     def predicts_with_model(self) -> bool:
         """Whether the pose is predicted over a known delay with the identified lags (`delay_predictor.py`)."""
-        return self.delay_compensation == "model" and self.known_delay_s > 0.0
+        return predicts_with_model(self.delay_compensation, self.known_delay_s)
 
     def __post_init__(self) -> None:
         # Every field on its own first (its rule, `config_checks.check_options`), then what relates them.
