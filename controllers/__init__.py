@@ -30,11 +30,14 @@ from workbench.base.compiled_cache import use_versioned_numba_cache
 use_versioned_numba_cache()  # before any controller module imports numba (workbench/base/compiled_cache.py)
 
 if TYPE_CHECKING:
+    from _typeshed import DataclassInstance
+
     from controllers.base import Controller, Measurement
     from controllers.clothoid import ClothoidConfig, ClothoidController
     from controllers.mpc import LMPCConfig, LMPCController, NMPCConfig, NMPCController
     from controllers.pure_pursuit import PurePursuit, PurePursuitConfig
     from controllers.stanley import Stanley, StanleyConfig
+    from workbench.vehicles.base import VehicleModel
     from workbench.vehicles.geometry import VehicleGeometry
 
 #: Exported name -> the module that defines it (imported on first access, `__getattr__`).
@@ -156,10 +159,11 @@ CONTROLLERS: ControllerRegistry = ControllerRegistry(
 
 
 def make_controller(
-    name: str, geometry: VehicleGeometry, config: object | None = None, vehicle: object | None = None
+    name: str, geometry: VehicleGeometry, config: DataclassInstance | None = None, vehicle: VehicleModel | None = None
 ) -> Controller:
-    """Build the controller registered under `name` for a vehicle, with its default config unless one is given.
-    `vehicle` (the steered `VehicleModel`) gives model-based controllers (the MPCs) their prediction parameters."""
+    """Build the controller registered under `name` for a vehicle, with its default config unless one is given
+    (an instance of that controller's `config_type`, which the name chooses: the controller checks it).
+    `vehicle` (the steered vehicle) gives model-based controllers (the MPCs) their prediction parameters."""
     CONTROLLERS.require(name)
     return CONTROLLERS[name](geometry, config, vehicle=vehicle)
 

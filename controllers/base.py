@@ -40,7 +40,7 @@ import math
 import sys
 from abc import ABC, abstractmethod
 from collections.abc import Mapping, Sequence
-from typing import TYPE_CHECKING, Any, ClassVar
+from typing import TYPE_CHECKING, ClassVar, Generic, TypeVar
 
 import numpy as np
 
@@ -52,6 +52,10 @@ from workbench.vehicles.geometry import VehicleGeometry
 
 if TYPE_CHECKING:
     from workbench.simulation.known_delays import KnownDelays
+    from workbench.vehicles.base import VehicleModel
+
+#: A controller's config: the frozen dataclass its `config_type` names.
+ConfigT = TypeVar("ConfigT")
 
 # The plausible envelope of a measurement (`Controller.step` rejects a frame outside it). Each bound is far beyond
 # what any vehicle here can do, so that no plausible run is ever touched, and near enough that what lies beyond is
@@ -84,17 +88,26 @@ _REAL_NUMBERS = "a field must be a float, an int or a NumPy real scalar (not a b
 _SHOWN_CHARS = 60
 
 
-class Controller(ABC):
-    """Base class: subclasses set `name`, `config_type` and implement `_reset` (calling `_declare_diagnostics` if
-    they log anything) and `_command` (the module docstring's contract is kept here, in `step`)."""
+class Controller(ABC, Generic[ConfigT]):
+    """Base class: subclasses (`Controller[TheirConfig]`) set `name`, `config_type` and implement `_reset` (calling
+    `_declare_diagnostics` if they log anything) and `_command` (the module docstring's contract is kept here, in
+    `step`)."""
 
     name: ClassVar[str]
+    #: The class of `config` (ConfigT; a class variable cannot name a type variable, so it is typed as a class).
     config_type: ClassVar[type]
+    config: ConfigT
+    _held_command: float
+    _last_t_s: float
+    _rewound_frames: int
+    rejection: str
     #: The options worth tuning, with bounds, scale and reason (`controllers.search_space`); empty: none declared,
     #: and a tournament spec gives the controller its space as a [search.NAME] table.
     search_space: ClassVar[tuple[Tunable, ...]] = ()
 
-    def __init__(self, geometry: VehicleGeometry, config: Any | None = None, vehicle: object | None = None) -> None:
+    def __init__(
+        self, geometry: VehicleGeometry, config: ConfigT | None = None, vehicle: VehicleModel | None = None
+    ) -> None:
         """`geometry`: the steered vehicle's; `config`: an instance of `config_type` (its defaults when None);
         `vehicle`: the steered vehicle's model (a `VehicleModel`), for controllers that predict with it (the
         MPCs); geometric controllers ignore it."""
@@ -113,7 +126,7 @@ class Controller(ABC):
         return doc.strip().splitlines()[0]
 
     @classmethod
-    def informed_config(cls, config: Any, delays: KnownDelays) -> Any:
+    def informed_config(cls, config: ConfigT, delays: KnownDelays) -> ConfigT:
         """`config` (a `config_type`) told the run's nominal delays and pose noise (`KnownDelays`): the options
         by which this controller compensates them set from `delays`, every other option as it is.
 
@@ -254,9 +267,10 @@ class Controller(ABC):
             self.rejection = f"the measurement is a {type(m).__name__}, not a Measurement"
             return None
         if not floats:
-            m = self._as_floats(m)
-            if m is None:
+            as_floats = self._as_floats(m)
+            if as_floats is None:
                 return None
+            m = as_floats
         plausible = (  # one expression on the path every plausible step takes (a comparison with NaN is False)
             abs(m.steer_wheel_rad) <= STEER_SENSOR_MARGIN * self.geometry.max_steer_wheel_angle_rad
             and math.hypot(m.vx_mps, m.vy_mps) <= MAX_SPEED_MPS

@@ -40,13 +40,17 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any, ClassVar
+from typing import TYPE_CHECKING, ClassVar
 
 from controllers.base import Controller, Measurement
 from controllers.config_checks import Flag, Number, check_options, option
 from controllers.search_space import Tunable
 from workbench.base.path import PathTracker, ReferencePath, wrap_angle
 from workbench.vehicles.geometry import VehicleGeometry
+
+if TYPE_CHECKING:
+    from workbench.vehicles.base import VehicleModel
+    from workbench.vehicles.single_track import SingleTrackParams
 
 
 @dataclass(frozen=True)
@@ -87,7 +91,7 @@ class StanleyConfig:
         check_options(self)
 
 
-class Stanley(Controller):
+class Stanley(Controller[StanleyConfig]):
     name: ClassVar[str] = "stanley"
     config_type: ClassVar[type] = StanleyConfig
     search_space: ClassVar[tuple[Tunable, ...]] = (
@@ -101,12 +105,15 @@ class Stanley(Controller):
                 "cost of lag in every correction"),
     )  # fmt: skip
 
-    def __init__(self, geometry: VehicleGeometry, config: Any | None = None, vehicle: object | None = None) -> None:
-        """As `Controller`; `vehicle` (a `VehicleModel`) gives the curvature feed-forward its tyres' slip (none
-        without it: the kinematic single track)."""
+    def __init__(
+        self, geometry: VehicleGeometry, config: StanleyConfig | None = None, vehicle: VehicleModel | None = None
+    ) -> None:
+        """As `Controller`; `vehicle` gives the curvature feed-forward its tyres' slip (none without it: the
+        kinematic single track)."""
         super().__init__(geometry, config)
-        single_track = getattr(vehicle, "single_track", None)
-        self._tyres = single_track().single_track if self.config.curvature_feedforward and single_track else None
+        self._tyres: SingleTrackParams | None = None
+        if self.config.curvature_feedforward and vehicle is not None:
+            self._tyres = vehicle.single_track().single_track
 
     def _reset(self, path: ReferencePath, sample_time_s: float) -> None:
         self._tracker: PathTracker = path.tracker(0.0)

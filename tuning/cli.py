@@ -25,7 +25,7 @@ from __future__ import annotations
 import argparse
 import math
 import sys
-from collections.abc import Iterator, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 from functools import partial
 from pathlib import Path
@@ -40,6 +40,7 @@ if TYPE_CHECKING:
 
     from tuning.lag_fit import SteeringGeometry
     from workbench.vehicles.base import VehicleGeometry, VehicleModel
+    from workbench.vehicles.steering_lag import SteeringLag
 
 # The tuning modules (python-control, SciPy, the controllers, the simulator) are imported inside the command that
 # needs them and the parser builds only the options of the command being run, so that `tuning --help` starts fast
@@ -357,7 +358,7 @@ def _validation_plot(out: Path) -> Path:
     return out.with_name(f"{out.stem}_validation.png")
 
 
-def _read_lag(flag: str, path: Path):
+def _read_lag(flag: str, path: Path) -> SteeringLag:
     """A steering-lag file; its JSON read safely first (deep nesting, not JSON), then checked as a lag."""
     from workbench.base.input_files import read_json
     from workbench.vehicles.steering_lag import read_lag_file
@@ -732,6 +733,9 @@ def _margins(args: argparse.Namespace) -> int:
 
     vehicle = _vehicle(args) if args.vehicle is not None or args.vehicle_file is not None else None
     limits = None
+    # the lags at a speed (km/h): the vehicle's tuning's, or the one read from a file at every speed
+    path_at: Callable[[float], SteeringLag]
+    measured_at: Callable[[float], SteeringLag | None] | None
     if args.lag is None:
         if vehicle is None:
             raise WorkbenchInputError(
@@ -747,16 +751,17 @@ def _margins(args: argparse.Namespace) -> int:
     else:
         path_lag = _read_lag("--lag", args.lag)
 
-        def path_at(_speed: float):
+        def path_lag_at(_speed: float) -> SteeringLag:
             return path_lag
 
-        measured_at, lead, source = None, None, f"lag {args.lag}"
+        path_at, measured_at, lead, source = path_lag_at, None, None, f"lag {args.lag}"
     if args.measured_lag is not None:
         measured_lag = _read_lag("--measured-lag", args.measured_lag)
 
-        def measured_at(_speed: float):
+        def measured_lag_at(_speed: float) -> SteeringLag:
             return measured_lag
 
+        measured_at = measured_lag_at
         source += f", measured lag {args.measured_lag}"
     if args.lead is not None:
         lead = read_filter_file(args.lead)

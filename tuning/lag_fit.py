@@ -207,9 +207,10 @@ class _PathDerivatives:
 
 def path_curvature(log: VehicleLog, smooth_s: float = 0.3) -> np.ndarray:
     """Curvature (1/m) of the logged rear-axle path, from Savitzky-Golay (cubic) time derivatives of x and y."""
-    if not log.has_positions:
+    x_m, y_m = log.x_m, log.y_m
+    if x_m is None or y_m is None:
         raise WorkbenchInputError(f"{log.name}: no x_m, y_m columns to compute the path curvature from")
-    kappa, speed = _PathDerivatives.of(log, _window(log, smooth_s)).curvature(log.x_m, log.y_m)
+    kappa, speed = _PathDerivatives.of(log, _window(log, smooth_s)).curvature(x_m, y_m)
     if speed.min() <= 1e-6:
         raise WorkbenchInputError(f"{log.name}: the rear axle stands still; the path curvature is undefined")
     return kappa

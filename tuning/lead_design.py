@@ -194,8 +194,8 @@ class _Problem:
         self.max_lead = max_lead_gain
         self.max_cascade = 10 ** (max_cascade_peak_db / 20)
 
-    def lead(self, wz: np.ndarray, psi: np.ndarray, wp: np.ndarray) -> np.ndarray:
-        """G_lead(jw) for parameter arrays of shape (m,), as (m, n)."""
+    def lead(self, wz: float | np.ndarray, psi: float | np.ndarray, wp: float | np.ndarray) -> np.ndarray:
+        """G_lead(jw) for parameter arrays of shape (m,) (or scalars: m = 1), as (m, n)."""
         wz, psi, wp = (np.atleast_1d(np.asarray(v, dtype=float))[:, None] for v in (wz, psi, wp))
         s = 1j * self.w
         return wp**3 * (s * s + 2.0 * psi * wz * s + wz**2) / (wz**2 * (s + wp) ** 3)
@@ -510,21 +510,22 @@ def _design_lead_for_margins(
     for _, wz, psi, ratio in sorted(grid):
         consider(wz, psi, ratio)
     for _ in range(_REFINE_ROUNDS):
-        if best is None and fallback is None:
+        leading = best if best is not None else fallback
+        if leading is None:
             break
-        centre = best[2] if best is not None else fallback[2]
+        centre = leading[2]
         wz0, psi0 = centre.omega_z_rad_s, centre.psi
         ratio0 = centre.omega_p_rad_s / centre.omega_z_rad_s
         for fw in _REFINE_FACTORS:
             for fp in _REFINE_FACTORS:
                 for fr in _REFINE_FACTORS:
                     consider(wz0 * fw, psi0 * fp, max(1.0, ratio0 * fr))
-    if best is None and fallback is None:
-        raise WorkbenchInputError(f"no lead filter of the grid meets max_lead_gain = {max_lead_gain:g}; raise it")
-    without = floor_of(None)
     if best is not None:
         floor, params, chosen_score = best[0], best[2], math.nan
-    else:
+    elif fallback is not None:
         floor, params, chosen_score = math.nan, fallback[2], -fallback[0]
+    else:
+        raise WorkbenchInputError(f"no lead filter of the grid meets max_lead_gain = {max_lead_gain:g}; raise it")
+    without = floor_of(None)
     design = replace(_report(params, lags.path, max_lead_gain, math.inf, None), method="margins")
     return MarginsDesign(design, floor, without, count, chosen_score)

@@ -265,14 +265,16 @@ class Comparison:
 
     def save_figures(self, out_dir: str | Path, prefix: str = "") -> list[Path]:
         """Write the four comparison figures as PNG; return their paths."""
-        from workbench.simulation.plots import file_axes
+        from workbench.simulation.plots import file_figure
 
         out = Path(out_dir)
         out.mkdir(parents=True, exist_ok=True)
         written = []
         for name, method in FIGURES:
             path = out / f"{prefix}{name}"
-            getattr(self, method)(file_axes()).figure.savefig(path, dpi=110)
+            figure = file_figure()
+            getattr(self, method)(figure.add_subplot())
+            figure.savefig(path, dpi=110)
             written.append(path)
         return written
 

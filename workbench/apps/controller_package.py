@@ -36,6 +36,8 @@ from workbench.base.path import ReferencePath
 from workbench.base.toml_text import toml_key, toml_value
 
 if TYPE_CHECKING:
+    from _typeshed import DataclassInstance
+
     from controllers.base import Controller
     from workbench.vehicles.base import VehicleModel
 
@@ -69,7 +71,7 @@ def pack_controller(
     folder: Path,
     controller: str,
     vehicle: VehicleModel,
-    options: Any,
+    options: DataclassInstance,
     named_files: dict[str, Path],
     path: ReferencePath,
     period_s: float,
@@ -169,7 +171,7 @@ def _write_path(file: Path, path: ReferencePath) -> None:
     if path.speed_mps is None:
         raise WorkbenchInputError(f"{path.name}: a packed path carries its planned speed; this one has none")
     columns: Iterable[np.ndarray] = [path.x_m, path.y_m, path.heading_rad, path.curvature_1pm, path.speed_mps]
-    names = PATH_COLUMNS
+    names: tuple[str, ...] = PATH_COLUMNS
     if path.width_right_m is not None and path.width_left_m is not None:
         columns = [*columns, path.width_right_m, path.width_left_m]
         names = (*PATH_COLUMNS, *WIDTH_COLUMNS)

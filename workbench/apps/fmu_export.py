@@ -21,6 +21,8 @@ from typing import TYPE_CHECKING, Any
 from workbench.base.errors import WorkbenchInputError
 
 if TYPE_CHECKING:
+    from _typeshed import DataclassInstance
+
     from workbench.base.path import ReferencePath
     from workbench.vehicles.base import VehicleModel
 
@@ -91,7 +93,7 @@ def build_controller_fmu(
     out: Path,
     controller: str,
     vehicle: VehicleModel,
-    options: Any,
+    options: DataclassInstance,
     files: dict[str, Path],
     path: ReferencePath,
     period_s: float,

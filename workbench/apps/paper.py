@@ -161,7 +161,7 @@ StepOutput = tuple[list[Path], dict[int, str]]
 
 
 def _save(ax_or_fig: plt.Axes | plt.Figure, path: Path) -> Path:
-    fig = ax_or_fig if isinstance(ax_or_fig, plt.Figure) else ax_or_fig.figure
+    fig = ax_or_fig.figure.get_figure(root=True)  # the figure itself, or the axes' (root) figure
     fig.savefig(path, dpi=110)
     plt.close(fig)
     return path
@@ -287,7 +287,7 @@ def _cte_vs_time(result: SimulationResult, ax: plt.Axes | None = None) -> plt.Ax
 
 
 #: Figures 11-16: (figure number, scenario, plot, file suffix).
-TRACKING_FIGURES: tuple[tuple[int, str, Callable[[SimulationResult], plt.Axes], str], ...] = (
+TRACKING_FIGURES: tuple[tuple[int, str, Callable[[SimulationResult, plt.Axes | None], plt.Axes], str], ...] = (
     (11, "figure8", plots.trajectory, "a_trajectory"),
     (11, "figure8", _cte_vs_time, "b_cte_vs_time"),
     (12, "figure8", plots.speed_vs_distance, "a_speed_vs_arc_length"),
@@ -442,7 +442,7 @@ def reproduce_paper(
         bar.set_postfix_str("Figures 11-16 and report.html")
         for number, scenario, draw, suffix in TRACKING_FIGURES:
             if scenario in runs:
-                files.append(_save(draw(runs[scenario]), out / f"fig{number}{suffix}_{scenario}.png"))
+                files.append(_save(draw(runs[scenario], None), out / f"fig{number}{suffix}_{scenario}.png"))
         notes |= _tracking_notes(runs)
         table = _table(runs)
         table_path = out / "paper_vs_ours.csv"

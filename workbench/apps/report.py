@@ -33,7 +33,7 @@ from workbench.apps.comparison import CONVERGED_CTE_M, FIGURES, Comparison
 from workbench.simulation.limit_cycle import LimitCycle
 
 if TYPE_CHECKING:
-    from matplotlib.figure import Figure
+    from matplotlib.figure import Figure, SubFigure
 
 #: Summary columns shown in the report, with their headings (the CSV keeps every column).
 TABLE_COLUMNS: tuple[tuple[str, str], ...] = (
@@ -182,13 +182,14 @@ def png_figure(png: bytes, caption: str) -> str:
     return f'<figure><img alt="{alt}" src="data:image/png;base64,{data}"><figcaption>{alt}</figcaption></figure>'
 
 
-def figure_png(fig: Figure) -> bytes:
-    """The figure as PNG at FIGURE_DPI; the figure is closed."""
+def figure_png(fig: Figure | SubFigure) -> bytes:
+    """The figure (an axes' `.figure`: the root figure of a subfigure) as PNG at FIGURE_DPI; the figure is closed."""
     import matplotlib.pyplot as plt
 
+    root = fig.get_figure(root=True)
     buffer = io.BytesIO()
-    fig.savefig(buffer, format="png", dpi=FIGURE_DPI)
-    plt.close(fig)
+    root.savefig(buffer, format="png", dpi=FIGURE_DPI)
+    plt.close(root)
     return buffer.getvalue()
 
 

@@ -38,6 +38,8 @@ from workbench.simulation.scenarios import is_named_scenario
 from workbench.vehicles import load_vehicle
 
 if TYPE_CHECKING:
+    from matplotlib.figure import Figure
+
     from workbench.simulation.circuit_ranges import CircuitRanges
 
 
@@ -225,8 +227,9 @@ def _check_path(
     warnings = path_feasibility_warnings(path, model)
     if not allow_infeasible:
         refuse_infeasible(warnings)
-    for warning in warnings if warn is not None else ():
-        warn(warning)
+    if warn is not None:
+        for warning in warnings:
+            warn(warning)
 
 
 @dataclass(frozen=True)
@@ -331,10 +334,9 @@ class RobustnessResult:
     def payload_summary(self) -> list[str]:
         """One line per controller on the payload axis: max |CTE| at each plant payload, from the matched base run
         outward, and what the mismatch changes for that controller. Empty without a payload axis."""
-        table = self.mismatch()
-        if table.empty:
+        table, axis = self.mismatch(), self.payload_axis()
+        if table.empty or axis is None:  # no payload axis (the table is empty then)
             return []
-        axis = self.payload_axis()
         plants = ", ".join(f"{v:g}" for v in axis.values)
         lines = [f"payload: the plant carries {plants} kg, every controller is built for {axis.values[0]:g} kg"]
         for controller, rows in table.groupby("controller", sort=False):
@@ -342,7 +344,7 @@ class RobustnessResult:
             lines.append(f"  {controller}: max |CTE| {cte} m; the mismatch changes {payload_mismatch(controller)}")
         return lines
 
-    def figure(self, axis: Axis):  # -> matplotlib Figure
+    def figure(self, axis: Axis) -> Figure:
         """Max |CTE|, steering oscillation and completion against the axis's value, a line per controller."""
         import matplotlib.pyplot as plt
 
@@ -381,11 +383,11 @@ class RobustnessResult:
         else:
             intro += "The controllers were not told the conditions' delays (--inform-delays tells them the base's)."
         parts = ["<h2>Where each controller stops passing</h2>", text_table(self.tolerance(), missing="none")]
-        mismatch = self.mismatch()
-        if len(mismatch):
+        mismatch, payload = self.mismatch(), self.payload_axis()
+        if len(mismatch) and payload is not None:  # the table has rows only with a payload axis
             note = (
                 f"The plant carries the payloads shown; every controller stays built for the nominal "
-                f"{self.payload_axis().values[0]:g} kg. The last column says what that changes for each controller."
+                f"{payload.values[0]:g} kg. The last column says what that changes for each controller."
             )
             parts += ["<h2>Payload mismatch</h2>", f"<p>{html.escape(note)}</p>", text_table(mismatch, missing="none")]
         for axis in self.axes:

@@ -60,7 +60,12 @@ def _private_temporary_folder() -> Path:
     """A fresh folder of this user's alone (mkdtemp: 0700), removed when the process that made it exits."""
     folder = Path(tempfile.mkdtemp(prefix="lateral-workbench-numba-"))
     maker = os.getpid()
-    atexit.register(lambda: os.getpid() == maker and shutil.rmtree(folder, ignore_errors=True))
+
+    def remove() -> None:
+        if os.getpid() == maker:  # not in a forked child, which inherits the hook
+            shutil.rmtree(folder, ignore_errors=True)
+
+    atexit.register(remove)
     return folder
 
 

@@ -183,7 +183,7 @@ class OutputDir:
         self.label = label
         self.previous = read_manifest(self.path)
         entries = [e for e in _entries(self.path) if e != MANIFEST]
-        ours = {_safe_relative(f).parts[0] for f in (self.previous or {}).get("files", []) if _safe_relative(f)}
+        ours = {rel.parts[0] for f in (self.previous or {}).get("files", []) if (rel := _safe_relative(f))}
         #: Top-level entries the workbench did not write (kept, even with overwrite).
         self.foreign = [e for e in entries if e not in ours]
         if entries and not overwrite:

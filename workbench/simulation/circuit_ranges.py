@@ -80,15 +80,16 @@ class CircuitRanges:
         for spec in fields(self):
             value = getattr(self, spec.name)
             if spec.name in ("min_turns", "max_turns"):
-                low, high = TURNS_RANGE
-                if isinstance(value, bool) or not isinstance(value, int) or not low <= value <= high:
+                fewest, most = TURNS_RANGE
+                if isinstance(value, bool) or not isinstance(value, int) or not fewest <= value <= most:
                     raise WorkbenchInputError(
-                        f"CircuitRanges.{spec.name} must be a whole number in [{low}, {high}]; got {value_text(value)}"
+                        f"CircuitRanges.{spec.name} must be a whole number in [{fewest}, {most}]; got "
+                        f"{value_text(value)}"
                     )
             else:
                 low, high, unit = _BOUNDS[spec.name]
                 require_in_range(f"CircuitRanges.{spec.name}", value, low, high, unit)
-        for low, high, unit in (
+        for lower, upper, unit in (
             ("min_radius_m", "max_radius_m", "m"),
             ("min_curvature_rate_1pm2", "max_curvature_rate_1pm2", "1/m^2"),
             ("min_turn_deg", "max_turn_deg", "deg"),
@@ -98,10 +99,10 @@ class CircuitRanges:
             ("min_straight_m", "max_straight_m", "m"),
             ("min_length_m", "max_length_m", "m"),
         ):
-            if getattr(self, low) > getattr(self, high):
+            if getattr(self, lower) > getattr(self, upper):
                 raise WorkbenchInputError(
-                    f"CircuitRanges.{low} must not exceed {high}; got {value_text(getattr(self, low))} and "
-                    f"{value_text(getattr(self, high))} {unit}".rstrip()
+                    f"CircuitRanges.{lower} must not exceed {upper}; got {value_text(getattr(self, lower))} and "
+                    f"{value_text(getattr(self, upper))} {unit}".rstrip()
                 )
         self._check_consistent()
 

@@ -256,7 +256,7 @@ def _profile_pairs(profile: object) -> tuple[tuple[float, float], ...]:
             f"road.friction_profile must be a list of [distance_m, scale] pairs; got {value_text(profile)}"
         )
     pairs = []
-    for i, entry in enumerate(profile):  # type: ignore[union-attr]
+    for i, entry in enumerate(profile):
         if isinstance(entry, str | bytes) or not hasattr(entry, "__len__") or len(entry) != 2:
             raise WorkbenchInputError(
                 f"road.friction_profile[{i}] must be a [distance_m, scale] pair; got {value_text(entry)}"

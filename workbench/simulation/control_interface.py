@@ -11,6 +11,8 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Protocol
 
 if TYPE_CHECKING:
+    import numpy as np
+
     from workbench.base.path import ReferencePath
 
 #: The diagnostics flags (1.0 or 0.0) a controller adds to its own signals: its last measurement was implausible,
@@ -49,7 +51,10 @@ class Measurement:
 class SteeringController(Protocol):
     """A lateral controller as the simulator drives it (`controllers.base.Controller` is the implementation)."""
 
-    name: str
+    @property
+    def name(self) -> str:
+        """The controller's registry name (a class constant of each implementation)."""
+        ...
 
     def reset(self, path: ReferencePath, sample_time_s: float) -> None:
         """Forget all state; steps on `path` come every `sample_time_s` seconds."""
@@ -62,6 +67,16 @@ class SteeringController(Protocol):
         """Optional: what to tell a person before a run on `path` (planned speeds included) with steps every
         `sample_time_s` s, one sentence each (e.g. an option that cannot act at these speeds); the simulation prints
         them before the run (`Simulation.warnings`). A controller without the method has none."""
+        ...
+
+    @property
+    def diagnostic_names(self) -> tuple[str, ...]:
+        """The names of `diagnostic_values`, the same every step from `reset` on."""
+        ...
+
+    @property
+    def diagnostic_values(self) -> np.ndarray:
+        """The last step's signals in the order of `diagnostic_names` (the controller's array: copy what you keep)."""
         ...
 
     @property

@@ -32,7 +32,7 @@ import dataclasses
 import math
 from collections.abc import Sequence
 from dataclasses import asdict, dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, overload
 
 import numpy as np
 from scipy.constants import g as G_MPS2  # standard gravity, 9.80665 m/s^2
@@ -145,6 +145,10 @@ class VehicleLimits:
             low, high = (middle, high) if below else (low, middle)
         return 1.0 / high
 
+    @overload
+    def _lock_angle(self, curvature_1pm: float, speed_sq: float) -> float: ...
+    @overload
+    def _lock_angle(self, curvature_1pm: np.ndarray, speed_sq: float | np.ndarray) -> np.ndarray: ...
     def _lock_angle(self, curvature_1pm: float | np.ndarray, speed_sq: float | np.ndarray) -> float | np.ndarray:
         """The steady-state road-wheel angle (rad) for this curvature (1/m, >= 0) at this squared speed."""
         return np.arctan(self.wheelbase_m * curvature_1pm) + self.understeer_gradient_rad_per_mps2 * (

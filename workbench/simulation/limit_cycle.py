@@ -62,10 +62,11 @@ class LimitCycle:
 
     def brief(self) -> str:
         """Frequency and amplitude, e.g. "1.0 Hz, ±150°"; "no" when not detected."""
-        if not self.detected:
+        frequency = self.frequency_hz
+        if not self.detected or frequency is None:
             return "no"
-        digits = 1 if self.frequency_hz >= 1.0 else 2
-        return f"{self.frequency_hz:.{digits}f} Hz, ±{self.amplitude_deg:.0f}°"
+        digits = 1 if frequency >= 1.0 else 2
+        return f"{frequency:.{digits}f} Hz, ±{self.amplitude_deg:.0f}°"
 
     def describe(self) -> str:
         """In words, e.g. "1.0 Hz, ±150° steering wheel for 40.0 s from t = 113.0 s"; "no limit cycle" when not
@@ -148,7 +149,7 @@ def _longest_cycle(eligible: np.ndarray, half_periods: np.ndarray, half_amplitud
     best, best_s = (0, 0), 0.0
     segment_end = 0  # end of the stretch of eligible half-cycles the run starts in
     for i in np.flatnonzero(eligible):
-        segment_end = max(segment_end, i)
+        segment_end = max(segment_end, int(i))
         while segment_end < eligible.size and eligible[segment_end]:
             segment_end += 1
         if elapsed[segment_end] - elapsed[i] <= best_s:  # cannot beat the best

@@ -106,7 +106,7 @@ def _serve(connection: Connection) -> None:  # pragma: no cover - runs in the wo
         os._exit(0)
     try:
         drawing, out_dir = job
-        reply = ("drawn", save_run_plots(drawing, out_dir))
+        reply: tuple[str, list[Path] | None] = ("drawn", save_run_plots(drawing, out_dir))
     except Exception:  # the parent draws again in its own process, where the error surfaces
         reply = ("failed", None)
     try:

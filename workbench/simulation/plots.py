@@ -8,7 +8,7 @@ tracked trajectories overlap at the scale of the course, so `trajectories` can z
 (`Stretch`: the hardest, chosen by the caller).
 
 matplotlib is imported where a figure is drawn, not with this module (issue 17): `result.py` and the CLI's
-startup need none of it; figures written to files are bare Figures (`file_axes`), without pyplot. A plotted run is
+startup need none of it; figures written to files are bare Figures (`file_figure`), without pyplot. A plotted run is
 anything with a `SimulationResult`'s fields (`PlottedRun`, its path and scenario read through `PlottedPath` and
 `PlottedCourse`), so this module does not import the result that draws itself with it; `RunDrawing` is such a run in
 plain arrays, for a process that only draws (`plot_worker.py`)."""
@@ -26,14 +26,17 @@ from workbench.base.errors import WorkbenchInputError, require_finite
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
     from matplotlib.lines import Line2D
 
 
 class PlottedPath(Protocol):
     """What a plot reads of a path (a `ReferencePath` is one): its samples and its track's edges."""
 
-    x_m: np.ndarray
-    y_m: np.ndarray
+    @property
+    def x_m(self) -> np.ndarray: ...
+    @property
+    def y_m(self) -> np.ndarray: ...
 
     def track_edges(self) -> tuple[tuple[np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray]] | None: ...
 
@@ -41,20 +44,28 @@ class PlottedPath(Protocol):
 class PlottedCourse(Protocol):
     """What a plot reads of a scenario (a `Scenario` is one): its name, description and cones."""
 
-    name: str
-    description: str
-    cones_xy: np.ndarray | None
+    @property
+    def name(self) -> str: ...
+    @property
+    def description(self) -> str: ...
+    @property
+    def cones_xy(self) -> np.ndarray | None: ...
 
 
 class PlottedRun(Protocol):
     """What a plot reads of a run (a `SimulationResult` is one): its trace, the path and scenario it ran on, and
     which controller and vehicle ran it."""
 
-    trace: dict[str, np.ndarray]
-    path: PlottedPath
-    scenario: PlottedCourse
-    controller: str
-    vehicle: str
+    @property
+    def trace(self) -> dict[str, np.ndarray]: ...
+    @property
+    def path(self) -> PlottedPath: ...
+    @property
+    def scenario(self) -> PlottedCourse: ...
+    @property
+    def controller(self) -> str: ...
+    @property
+    def vehicle(self) -> str: ...
 
 
 @dataclass(frozen=True)
@@ -122,12 +133,12 @@ def _axes(ax: Axes | None) -> Axes:
     return ax
 
 
-def file_axes() -> Axes:
-    """The axes of a new figure to be written to a file: a bare `matplotlib.figure.Figure`, not pyplot's (no
-    figure manager or GUI backend loaded, nothing to close: matplotlib's way for figures a program saves)."""
+def file_figure() -> Figure:
+    """A new figure to be written to a file: a bare `matplotlib.figure.Figure`, not pyplot's (no figure manager or
+    GUI backend loaded, nothing to close: matplotlib's way for figures a program saves)."""
     from matplotlib.figure import Figure
 
-    return Figure(figsize=FIGURE_SIZE_IN, layout="constrained").add_subplot()
+    return Figure(figsize=FIGURE_SIZE_IN, layout="constrained")
 
 
 def _label(result: PlottedRun) -> str:
@@ -217,7 +228,9 @@ def save_run_plots(result: PlottedRun, out_dir: Path) -> list[Path]:
     written = []
     for filename, draw in RUN_PLOTS.items():
         path = out_dir / filename
-        draw(result, file_axes()).figure.savefig(path, dpi=120)
+        figure = file_figure()
+        draw(result, figure.add_subplot())
+        figure.savefig(path, dpi=120)
         written.append(path)
     return written
 
@@ -302,8 +315,8 @@ INSET_EDGE = 0.02
 INSET_MIN_MARGIN_M = 0.05
 
 
-def _inset_place(ax: Axes) -> list[float]:
-    """[x0, y0, width, height] (axes fraction) of the place for the inset: of the corners, the edges' middles and the
+def _inset_place(ax: Axes) -> tuple[float, float, float, float]:
+    """(x0, y0, width, height) (axes fraction) of the place for the inset: of the corners, the edges' middles and the
     centre, the first (from the top right) that covers no point drawn (trajectories, references, cones); when each
     covers some, the top right, with the axes' data limits raised so that everything drawn lies below it."""
     points = np.concatenate([np.asarray(line.get_xydata(), dtype=float) for line in ax.get_lines()])
@@ -315,14 +328,14 @@ def _inset_place(ax: Axes) -> list[float]:
     places = [(x0, y0) for y0 in steps for x0 in reversed(steps)]  # top right first, bottom left last
     for x0, y0 in places:
         if not np.any(np.all((axes_xy >= (x0, y0)) & (axes_xy <= (x0 + INSET_SIZE, y0 + INSET_SIZE)), axis=1)):
-            return [x0, y0, INSET_SIZE, INSET_SIZE]
+            return (x0, y0, INSET_SIZE, INSET_SIZE)
     # Room above: the data limits reach up so far that what the axes show fills at most `below` of the height (the
     # limits stay automatic, so that an equal aspect widens them about their middle, which keeps it so).
     low, top = float(ax.dataLim.y0), float(ax.dataLim.y1)
     below = 1.0 - INSET_SIZE - 2.0 * INSET_EDGE
     ax.update_datalim([(float(ax.dataLim.x0), low + (top - low) / below)])
     ax.autoscale_view()
-    return [steps[0], steps[0], INSET_SIZE, INSET_SIZE]
+    return (steps[0], steps[0], INSET_SIZE, INSET_SIZE)
 
 
 def _zoom_inset(

@@ -73,6 +73,8 @@ def read_fmu_interface(params: FmuPlantParams) -> FmuInterface:
             f"{where}: no binary for this platform ({fmpy.platform}); it has: {', '.join(platforms) or 'none'}"
         )
     variables = {v.name: v for v in md.modelVariables}
+    # (variable name, the causalities it may have, the variability it must have (None: any)); name None: not used
+    checks: list[tuple[str | None, tuple[str, ...], str | None]]
     checks = [(name, ("input",), None) for name in params.input_names()]
     checks += [(getattr(params, field), OUTPUT_CAUSALITIES, None) for field in params.output_fields()]
     checks += [(name, ("parameter",), None) for name in (params.speed_parameter, params.payload_parameter)]

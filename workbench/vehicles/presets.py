@@ -26,7 +26,7 @@ import os
 import sys
 from importlib import resources
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from workbench.base.entry_points import installed_entry_points
 from workbench.base.errors import WorkbenchInputError, value_text
@@ -41,8 +41,11 @@ from workbench.vehicles.fmu_plant_params import FmuPlantParams
 from workbench.vehicles.kinematic_bicycle import KinematicBicycle, KinematicBicycleParams
 from workbench.vehicles.tractor_semitrailer import TractorSemitrailer, TractorSemitrailerParams
 
+if TYPE_CHECKING:
+    from _typeshed import DataclassInstance
+
 #: model type -> (model class, params dataclass).
-MODEL_TYPES: dict[str, tuple[type[VehicleModel], type]] = {
+MODEL_TYPES: dict[str, tuple[type[VehicleModel], type[DataclassInstance]]] = {
     KinematicBicycle.name: (KinematicBicycle, KinematicBicycleParams),
     DynamicBicycle.name: (DynamicBicycle, DynamicBicycleParams),
     TractorSemitrailer.name: (TractorSemitrailer, TractorSemitrailerParams),
@@ -58,7 +61,7 @@ _TOP_KEYS = ("model", "parameters")
 _MODEL_KEYS = ("type", "description")
 
 
-def _installed_model_types() -> dict[str, tuple[type[VehicleModel], type]]:
+def _installed_model_types() -> dict[str, tuple[type[VehicleModel], type[DataclassInstance]]]:
     """The vehicle models installed packages register (`VEHICLE_ENTRY_POINTS`), each checked; one that cannot be
     imported or breaks the rules (module docstring) is left out with a warning on stderr saying why."""
     found = {}

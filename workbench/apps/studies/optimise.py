@@ -42,6 +42,7 @@ from workbench.base.toml_text import toml_value
 from workbench.vehicles.presets import load_vehicle
 
 if TYPE_CHECKING:
+    from _typeshed import DataclassInstance
     from matplotlib.axes import Axes
 
 BEST_CONFIG = "best.toml"
@@ -105,7 +106,9 @@ def _write_object(folder: Path, value: Any, stem: str = "best") -> str | None:
     return None
 
 
-def write_controller_config(path: Path, controller: str, config: Any, header: str, stem: str = "best") -> Path:
+def write_controller_config(
+    path: Path, controller: str, config: DataclassInstance, header: str, stem: str = "best"
+) -> Path:
     """Write every field of a controller config as a controller-config TOML file (one [controller] table; None
     as "none"; paths inside the file's folder relative to it, others absolute); an object a file option was read
     into (`FILE_OPTIONS`) is written to a file beside it, its name starting with `stem` (`_write_object`), and
@@ -218,10 +221,8 @@ def run_optimisation(
                 entry |= {"runs": len(trial_rows), "failed_runs": sum(r["status"] != "completed" for r in trial_rows)}
                 entry["reason"] = reason
                 for key in weights:
-                    numbers = [r.get(key) for r in trial_rows]
-                    entry[f"mean_{key}"] = (
-                        float(np.mean(numbers)) if all(isinstance(x, int | float) for x in numbers) else None
-                    )
+                    numbers = [x for r in trial_rows if isinstance(x := r.get(key), int | float)]
+                    entry[f"mean_{key}"] = float(np.mean(numbers)) if len(numbers) == len(trial_rows) else None
                 history.append(entry)
                 all_rows += [{"trial": trial.number} | r for r in trial_rows]
             pd.DataFrame(history).to_parquet(out / HISTORY_FILE, index=False)
@@ -278,9 +279,9 @@ def _write_best(spec: StudySpec, out: Path, best: dict[str, Any], params: dict[s
 def _save_history_figure(result: OptimisationResult, out: Path) -> None:
     import matplotlib.pyplot as plt
 
-    ax = result.plot_history()
-    ax.figure.savefig(out / HISTORY_FIGURE, dpi=110)
-    plt.close(ax.figure)
+    figure = result.plot_history().figure.get_figure(root=True)
+    figure.savefig(out / HISTORY_FIGURE, dpi=110)
+    plt.close(figure)
 
 
 __all__ = ["OptimisationResult", "objective_text", "run_optimisation", "trial_value", "write_controller_config"]

@@ -463,7 +463,8 @@ class StudySpec:
                 "random.conditions: draw the conditions' fields (e.g. actuation_dead_time_s), not the preset; give "
                 "conditions in [grid]"
             )
-        controller_grid, controller_random = {}, {}
+        controller_grid: dict[str, Mapping[str, Any]] = {}
+        controller_random: dict[str, Mapping[str, Any]] = {}
         for where, table, out, parse in (
             ("grid", self.controller_grid, controller_grid, _axes),
             ("random", self.controller_random, controller_random, _draws),

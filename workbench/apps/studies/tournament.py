@@ -97,10 +97,12 @@ def trial_objectives(
         return None, f"{len(failures)} of {len(rows)} runs failed (e.g. {case_id(row)}: {why})"
     values = []
     for metric in objectives:
-        numbers = [row.get(metric) for row in rows]
-        for row, number in zip(rows, numbers, strict=True):
+        numbers: list[float] = []
+        for row in rows:
+            number = row.get(metric)
             if number is None or not math.isfinite(number):
                 return None, f"metric {metric} is {value_text(number)} for {case_id(row)}"
+            numbers.append(number)
         values.append(float(np.mean(numbers)))
     return values, ""
 
@@ -190,7 +192,7 @@ def write_config_files(
     `folder`: `<name>.toml`, and `<name>@<vehicle>.toml` for a vehicle whose config differs from the first
     vehicle's (a lead filter scaled from its own); return vehicle -> file."""
     folder.mkdir(parents=True, exist_ok=True)
-    first_runs = {}
+    first_runs: dict[str, PlannedRun] = {}
     for run in spec.plan(controller, TEST, options):
         first_runs.setdefault(run.vehicle, run)
     written: list[tuple[Any, Path]] = []

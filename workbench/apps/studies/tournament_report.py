@@ -15,7 +15,7 @@ import html
 import json
 from collections.abc import Mapping, Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import pandas as pd
@@ -140,6 +140,7 @@ def judged_points(
         x, y = getattr(row, effort), getattr(row, error)
         xerr = [[x - getattr(row, f"{effort}_low")], [getattr(row, f"{effort}_high") - x]]
         yerr = [[y - getattr(row, f"{error}_low")], [getattr(row, f"{error}_high") - y]]
+        style: dict[str, Any]  # matplotlib's keyword arguments, of mixed types
         if config == DEFAULT:
             style = {"marker": "s", "color": "tab:orange", "label": "default"}
         elif config == TUNED:
@@ -160,7 +161,7 @@ def judged_points(
 
 
 def _interval_bars(
-    ax: Axes, x: np.ndarray, mean: np.ndarray, low: np.ndarray, high: np.ndarray, **style: object
+    ax: Axes, x: np.ndarray, mean: np.ndarray, low: np.ndarray, high: np.ndarray, **style: Any
 ) -> None:
     ax.errorbar(x, mean, yerr=[mean - low, high - mean], ls="none", capsize=3, **style)
 
@@ -244,7 +245,7 @@ def _traces_figure(traces: Mapping[str, SimulationResult], labels: Sequence[str]
     plots.steering_comparison(runs, labels, angle, styles)
     steering_rate_comparison(runs, labels, rate, styles)
     plots.cte_comparison(runs, labels, cte, styles)
-    return angle.figure
+    return angle.figure.get_figure(root=True)
 
 
 def _interval_text(mean: float, low: float, high: float) -> str:

@@ -231,8 +231,10 @@ class TournamentSpec:
     batch_size: int = DEFAULT_BATCH_SIZE
     seed: int = 0
     objectives: tuple[str, ...] = DEFAULT_OBJECTIVES
-    selection: Mapping[str, float] | None = None
-    ranking: Mapping[str, float] | None = None
+    # None gives the default weights; __post_init__ replaces it by the checked weights, so that a constructed spec
+    # always holds a mapping (a field's type cannot differ between the constructor and the instance)
+    selection: Mapping[str, float] = None  # type: ignore[assignment]
+    ranking: Mapping[str, float] = None  # type: ignore[assignment]
     failure_score: float = DEFAULT_FAILURE_SCORE
     off_path_m: float = DEFAULT_OFF_PATH_M
     front_points: int = MAX_FRONT_POINTS
@@ -426,7 +428,8 @@ class TournamentSpec:
                 grid=grid,
                 controller_grid={controller: {k: [v] for k, v in self.fixed[controller].items()}},
                 seed=self.seed,
-                track_file=self.track_file,
+                # the file's text: StudySpec checks it and makes it an absolute Path, naming study.track_file
+                track_file=self.track_file,  # type: ignore[arg-type]
                 description=self.description,
                 base_dir=self.base_dir,
                 optimise=optimise,

@@ -86,7 +86,10 @@ def check_object(
     in every context and every planned combination with the object's other values: first a value that fails on
     its own (the others at their defaults), so that the value to blame is named, then one that fails only with the
     others planned. See the module docstring."""
-    given = [(k, where, v, None) for k, (where, values) in axes.items() for v in values]
+    # (parameter, where it is set, value, the random draw's index: None for a grid value)
+    given: list[tuple[str, str, Any, int | None]] = [
+        (k, where, v, None) for k, (where, values) in axes.items() for v in values
+    ]
     given += [(k, where, v, i) for k, (where, values) in draws.items() for i, v in enumerate(values)]
     alone: dict[tuple[str, str], str] = {}
     for key, _, value, _ in given:
