@@ -40,11 +40,6 @@ STANDARD_OUTPUTS: tuple[str, ...] = (
 #: road the tyre data describe (1.0): from about ice (0.05) to a road half as grippy again (1.5).
 ROAD_FRICTION_RANGE: tuple[float, float] = (0.05, 1.5)
 
-#: The models whose tyres `set_road_friction` scales, named in the refusal of a model without tyres (the registry,
-#: `workbench.vehicles.VEHICLES`, imports this module, so it is not consulted here).
-MODELS_WITH_TYRES_TEXT = "dynamic-bicycle, tractor-semitrailer, commonroad-mb"
-
-
 class PlantStepError(WorkbenchInputError):
     """A plant failed a step and cannot go on (an FMU plant's doStep returned an error): the message says when and
     why. The simulator ends the run with status `plant_failed`; any other caller shows it as an error."""
@@ -128,7 +123,7 @@ class VehicleModel(ABC):
             if scale != 1.0:
                 raise WorkbenchInputError(
                     f"road_friction {scale!r} needs tyres, and the {self.name} model has none (it does not slip: "
-                    f"only 1.0 is accepted); use a model with tyres ({MODELS_WITH_TYRES_TEXT})"
+                    f"only 1.0 is accepted); use a model with tyres ({', '.join(models_with_tyres())})"
                 )
             return
         if scale != self._road_friction:
@@ -193,3 +188,16 @@ class CompiledVehicleModel(VehicleModel):
         return self._outputs_kernel(
             np.asarray(state, dtype=float), self._p, delta_cmd, accel, self.params.steering_ratio
         )
+
+def models_with_tyres() -> list[str]:
+    """The names of the vehicle models with tyres (`VehicleModel.has_tyres`), sorted: those a road friction other
+    than 1.0 needs. Read from the model classes themselves, every one of them defined once the package
+    `workbench.vehicles` (its registry, which imports this module) is imported."""
+    names: set[str] = set()
+    classes = VehicleModel.__subclasses__()
+    while classes:
+        cls = classes.pop()
+        classes.extend(cls.__subclasses__())
+        if cls.has_tyres and isinstance(getattr(cls, "name", None), str):
+            names.add(cls.name)
+    return sorted(names)

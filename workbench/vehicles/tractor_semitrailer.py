@@ -36,7 +36,7 @@ from numba import njit
 
 from workbench.base.errors import WorkbenchInputError, require_in_range
 from workbench.vehicles.actuator import realised_accel, road_wheel_rate
-from workbench.vehicles.base import CompiledVehicleModel, VehicleGeometry
+from workbench.vehicles.base import STANDARD_OUTPUTS, CompiledVehicleModel, VehicleGeometry
 from workbench.vehicles.blend import blend, blend_weight, check_blend_speeds, pull
 from workbench.vehicles.integration import rk4
 from workbench.vehicles.reference_point import reference_point, world_velocity
@@ -345,6 +345,24 @@ def _rhs(s, p, delta_cmd, accel, out):  # pragma: no cover - compiled
     out[8] = ddelta
 
 
+#: The model's outputs after the standard ones (`_outputs` writes them in this order): the load transfer ratios
+#: (the largest |LTR| and each axle group's), the trailer axle's position (m) and yaw (rad), the articulation angle
+#: (rad) and the path curvature the reference point follows (1/m).
+EXTRA_OUTPUT_NAMES: tuple[str, ...] = (
+    "ltr",
+    "ltr_front",
+    "ltr_drive",
+    "ltr_trailer",
+    "trailer_x_m",
+    "trailer_y_m",
+    "trailer_yaw_rad",
+    "articulation_rad",
+    "path_curvature_1pm",
+)
+#: The length of `_outputs`' array: the standard outputs, then EXTRA_OUTPUT_NAMES.
+OUTPUT_COUNT = len(STANDARD_OUTPUTS) + len(EXTRA_OUTPUT_NAMES)
+
+
 @njit(cache=True)
 def _advance(state, p, delta_cmd, accel, h, n):  # pragma: no cover - compiled
     return rk4(_rhs, state, p, delta_cmd, accel, h, n)
@@ -367,7 +385,7 @@ def _outputs(s, p, delta_cmd, accel, ratio):  # pragma: no cover - compiled
     ltr_t = p[P_KT1] * ay1 + p[P_KT2] * ay2
     hx = x + p[P_HOFF] * math.cos(yaw)
     hy = y + p[P_HOFF] * math.sin(yaw)
-    out = np.empty(18)
+    out = np.empty(OUTPUT_COUNT)
     out[0], out[1], out[2], out[3], out[4], out[5] = x, y, yaw, u, vref, r1
     out[6], out[7], out[8] = delta * ratio, delta, ay_ref
     out[9] = max(abs(ltr_f), abs(ltr_d), abs(ltr_t))
@@ -395,17 +413,7 @@ class TractorSemitrailer(CompiledVehicleModel):
     )
     heading_states: ClassVar[tuple[str, ...]] = ("trailer_yaw_rad",)
     has_tyres: ClassVar[bool] = True
-    extra_output_names: ClassVar[tuple[str, ...]] = (
-        "ltr",
-        "ltr_front",
-        "ltr_drive",
-        "ltr_trailer",
-        "trailer_x_m",
-        "trailer_y_m",
-        "trailer_yaw_rad",
-        "articulation_rad",
-        "path_curvature_1pm",
-    )
+    extra_output_names: ClassVar[tuple[str, ...]] = EXTRA_OUTPUT_NAMES
 
     _advance_kernel = staticmethod(_advance)
     _outputs_kernel = staticmethod(_outputs)
