@@ -30,7 +30,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import replace
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, TypeVar
 
 import casadi as ca
 import numpy as np
@@ -52,6 +52,10 @@ from workbench.vehicles.geometry import VehicleGeometry
 
 if TYPE_CHECKING:
     from workbench.simulation.known_delays import KnownDelays
+    from workbench.vehicles.base import VehicleModel
+
+#: An MPC's config: `MPCConfig` or the subclass its controller's `config_type` names.
+MPCConfigT = TypeVar("MPCConfigT", bound=MPCConfig)
 
 #: Below this speed (m/s) yaw rate / speed and the course angle are not used (the yaw and the previous plan are).
 MIN_MEASURED_SPEED_MPS = 0.5
@@ -73,11 +77,11 @@ SOLVE_DIAGNOSTICS = (
 )
 
 
-class MPCController(Controller):
+class MPCController(Controller[MPCConfigT]):
     """Base of the two MPCs: subclasses build `self.solver` (an `MPCSolver`) in `_build_solver`."""
 
     @classmethod
-    def informed_config(cls, config: MPCConfig, delays: KnownDelays) -> MPCConfig:
+    def informed_config(cls, config: MPCConfigT, delays: KnownDelays) -> MPCConfigT:
         """`config` told the conditions' nominal delays, as a vehicle's state estimator and delay compensation
         would be configured; both MPCs (`NMPCConfig`, `LMPCConfig`) have every option set here (`MPCConfig`).
 
@@ -109,10 +113,8 @@ class MPCController(Controller):
             yaw_rate_latency_s=yaw_rate_latency,
         )
 
-    config: MPCConfig
-
     def __init__(
-        self, geometry: VehicleGeometry, config: MPCConfig | None = None, vehicle: object | None = None
+        self, geometry: VehicleGeometry, config: MPCConfigT | None = None, vehicle: VehicleModel | None = None
     ) -> None:
         """`config`: an instance of the subclass's `config_type` (its defaults when None); `vehicle`: what to predict
         with when the config's vehicle is "auto" (`resolve_prediction_params`)."""

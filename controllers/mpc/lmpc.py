@@ -123,12 +123,11 @@ class LMPCConfig(MPCConfig):
         super().__post_init__()  # every field's rule, this class's included (`check_options`)
 
 
-class LMPCController(MPCController):
+class LMPCController(MPCController[LMPCConfig]):
     """Autoware-style LTV-MPC (module docstring). `vehicle` (optional): the vehicle model or its parameters."""
 
     name: ClassVar[str] = "lmpc"
     config_type: ClassVar[type] = LMPCConfig
-    config: LMPCConfig
     search_space: ClassVar[tuple[Tunable, ...]] = MPC_SEARCH_SPACE
 
     def _build_solver(self) -> None:

@@ -59,13 +59,12 @@ class NMPCConfig(MPCConfig):
         super().__post_init__()  # every field's rule, this class's included (`check_options`)
 
 
-class NMPCController(MPCController):
+class NMPCController(MPCController[NMPCConfig]):
     """CasADi NMPC (module docstring). `vehicle` (optional): the vehicle model or its parameters to predict with;
     without it the config's `vehicle`/`vehicle_file` decide."""
 
     name: ClassVar[str] = "nmpc"
     config_type: ClassVar[type] = NMPCConfig
-    config: NMPCConfig
     search_space: ClassVar[tuple[Tunable, ...]] = MPC_SEARCH_SPACE
 
     def _build_solver(self) -> None:

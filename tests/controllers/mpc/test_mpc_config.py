@@ -3,12 +3,11 @@ run gives its own (`DEFAULT_PERIOD_S`, the solver's budget until then), and cons
 
 from __future__ import annotations
 
-import typing
-
 import pytest
 
 from controllers.mpc import LMPCConfig, LMPCController, MPCConfig, MPCController, NMPCConfig, NMPCController
 from controllers.mpc.config import DEFAULT_PERIOD_S
+from controllers.mpc.controller import MPCConfigT
 from workbench.base.clothoid_chain import ClothoidChain
 from workbench.vehicles import make_vehicle
 
@@ -30,6 +29,7 @@ def test_the_solve_budget_is_the_default_period_until_a_run_gives_its_own(cls, c
 @pytest.mark.parametrize(("cls", "config_type"), VARIANTS)
 def test_the_constructors_are_typed_by_the_config(cls, config_type) -> None:
     assert "__init__" not in vars(cls)  # the shared constructor, no pass-through of its own
-    hints = typing.get_type_hints(MPCController.__init__)
-    assert hints["config"] == MPCConfig | None
-    assert typing.get_type_hints(cls)["config"] is config_type
+    assert MPCConfigT.__bound__ is MPCConfig
+    assert MPCController.__init__.__annotations__["config"] == "MPCConfigT | None"
+    assert cls.__orig_bases__ == (MPCController[config_type],)  # its config is the one it is built with
+    assert cls.config_type is config_type
