@@ -20,7 +20,7 @@ from controllers.config_checks import Number, check_options, option
 from controllers.search_space import Tunable
 from workbench.base.errors import WorkbenchInputError, value_text
 from workbench.base.path import PathTracker, ReferencePath
-from workbench.base.path_search import first_beyond, track, value_at
+from workbench.base.path_search import PATH_X, PATH_Y, first_beyond, track, value_at
 
 #: The longest lookahead (m) the options allow.
 MAX_LOOKAHEAD_M = 1000.0
@@ -73,10 +73,10 @@ class PurePursuit(Controller):
 
     def _command(self, measurement: Measurement, path: ReferencePath) -> float:
         cfg, m, tracker = self.config, measurement, self._tracker
+        compiled = tracker.compiled
         curvature, lookahead, target_s = pure_pursuit_step(
             m.x_m, m.y_m, m.yaw_rad, m.speed_mps, cfg.lookahead_gain_s, cfg.min_lookahead_m, cfg.max_lookahead_m,
-            path.x_m, path.y_m, path.heading_rad, path.curvature_1pm, path.spacing_m, path.length_m, path.closed,
-            path.max_segment_m, tracker.extent_m, tracker.min_window_m, tracker.state, tracker.out,
+            compiled.table, compiled.record, tracker.state, tracker.out,
         )  # fmt: skip
         self._diag[:] = (lookahead, target_s, curvature)
         return self.saturate(self.geometry.steer_wheel_for_curvature(curvature))
@@ -91,31 +91,24 @@ def pure_pursuit_step(
     gain_s: float,
     min_lookahead_m: float,
     max_lookahead_m: float,
-    path_x: np.ndarray,
-    path_y: np.ndarray,
-    path_heading: np.ndarray,
-    path_curvature: np.ndarray,
-    spacing: float,
-    length: float,
-    closed: bool,
-    max_segment: float,
-    extent: float,
-    min_window: float,
+    table: np.ndarray,
+    record: np.ndarray,
     tracker: np.ndarray,
     foot: np.ndarray,
 ) -> tuple[float, float, float]:  # pragma: no cover - compiled
     """(curvature 1/m, lookahead l_d m, target arc length m) of one step (module docstring), compiled: the foot
-    point (`path_search.track`, the tracker's state and output arrays), l_d, the target at l_d ahead
-    (`ReferencePath.s_at_euclidean_distance`) and the arc to it."""
-    track(
-        path_x, path_y, path_heading, path_curvature, spacing, length, closed, extent, min_window, tracker, x_m, y_m,
-        foot,
-    )  # fmt: skip
+    point on the compiled path (`path_search.CompiledPath`'s table and record; `path_search.track`, the tracker's
+    state and output arrays), l_d, the target at l_d ahead (`ReferencePath.s_at_euclidean_distance`) and the arc
+    to it."""
+    track(table, record, tracker, x_m, y_m, foot)
+    path_x, path_y = table[PATH_X], table[PATH_Y]
+    shape = record[0]
+    spacing, length, closed = shape.spacing, shape.length, shape.closed
     foot_s, foot_curvature, cte = foot[0], foot[5], foot[6]
     lookahead = min(max(gain_s * speed_mps, min_lookahead_m), max_lookahead_m)
     lookahead = max(lookahead, abs(cte) + min_lookahead_m)
     s_from = foot_s % length if closed else min(max(foot_s, 0.0), length)
-    index = first_beyond(path_x, path_y, x_m, y_m, s_from / spacing, lookahead, closed, max_segment)
+    index = first_beyond(path_x, path_y, x_m, y_m, s_from / spacing, lookahead, closed, shape.max_segment)
     if index < 0.0:  # no point ahead is that far: the end of an open path
         target_s = length if not closed else s_from
     else:

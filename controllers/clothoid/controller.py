@@ -63,7 +63,7 @@ from controllers.clothoid.vehicle_tuning import VehicleTuning
 from controllers.config_checks import Choice, Flag, Instance, Number, check_options, option
 from controllers.search_space import Tunable
 from workbench.base.errors import WorkbenchInputError, value_text
-from workbench.base.path import PathTracker, ReferencePath
+from workbench.base.path import ReferencePath
 from workbench.vehicles.base import VehicleGeometry
 
 if TYPE_CHECKING:  # the loop analysis (python-control, ~0.9 s to import) only where floors are computed
@@ -453,16 +453,13 @@ class ClothoidController(Controller):
                 self.filter_schedule = cfg.lead_filter
             elif self.tuning is not None:
                 self.filter_schedule = self.tuning.filter_schedule
-        self._buffers = np.empty((4, MAX_CURVE_POINTS))
         top = self._floor_search_top_m
         self._scores = np.empty(candidate_count(cfg.min_lookahead_m, top, cfg.lookahead_step_m))
         self._results = np.empty((self._scores.size, 8))  # each candidate's evaluation (lookahead.adaptive_search)
         self._floors: dict[int, float] = {}  # per speed band, for the sample time _floors_dt
         self._floors_dt: float | None = None
-        self._state = np.empty(sk.STATE_SIZE)
-        self._floor_table = np.empty(sk.FLOOR_ROWS)
-        self._filter_table = np.empty((sk.FILTER_ROWS, 9))
-        self._scratch = np.empty(sk.SCRATCH_SIZE)
+        self._state = sk.initial_state()  # the compiled step's state (step_kernel.STATE)
+        self._measured = np.zeros(1, sk.MEASUREMENT)  # the measurement as the compiled step reads it
         self._history = np.empty(1)  # the delay predictor's commands sent, sized by `_reset`
         self._params = self._parameters()
         self._tables()
@@ -471,16 +468,8 @@ class ClothoidController(Controller):
         if float(sample_time_s) != self._floors_dt:  # the floors depend on the sample time, not on the path
             self._floors, self._floors_dt = {}, float(sample_time_s)
         self._dt = float(sample_time_s)
-        self._tracker: PathTracker = path.tracker(0.0)
-        self._here: PathTracker = path.tracker(0.0)
-        self._state[:] = np.nan
-        self._state[sk.S_HELD_BAND] = -1.0
-        self._floor_table[:] = np.nan
-        self._filter_table[:] = np.nan
-        p = self._params
-        p[sk.P_DT], p[sk.P_PATH_SPACING], p[sk.P_PATH_LENGTH] = self._dt, path.spacing_m, path.length_m
-        p[sk.P_PATH_EXTENT], p[sk.P_TRACKER_WINDOW] = self._tracker.extent_m, self._tracker.min_window_m
-        p[sk.P_PATH_MAX_SEGMENT] = path.max_segment_m
+        self._state = sk.initial_state()  # both path trackers at the path's start
+        self._params["dt"] = self._dt
         self._diag = self._declare_diagnostics(DIAGNOSTIC_KEYS)
         self._tables()  # read again: limits, tuning and schedule are the controller's attributes
         if self.config.predicts_with_model:
@@ -488,11 +477,11 @@ class ClothoidController(Controller):
                 max(self._lags[:, 2].max(), self._measured_lags[:, 2].max(initial=0.0))
             )
             self._history = np.empty(history_length(self._dt, longest))
-        # The step's own arrays, in clothoid_step's order after the path's: looked up once, not every step.
-        self._own_arrays = (
-            self._tracker.state, self._here.state, self._limits, self._limit_speeds, self._lags, self._measured_lags,
-            self._lag_speeds, self._schedule, self._schedule_speeds, self._floor_table, self._filter_table,
-            self._buffers, self._scores, self._results, self._scratch, self._diag, self._history,
+        compiled = path.compiled()
+        self._step_arguments = sk.StepArguments(
+            self._measured, self._params, self._state, compiled.table, compiled.record, self._limits,
+            self._limit_speeds, self._lags, self._measured_lags, self._lag_speeds, self._schedule,
+            self._schedule_speeds, self._scores, self._results, self._diag, self._history,
         )  # fmt: skip
         # The planned speeds' floors now, not in a step (~0.04 s a band, with the delay model 0.5 s).
         for band in self._planned_bands(path):
@@ -512,40 +501,47 @@ class ClothoidController(Controller):
             self._schedule_speeds, self._schedule = np.zeros(0), np.zeros((0, 3))
 
     def _parameters(self) -> np.ndarray:
-        """The compiled step's parameter vector (step_kernel.P_*): geometry and options (the period and the path's
-        are set by `_reset`)."""
-        cfg, g, p = self.config, self.geometry, np.full(sk.PARAM_COUNT, np.nan)
-        p[sk.P_WHEELBASE], p[sk.P_STEERING_RATIO], p[sk.P_MAX_STEER] = (
-            g.wheelbase_m,
-            g.steering_ratio,
-            g.max_steer_wheel_angle_rad,
+        """The compiled step's parameters (step_kernel.PARAMS): geometry and options (the period, NaN here, is set
+        by `_reset`)."""
+        cfg, g = self.config, self.geometry
+        return sk.parameters(
+            wheelbase=g.wheelbase_m,
+            steering_ratio=g.steering_ratio,
+            max_steer=g.max_steer_wheel_angle_rad,
+            dt=math.nan,
+            horizon=self._prediction_horizon_s,
+            known_delay=cfg.known_delay_s,
+            lookahead_mode=LOOKAHEAD_MODES.index(cfg.lookahead_mode),
+            initial_curvature=INITIAL_CURVATURE.index(cfg.initial_curvature),
+            course=cfg.heading == "course",
+            excess=cfg.threshold_mode == "excess",
+            min_lookahead=cfg.min_lookahead_m,
+            max_lookahead=cfg.max_lookahead_m,
+            lookahead_step=cfg.lookahead_step_m,
+            min_preview=cfg.min_preview_time_s,
+            fixed_lookahead=cfg.fixed_lookahead_m,
+            lookahead_gain=cfg.lookahead_gain_s,
+            max_turn=math.radians(cfg.max_target_turn_deg),
+            frechet_threshold=cfg.frechet_threshold_m,
+            point_spacing=cfg.frechet_point_spacing_m,
+            tolerance_x=cfg.tolerance_x_m,
+            tolerance_y=cfg.tolerance_y_m,
+            kdot_max=cfg.max_curvature_rate_1pm2,
+            feedforward=cfg.path_feedforward,
+            feedforward_window=cfg.feedforward_window_m,
+            feedforward_time=cfg.feedforward_time_s,
+            reference_lead=cfg.reference_lead_s,
+            hysteresis=cfg.lookahead_hysteresis_m,
+            max_growth=cfg.max_lookahead_growth_m_per_m,
+            max_shrink=cfg.max_lookahead_shrink_m_per_m,
+            min_speed=MIN_SPEED_MPS,
+            band_kmh=FLOOR_SPEED_BAND_KMH,
+            band_hysteresis_kmh=FLOOR_BAND_HYSTERESIS_KMH,
+            warm_search=cfg.search_start == "last",
+            delay_model=cfg.predicts_with_model,
+            feedforward_inversion=cfg.feedforward_inversion,
+            lag_model_reference=cfg.lag_model_reference,
         )
-        p[sk.P_HORIZON], p[sk.P_KNOWN_DELAY] = self._prediction_horizon_s, cfg.known_delay_s
-        p[sk.P_LOOKAHEAD_MODE] = LOOKAHEAD_MODES.index(cfg.lookahead_mode)
-        p[sk.P_INITIAL_CURVATURE] = INITIAL_CURVATURE.index(cfg.initial_curvature)
-        p[sk.P_COURSE], p[sk.P_EXCESS] = cfg.heading == "course", cfg.threshold_mode == "excess"
-        p[sk.P_MIN_LOOKAHEAD], p[sk.P_MAX_LOOKAHEAD] = cfg.min_lookahead_m, cfg.max_lookahead_m
-        p[sk.P_LOOKAHEAD_STEP], p[sk.P_MIN_PREVIEW] = cfg.lookahead_step_m, cfg.min_preview_time_s
-        p[sk.P_WARM_SEARCH] = cfg.search_start == "last"
-        p[sk.P_DELAY_MODEL] = cfg.predicts_with_model
-        p[sk.P_FIXED_LOOKAHEAD], p[sk.P_LOOKAHEAD_GAIN] = cfg.fixed_lookahead_m, cfg.lookahead_gain_s
-        p[sk.P_MAX_TURN_RAD] = math.radians(cfg.max_target_turn_deg)
-        p[sk.P_FRECHET_THRESHOLD], p[sk.P_POINT_SPACING] = cfg.frechet_threshold_m, cfg.frechet_point_spacing_m
-        p[sk.P_TOLERANCE_X], p[sk.P_TOLERANCE_Y] = cfg.tolerance_x_m, cfg.tolerance_y_m
-        p[sk.P_KDOT_MAX], p[sk.P_FEEDFORWARD] = cfg.max_curvature_rate_1pm2, cfg.path_feedforward
-        p[sk.P_FEEDFORWARD_WINDOW] = cfg.feedforward_window_m
-        p[sk.P_FEEDFORWARD_INVERSION] = cfg.feedforward_inversion
-        p[sk.P_LAG_MODEL_REFERENCE] = cfg.lag_model_reference
-        for index, value in (
-            (sk.P_FEEDFORWARD_TIME, cfg.feedforward_time_s),
-            (sk.P_REFERENCE_LEAD, cfg.reference_lead_s),
-            (sk.P_MAX_GROWTH, cfg.max_lookahead_growth_m_per_m),
-            (sk.P_MAX_SHRINK, cfg.max_lookahead_shrink_m_per_m),
-        ):
-            p[index] = math.nan if value is None else value
-        p[sk.P_HYSTERESIS], p[sk.P_MIN_SPEED] = cfg.lookahead_hysteresis_m, MIN_SPEED_MPS
-        p[sk.P_BAND_KMH], p[sk.P_BAND_HYSTERESIS_KMH] = FLOOR_SPEED_BAND_KMH, FLOOR_BAND_HYSTERESIS_KMH
-        return p
 
     def plant_lags(self, speed_kmh: float) -> PlantLags | None:
         """The vehicle's identified lags at this speed (None without a tuning)."""
@@ -706,16 +702,14 @@ class ClothoidController(Controller):
 
     def _command(self, measurement: Measurement, path: ReferencePath) -> float:
         m = measurement
+        self._measured[0] = (m.t_s, m.x_m, m.y_m, m.vx_mps, m.vy_mps, m.yaw_rad, m.yaw_rate_rad_s, m.steer_wheel_rad)
         while True:  # once, unless the step asks for a floor or a lead filter Python makes (step_kernel.py)
-            command, status = sk.clothoid_step(
-                m.t_s, m.x_m, m.y_m, m.vx_mps, m.vy_mps, m.yaw_rad, m.yaw_rate_rad_s, m.steer_wheel_rad, self._params,
-                self._state, path.x_m, path.y_m, path.heading_rad, path.curvature_1pm, path.closed, *self._own_arrays
-            )  # fmt: skip
+            command, status = sk.clothoid_step(*self._step_arguments)
             if status == sk.STEP_DONE:
                 return command
-            need = int(self._state[sk.S_NEED])
+            need = int(self._state["need"][0])
             if status == sk.NEED_FLOOR:
-                self._floor_table[need] = self._band_floor_m(need)
+                self._state["floors"][0, need] = self._band_floor_m(need)
             else:
                 params = self.filter_schedule.at_speed(float(need))
-                self._filter_table[need] = DiscreteLeadFilter(params, self._dt).coefficients
+                self._state["filters"][0, need] = DiscreteLeadFilter(params, self._dt).coefficients

@@ -29,10 +29,26 @@ from numba import njit
 from controllers.clothoid.clothoid_fit import FIT_UNREACHABLE, fit_kernel, sample_kernel
 from controllers.clothoid.frechet import frechet_below
 from workbench.base.path import ReferencePath
-from workbench.base.path_search import first_beyond
+from workbench.base.path_search import PATH_HEADING, PATH_X, PATH_Y, first_beyond
 
 #: Most points per sampled curve (the Fréchet cost grows with its square).
 MAX_CURVE_POINTS = 64
+#: The adaptive search's settings (`adaptive_search`'s `settings`, one record): the grid's step (m), the
+#: tolerances on the clothoid's end point (m, Eq. 3), the curvature rate's saturation (1/m^2) and the spacing of
+#: the points the Fréchet distance compares (m). Any record with these fields serves (the clothoid step's own
+#: parameters, `step_kernel.PARAMS`).
+SEARCH_SETTINGS = np.dtype(
+    [(name, np.float64) for name in ("lookahead_step", "tolerance_x", "tolerance_y", "kdot_max", "point_spacing")]
+)
+
+
+def search_settings(
+    step_m: float, tolerance_x_m: float, tolerance_y_m: float, kdot_max_1pm2: float, point_spacing_m: float
+) -> np.ndarray:
+    """The adaptive search's settings as one record (SEARCH_SETTINGS, a structured array of one element)."""
+    settings = np.zeros(1, SEARCH_SETTINGS)
+    settings[0] = (step_m, tolerance_x_m, tolerance_y_m, kdot_max_1pm2, point_spacing_m)
+    return settings
 
 
 @njit(cache=True)
@@ -69,9 +85,8 @@ def _beyond_end(x: np.ndarray, y: np.ndarray, px: float, py: float, distance_m: 
 
 @njit(cache=True)
 def evaluate_candidate(
-    path_x: np.ndarray,
-    path_y: np.ndarray,
-    closed: bool,
+    table: np.ndarray,
+    record: np.ndarray,
     foot_index: float,
     px: float,
     py: float,
@@ -81,18 +96,19 @@ def evaluate_candidate(
     kdot_max: float,
     point_spacing_m: float,
     buffers: np.ndarray,
-    max_segment_m: float,
     limit_m: float,
 ) -> tuple[float, float, float, float, float, float, float, int]:  # pragma: no cover - compiled
-    """Fit and score one lookahead distance.
+    """Fit and score one lookahead distance on the compiled path (`path_search.CompiledPath`'s table and record).
 
     Returns (frechet_m, kdot, length_m, target_x, target_y, end_x, end_y, status); buffers is a (4, MAX) work
-    array for the sampled clothoid (rows 0, 1) and reference (rows 2, 3); max_segment_m: the path's longest chord
-    between samples (`path_search.first_beyond`); frechet_m is inf once it is known to exceed limit_m
-    (`frechet.frechet_below`; inf: always the distance itself).
+    array for the sampled clothoid (rows 0, 1) and reference (rows 2, 3); frechet_m is inf once it is known to
+    exceed limit_m (`frechet.frechet_below`; inf: always the distance itself).
     """
+    path_x, path_y = table[PATH_X], table[PATH_Y]
+    shape = record[0]
+    closed = shape.closed
     n_seg = path_x.size - 1
-    target_index = first_beyond(path_x, path_y, px, py, foot_index, lookahead_m, closed, max_segment_m)
+    target_index = first_beyond(path_x, path_y, px, py, foot_index, lookahead_m, closed, shape.max_segment)
     if target_index < 0.0:  # the open path ends nearer than the lookahead: aim beyond it, on its last tangent
         target_index = float(n_seg) + _beyond_end(path_x, path_y, px, py, lookahead_m)
     tx, ty = _point_at_index(path_x, path_y, target_index, closed)
@@ -125,9 +141,9 @@ def evaluated(
 
 @njit(cache=True)
 def adaptive_search(
-    path_x: np.ndarray,
-    path_y: np.ndarray,
-    closed: bool,
+    table: np.ndarray,
+    record: np.ndarray,
+    settings: np.ndarray,
     foot_index: float,
     px: float,
     py: float,
@@ -135,22 +151,19 @@ def adaptive_search(
     kappa0: float,
     min_lookahead_m: float,
     max_lookahead_m: float,
-    step_m: float,
     threshold_m: float,
-    tolerance_x_m: float,
-    tolerance_y_m: float,
-    kdot_max: float,
-    point_spacing_m: float,
+    hint_m: float,
     buffers: np.ndarray,
     scores: np.ndarray,
     results: np.ndarray,
-    max_segment_m: float,
-    hint_m: float,
 ) -> tuple[float, int]:  # pragma: no cover - compiled
-    """The chosen lookahead (m) and the number of candidates evaluated; scores[k] holds candidate k's Fréchet
-    distance (NaN where not evaluated, inf where it was cut short: more than the threshold in the bisection, more
-    than the least so far in the fallback's scan, so that it could not change the choice), with candidate k at
-    min + k step, and results[k] (scores.size, 8) all that `evaluate_candidate` returned for it (`evaluated`).
+    """The chosen lookahead (m) on the compiled path (`path_search.CompiledPath`'s table and record) and the number
+    of candidates evaluated; settings: the grid's step, the end point's tolerances, the curvature rate's saturation
+    and the Fréchet points' spacing (a record with SEARCH_SETTINGS's fields, `search_settings`); scores[k] holds
+    candidate k's Fréchet distance (NaN where not evaluated, inf where it was cut short: more than the threshold in
+    the bisection, more than the least so far in the fallback's scan, so that it could not change the choice),
+    with candidate k at min + k step, and results[k] (scores.size, 8) all that `evaluate_candidate` returned for
+    it (`evaluated`).
 
     hint_m: where to start (NaN: from the range's ends). The choice moves little from one step to the next, so
     a controller passes its last one: the hint and the candidate above it settle the search in two evaluations
@@ -160,14 +173,17 @@ def adaptive_search(
     (the paper's Figure 4b; the premises of the search from the ends too), both starts choose the same candidate
     (`test_lookahead.py`); elsewhere each finds one of the places where admissibility changes.
     """
+    search = settings[0]
+    step_m, tolerance_x_m, tolerance_y_m = search.lookahead_step, search.tolerance_x, search.tolerance_y
+    kdot_max, point_spacing_m = search.kdot_max, search.point_spacing
     count = max(1, min(candidate_count(min_lookahead_m, max_lookahead_m, step_m), scores.size))
     scores[:] = np.nan
     evaluations = 0
 
     def admissible(k: int, limit: float) -> bool:
         fd, kdot, length, tx, ty, ex, ey, status = evaluate_candidate(
-            path_x, path_y, closed, foot_index, px, py, theta, kappa0, min_lookahead_m + k * step_m,
-            kdot_max, point_spacing_m, buffers, max_segment_m, limit,
+            table, record, foot_index, px, py, theta, kappa0, min_lookahead_m + k * step_m, kdot_max,
+            point_spacing_m, buffers, limit,
         )  # fmt: skip
         scores[k] = fd
         row = results[k]
@@ -248,16 +264,13 @@ def adaptive_search(
 
 @njit(cache=True)
 def turn_limited_lookahead(
-    path_x: np.ndarray,
-    path_y: np.ndarray,
-    path_heading: np.ndarray,
-    closed: bool,
+    table: np.ndarray,
+    record: np.ndarray,
     foot_index: float,
     px: float,
     py: float,
     max_turn_rad: float,
     max_m: float,
-    max_segment_m: float,
 ) -> float:  # pragma: no cover - compiled
     """The longest lookahead (m, at most max_m) whose target (`first_beyond` from (px, py)) the path reaches before
     its heading has turned by more than max_turn_rad from the heading at the foot point: the largest distance from
@@ -268,7 +281,11 @@ def turn_limited_lookahead(
 
     The walk reads headings only; a sample's distance is measured where it may reach max_m (k chords past the foot
     point it is at most r0 + k max_segment_m away, r0 the foot point's distance: `path_search.first_beyond`), and
-    those before the turn are measured once the turn is found."""
+    those before the turn are measured once the turn is found. The path: `path_search.CompiledPath`'s table and
+    record."""
+    path_x, path_y, path_heading = table[PATH_X], table[PATH_Y], table[PATH_HEADING]
+    shape = record[0]
+    closed, max_segment_m = shape.closed, shape.max_segment
     n_seg = path_x.size - 1
     lap_turn = path_heading[-1] - path_heading[0]
     i0 = int(foot_index)
@@ -319,11 +336,11 @@ class LookaheadEvaluator:
         self, s_foot_m: float, x_m: float, y_m: float, heading_rad: float, curvature_1pm: float,
         lookahead_m: float, max_curvature_rate_1pm2: float,
     ) -> Candidate:  # fmt: skip
-        path = self.path
+        path, compiled = self.path, self.path.compiled()
         fd, kdot, length, tx, ty, ex, ey, status = evaluate_candidate(
-            path.x_m, path.y_m, path.closed, s_foot_m / path.spacing_m, float(x_m), float(y_m),
-            float(heading_rad), float(curvature_1pm), float(lookahead_m), float(max_curvature_rate_1pm2),
-            self.point_spacing_m, self._buffers, path.max_segment_m, np.inf,
+            compiled.table, compiled.record, s_foot_m / path.spacing_m, float(x_m), float(y_m), float(heading_rad),
+            float(curvature_1pm), float(lookahead_m), float(max_curvature_rate_1pm2), self.point_spacing_m,
+            self._buffers, np.inf,
         )  # fmt: skip
         return Candidate(lookahead_m, fd, kdot, length, (tx, ty), (ex, ey), status)
 

@@ -43,7 +43,7 @@ from numba import njit
 from controllers.clothoid.clothoid_fit import fit_kernel
 from controllers.clothoid.pose_prediction import along_arc
 from workbench.base.errors import require_in_range
-from workbench.base.path_search import value_at
+from workbench.base.path_search import PATH_CURVATURE, PATH_HEADING, PATH_X, PATH_Y, value_at
 
 #: Saturation of the reference fit's kappa' (1/m^2): far above any path's, so the fit is never clipped.
 REFERENCE_KDOT_MAX = 1e6
@@ -68,13 +68,8 @@ class FeedforwardTiming:
 @njit(cache=True)
 def two_degree_of_freedom_rate(
     vehicle_kdot: float,
-    path_x: np.ndarray,
-    path_y: np.ndarray,
-    path_heading: np.ndarray,
-    path_curvature: np.ndarray,
-    spacing: float,
-    length: float,
-    closed: bool,
+    table: np.ndarray,
+    record: np.ndarray,
     here: np.ndarray,
     target_x: float,
     target_y: float,
@@ -87,9 +82,10 @@ def two_degree_of_freedom_rate(
     path_time_s: float = 0.0,
     reference_curvature: float = math.nan,
 ) -> tuple[float, float, float]:  # pragma: no cover - compiled
-    """(kappa' to integrate, the reference's kappa', the feed-forward kappa') (1/m^2), module docstring. here: the
-    foot point of the vehicle's measured position (`path_search.track`'s output: s, progress, x, y, heading,
-    curvature, ...); the timings of `FeedforwardTiming`.
+    """(kappa' to integrate, the reference's kappa', the feed-forward kappa') (1/m^2), module docstring, on the
+    compiled path (`path_search.CompiledPath`'s table and record). here: the foot point of the vehicle's measured
+    position (`path_search.track`'s output: s, progress, x, y, heading, curvature, ...); the timings of
+    `FeedforwardTiming`.
 
     The reference pose: the path's pose path_time_s + reference_lead_s ahead of the foot point, moved over the rest
     of the prediction time on the path's curvature there, by the chord of that arc (as the vehicle's own
@@ -98,12 +94,15 @@ def two_degree_of_freedom_rate(
     reference pose moves on (NaN: the path's there).
     The feed-forward: dkappa/ds of the path speed x feedforward_time_s ahead of the foot point, averaged over
     window_m, over K."""
+    shape = record[0]
+    spacing, length, closed = shape.spacing, shape.length, shape.closed
+    path_curvature = table[PATH_CURVATURE]
     lead = min(reference_lead_s, prediction_time_s)
     if path_time_s + lead > 0.0:
         s_ref = here[0] + speed_mps * (path_time_s + lead)
-        rx = value_at(path_x, s_ref, spacing, length, closed)
-        ry = value_at(path_y, s_ref, spacing, length, closed)
-        rh = value_at(path_heading, s_ref, spacing, length, closed)
+        rx = value_at(table[PATH_X], s_ref, spacing, length, closed)
+        ry = value_at(table[PATH_Y], s_ref, spacing, length, closed)
+        rh = value_at(table[PATH_HEADING], s_ref, spacing, length, closed)
         rk = value_at(path_curvature, s_ref, spacing, length, closed)
     else:
         rx, ry, rh, rk = here[2], here[3], here[4], here[5]
@@ -122,10 +121,8 @@ def two_degree_of_freedom_rate(
 
 @njit(cache=True)
 def previewed_curvature(
-    path_curvature: np.ndarray,
-    spacing: float,
-    length: float,
-    closed: bool,
+    table: np.ndarray,
+    record: np.ndarray,
     s_m: float,
     speed_mps: float,
     preview_s: float,
@@ -136,7 +133,11 @@ def previewed_curvature(
     """(kappa + first_s dkappa/dt + second_s2 d2kappa/dt2 1/m, dkappa/ds 1/m^2) of the path speed x preview_s ahead
     of s_m, with d/dt = V d/ds at the speed V now (the speed's own change is left out); the derivatives are central
     differences over window_m (dkappa/ds the mean slope over the window, d2kappa/ds2 the second difference over half
-    of it), so a clothoid's corner in curvature rate is spread over the window, not a one-step impulse."""
+    of it), so a clothoid's corner in curvature rate is spread over the window, not a one-step impulse. The path:
+    `path_search.CompiledPath`'s table and record."""
+    path_curvature = table[PATH_CURVATURE]
+    shape = record[0]
+    spacing, length, closed = shape.spacing, shape.length, shape.closed
     s, half = s_m + speed_mps * preview_s, 0.5 * window_m
     ahead = value_at(path_curvature, s + half, spacing, length, closed)
     middle = value_at(path_curvature, s, spacing, length, closed)
@@ -148,10 +149,8 @@ def previewed_curvature(
 
 @njit(cache=True)
 def lag_inverse_curvature(
-    path_curvature: np.ndarray,
-    spacing: float,
-    length: float,
-    closed: bool,
+    table: np.ndarray,
+    record: np.ndarray,
     s_m: float,
     speed_mps: float,
     dead_time_s: float,
@@ -169,11 +168,10 @@ def lag_inverse_curvature(
         u(t) = (kappa_p + 2 zeta / wn dkappa_p/dt + 1 / wn^2 d2kappa_p/dt^2)(t + T) / K,
 
     read along the path from the foot point s_m by `previewed_curvature` (T: dead_time_s, the lag's delay plus any
-    known delay). omega_n_rad_s NaN (no identified lag): the path's curvature there, over K."""
+    known delay; the path: `path_search.CompiledPath`'s table and record). omega_n_rad_s NaN (no identified lag):
+    the path's curvature there, over K."""
     first = second = 0.0
     if not math.isnan(omega_n_rad_s):
         first, second = 2.0 * zeta / omega_n_rad_s, 1.0 / (omega_n_rad_s * omega_n_rad_s)
-    curvature, slope = previewed_curvature(
-        path_curvature, spacing, length, closed, s_m, speed_mps, dead_time_s, first, second, window_m
-    )
+    curvature, slope = previewed_curvature(table, record, s_m, speed_mps, dead_time_s, first, second, window_m)
     return curvature / steady_state_gain, slope / steady_state_gain

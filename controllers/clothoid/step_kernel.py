@@ -1,63 +1,78 @@
 """The clothoid controller's whole step (Figure 2, `controller.py`) as one compiled call.
 
-Python only unpacks the measurement, calls `clothoid_step`, and fills in what the step asks for and Python alone
-can make: a speed band's lookahead floor (`loop_analysis.py`, python-control) or a km/h's discretised lead filter
-(scipy). The step asks before it changes any state (`NEED_FLOOR`, `NEED_FILTER`; the band or km/h in
-state[S_NEED]), so the caller fills the table and calls again with the same arguments.
+Python only copies the measurement into its record, calls `clothoid_step`, and fills in what the step asks for and
+Python alone can make: a speed band's lookahead floor (`loop_analysis.py`, python-control) or a km/h's discretised
+lead filter (scipy). The step asks before it changes any state (`NEED_FLOOR`, `NEED_FILTER`; the band or km/h in
+the state's `need`), so the caller fills the state's table and calls again with the same arguments.
 
-What the step holds between calls lives in arrays: `state` (the S_* layout), the two path trackers' states
-(`workbench.base.path_search.track`), and the tables it reads (`StepTables`). The order of every floating-point
-operation is the Python step's (commit b614e88), so the two agree to rounding; the replayed traces in
+The step reads the path in its compiled form (`workbench.base.path_search.CompiledPath`), its parameters from one
+named record (PARAMS, made by `parameters`), and keeps what it holds between calls in another (STATE, made by
+`initial_state`: the integrator, the filters, both path trackers' states, the floors and lead filters made so far);
+the tables it reads against speed (limits, lags, lead-filter schedule) are arrays of their own. The order of
+every floating-point operation is the Python step's, so the two agree to rounding; the replayed traces in
 tests/controllers/clothoid/replay hold it to 1e-12.
 """
 
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit
 
 from controllers.clothoid import delay_predictor as dp
 from controllers.clothoid.lead_filter import lead_step
-from controllers.clothoid.lookahead import adaptive_search, evaluate_candidate, evaluated, turn_limited_lookahead
+from controllers.clothoid.lookahead import (
+    MAX_CURVE_POINTS,
+    adaptive_search,
+    evaluate_candidate,
+    evaluated,
+    turn_limited_lookahead,
+)
 from controllers.clothoid.lookahead_filter import filtered_lookahead
 from controllers.clothoid.path_feedforward import lag_inverse_curvature, previewed_curvature, two_degree_of_freedom_rate
 from controllers.clothoid.pose_prediction import along_arc
 from controllers.clothoid.speed_tables import table_row
-from workbench.base.path_search import TRACK_OUT_SIZE, track
+from workbench.base.path_search import TRACK_OUT_SIZE, TRACK_PROGRESS, TRACK_S, TRACK_STATE_SIZE, track
 
 # Option codes (ClothoidConfig's strings).
 MODE_ADAPTIVE, MODE_FIXED, MODE_SPEED = 0, 1, 2
 KAPPA0_YAW_RATE, KAPPA0_COMMAND, KAPPA0_STEERING = 0, 1, 2
 
-# The parameter vector (`params`): the vehicle's geometry, the period and ClothoidConfig's numbers; NaN stands for
-# an option's None.
-(
-    P_WHEELBASE, P_STEERING_RATIO, P_MAX_STEER, P_DT, P_HORIZON, P_KNOWN_DELAY, P_LOOKAHEAD_MODE, P_INITIAL_CURVATURE,
-    P_COURSE, P_EXCESS, P_MIN_LOOKAHEAD, P_MAX_LOOKAHEAD, P_LOOKAHEAD_STEP, P_MIN_PREVIEW, P_FIXED_LOOKAHEAD,
-    P_LOOKAHEAD_GAIN, P_MAX_TURN_RAD, P_FRECHET_THRESHOLD, P_POINT_SPACING, P_TOLERANCE_X, P_TOLERANCE_Y,
-    P_KDOT_MAX, P_FEEDFORWARD, P_FEEDFORWARD_WINDOW, P_FEEDFORWARD_TIME, P_REFERENCE_LEAD, P_HYSTERESIS,
-    P_MAX_GROWTH, P_MAX_SHRINK, P_MIN_SPEED, P_BAND_KMH, P_BAND_HYSTERESIS_KMH, P_PATH_SPACING, P_PATH_LENGTH,
-    P_PATH_EXTENT, P_TRACKER_WINDOW, P_PATH_MAX_SEGMENT, P_WARM_SEARCH, P_DELAY_MODEL, P_FEEDFORWARD_INVERSION,
-    P_LAG_MODEL_REFERENCE,
-) = range(41)  # fmt: skip
-PARAM_COUNT = 41
+#: The step's parameters (`params`, one record, made by `parameters`): the vehicle's geometry (wheelbase m,
+#: steering ratio, steering-wheel limit rad), the period (s) and ClothoidConfig's numbers; NaN stands for an option's
+#: None; lookahead_mode and initial_curvature are the option codes MODE_* and KAPPA0_*, the flags booleans. Its
+#: lookahead_step, tolerance_x, tolerance_y, kdot_max and point_spacing are the adaptive search's settings
+#: (`lookahead.SEARCH_SETTINGS`), so the step hands its parameters to the search as they are.
+PARAMS = np.dtype(
+    [(name, np.float64) for name in (
+        "wheelbase", "steering_ratio", "max_steer", "dt", "horizon", "known_delay", "min_lookahead", "max_lookahead",
+        "lookahead_step", "min_preview", "fixed_lookahead", "lookahead_gain", "max_turn", "frechet_threshold",
+        "point_spacing", "tolerance_x", "tolerance_y", "kdot_max", "feedforward_window", "feedforward_time",
+        "reference_lead", "hysteresis", "max_growth", "max_shrink", "min_speed", "band_kmh", "band_hysteresis_kmh",
+    )]
+    + [(name, np.int64) for name in ("lookahead_mode", "initial_curvature")]
+    + [(name, np.bool_) for name in (
+        "course", "excess", "feedforward", "warm_search", "delay_model", "feedforward_inversion",
+        "lag_model_reference",
+    )]
+)  # fmt: skip
 
-# The step's own state (`state`).
-S_KAPPA_CMD = 0  # the integrator's curvature command (1/m; NaN before the first step)
-S_HELD_BAND = 1  # the speed band whose floor applies (-1 before the first step)
-S_LOOKAHEAD = 2  # the lookahead filter's state: its lookahead and floor (m; NaN before the first step)
-S_FILTER_X = 4  # the lead filter's three states (rad), shared by the filters of every km/h (a bumpless switch)
-S_NEED = 7  # what a NEED_* return asks for: the speed band or the km/h
-S_SEARCHED = 8  # the adaptive search's last choice (m; NaN before the first search): where the next one starts
-S_MODEL = 9  # the delay predictor's model (`delay_predictor.MODEL_SIZE` values; NaN before the first step)
-#: With the lag-inverting feed-forward: its kinematic curvature sent last step (1/m; NaN before the first step);
-#: S_KAPPA_CMD then holds the feedback's integrated curvature alone.
-S_FEEDFORWARD_KAPPA = S_MODEL + dp.MODEL_SIZE
-STATE_SIZE = S_FEEDFORWARD_KAPPA + 1
 
-# `clothoid_step`'s status.
+def parameters(**fields: float | int | bool | None) -> np.ndarray:
+    """The step's parameters as one record (PARAMS, a structured array of one element), every field given by name
+    (None: NaN, an option left out); a field missing or unknown is refused."""
+    missing, unknown = set(PARAMS.names) - set(fields), set(fields) - set(PARAMS.names)
+    if missing or unknown:
+        raise ValueError(f"clothoid step parameters: missing {sorted(missing)}, unknown {sorted(unknown)}")
+    params = np.zeros(1, PARAMS)
+    for name, value in fields.items():
+        params[name] = math.nan if value is None else value
+    return params
+
+
+# `clothoid_step`'s status.# `clothoid_step`'s status.
 STEP_DONE, NEED_FLOOR, NEED_FILTER = 0, 1, 2
 #: km/h rows of the lead-filter table: every whole km/h up to the plausible measurement's top speed (540 km/h).
 FILTER_ROWS = 541
@@ -66,6 +81,50 @@ FLOOR_ROWS = 120
 #: Size of `clothoid_step`'s scratch array: a table row, a projection, then the two lags' rows at this speed.
 LAG_ROWS = 4 + TRACK_OUT_SIZE
 SCRATCH_SIZE = LAG_ROWS + 8
+
+#: What the step holds between calls (`state`, one record, made by `initial_state`): the integrator's curvature
+#: command (1/m; NaN before the first step; with the lag-inverting feed-forward the feedback's alone); the speed
+#: band whose floor applies (-1 before the first step); the lookahead filter's lookahead and floor (m); the lead
+#: filter's three states (rad, shared by the filters of every km/h: a bumpless switch); what a NEED_* return asks
+#: for (the speed band or the km/h); the adaptive search's last choice (m, where the next one starts); the delay
+#: predictor's model (`delay_predictor.MODEL_SIZE`); the lag-inverting feed-forward's curvature sent last step
+#: (1/m); the path trackers' states of the start pose and of the measured position (`path_search.track`); the
+#: floors per speed band (m) and the lead filters per km/h (`DiscreteLeadFilter.coefficients`), NaN where Python
+#: has not made them yet; the search's sampled curves (`lookahead.evaluate_candidate`) and scratch. NaN where
+#: nothing is known yet.
+STATE = np.dtype(
+    [
+        ("kappa_cmd", np.float64),
+        ("held_band", np.int64),
+        ("lookahead", np.float64, (2,)),
+        ("filter_x", np.float64, (3,)),
+        ("need", np.int64),
+        ("searched", np.float64),
+        ("model", np.float64, (dp.MODEL_SIZE,)),
+        ("feedforward_kappa", np.float64),
+        ("tracker", np.float64, (TRACK_STATE_SIZE,)),
+        ("here", np.float64, (TRACK_STATE_SIZE,)),
+        ("floors", np.float64, (FLOOR_ROWS,)),
+        ("filters", np.float64, (FILTER_ROWS, 9)),
+        ("buffers", np.float64, (4, MAX_CURVE_POINTS)),
+        ("scratch", np.float64, (SCRATCH_SIZE,)),
+    ]
+)
+#: The step's measurement (`measurement`, one record): `controllers.base.Measurement`'s fields in its order.
+MEASUREMENT = np.dtype([(name, np.float64) for name in ("t", "x", "y", "vx", "vy", "yaw", "yaw_rate", "steer_wheel")])
+
+
+def initial_state() -> np.ndarray:
+    """The step's state before its first step (STATE, one record): nothing known (NaN), no band held, both path
+    trackers at the path's start (`PathTracker.reset(0.0)`)."""
+    state = np.zeros(1, STATE)
+    for name in STATE.names:
+        if STATE[name].base == np.float64:
+            state[name] = np.nan
+    state["held_band"], state["need"] = -1, 0
+    for tracker in ("tracker", "here"):
+        state[tracker][0, TRACK_S], state[tracker][0, TRACK_PROGRESS] = 0.0, 0.0
+    return state
 
 
 @njit(cache=True)
@@ -79,7 +138,8 @@ def feedforward_timing(
     schedule_speeds: np.ndarray,
     scratch: np.ndarray,
 ) -> tuple[float, float, float]:  # pragma: no cover - compiled
-    """(feed-forward time s, reference lead s, K) at this speed (`ClothoidController.feedforward_timing`): lags
+    """(feed-forward time s, reference lead s, K) at this speed (`ClothoidController.feedforward_timing`;
+    params: PARAMS): lags
     (n, 4: wn, zeta, delay, K; no rows: untuned), measured_lags (the same, or no rows: the path lag's), schedule
     (m, 3: wz, psi, wp; no rows: no lead filter)."""
     speed_kmh = speed_mps * 3.6
@@ -96,22 +156,21 @@ def feedforward_timing(
     if schedule.shape[0] > 0:
         table_row(schedule_speeds, schedule, speed_kmh, True, scratch[:3])
         lead_delay = 3.0 / scratch[2] - 2.0 * scratch[1] / scratch[0]  # LeadFilterParams.group_delay_s
-    ff = params[P_FEEDFORWARD_TIME]
+    p = params[0]
+    ff = p.feedforward_time
     if math.isnan(ff):
         ff = max(0.0, path_delay + lead_delay)
-    ff += params[P_KNOWN_DELAY]
-    ref = params[P_REFERENCE_LEAD]
+    ff += p.known_delay
+    ref = p.reference_lead
     if math.isnan(ref):
-        ref = min(max(path_delay - measured_delay, 0.0), params[P_HORIZON])
+        ref = min(max(path_delay - measured_delay, 0.0), p.horizon)
     return min(ff, 5.0), min(ref, 5.0), gain
 
 
 @njit(cache=True)
 def reference_curvature(
-    path_curvature: np.ndarray,
-    spacing: float,
-    length: float,
-    closed: bool,
+    table: np.ndarray,
+    record: np.ndarray,
     s_m: float,
     speed_mps: float,
     lags: np.ndarray,
@@ -129,41 +188,51 @@ def reference_curvature(
     speed the yaw rate over speed is the path's curvature (rigid-body kinematics), so the reference must equal the
     path's curvature on an arc; the two identified gains differ by their fits' errors (about 1 % on the loaded
     truck), which would leave the feedback holding that error as a steady offset in every arc. Without a measured
-    lag: the path's curvature at s_m. rows: 8 floats of scratch (the two lags' rows at this speed)."""
+    lag: the path's curvature at s_m. The path: `path_search.CompiledPath`'s table and record; rows: 8 floats of
+    scratch (the two lags' rows at this speed)."""
     path_lag, measured_lag = rows[:4], rows[4:8]
     table_row(lag_speeds, lags, speed_mps * 3.6, False, path_lag)
     if measured_lags.shape[0] == 0:
-        return previewed_curvature(path_curvature, spacing, length, closed, s_m, speed_mps, 0.0, 0.0, 0.0, window_m)[0]
+        return previewed_curvature(table, record, s_m, speed_mps, 0.0, 0.0, 0.0, window_m)[0]
     table_row(lag_speeds, measured_lags, speed_mps * 3.6, False, measured_lag)
     a_p, b_p = 2.0 * path_lag[1] / path_lag[0], 1.0 / (path_lag[0] * path_lag[0])
     a_m, b_m = 2.0 * measured_lag[1] / measured_lag[0], 1.0 / (measured_lag[0] * measured_lag[0])
     first = a_p - a_m
     curvature = previewed_curvature(
-        path_curvature, spacing, length, closed, s_m, speed_mps, path_lag[2] - measured_lag[2], first,
-        b_p - b_m - a_m * first, window_m,
-    )[0]  # fmt: skip
+        table, record, s_m, speed_mps, path_lag[2] - measured_lag[2], first, b_p - b_m - a_m * first, window_m
+    )[0]
     return curvature
+
+
+class StepArguments(NamedTuple):
+    """`clothoid_step`'s arguments by name, in its order (a controller builds them once per run and calls
+    `clothoid_step(*arguments)`; the arrays are written in place)."""
+
+    measurement: np.ndarray
+    params: np.ndarray
+    state: np.ndarray
+    path: np.ndarray
+    record: np.ndarray
+    limits: np.ndarray
+    limit_speeds: np.ndarray
+    lags: np.ndarray
+    measured_lags: np.ndarray
+    lag_speeds: np.ndarray
+    schedule: np.ndarray
+    schedule_speeds: np.ndarray
+    scores: np.ndarray
+    results: np.ndarray
+    diagnostics: np.ndarray
+    history: np.ndarray
 
 
 @njit(cache=True)
 def clothoid_step(
-    t_s: float,
-    x_m: float,
-    y_m: float,
-    vx_mps: float,
-    vy_mps: float,
-    yaw_rad: float,
-    yaw_rate_rad_s: float,
-    steer_wheel_rad: float,
+    measurement: np.ndarray,
     params: np.ndarray,
     state: np.ndarray,
-    path_x: np.ndarray,
-    path_y: np.ndarray,
-    path_heading: np.ndarray,
-    path_curvature: np.ndarray,
-    closed: bool,
-    tracker: np.ndarray,
-    here: np.ndarray,
+    path: np.ndarray,
+    record: np.ndarray,
     limits: np.ndarray,
     limit_speeds: np.ndarray,
     lags: np.ndarray,
@@ -171,24 +240,22 @@ def clothoid_step(
     lag_speeds: np.ndarray,
     schedule: np.ndarray,
     schedule_speeds: np.ndarray,
-    floors: np.ndarray,
-    filters: np.ndarray,
-    buffers: np.ndarray,
     scores: np.ndarray,
     results: np.ndarray,
-    scratch: np.ndarray,
     diagnostics: np.ndarray,
     history: np.ndarray,
 ) -> tuple[float, int]:  # pragma: no cover - compiled
-    """(steering-wheel command rad, status) of one step (`controller.py` documents what it does); diagnostics (16)
-    in the order of controller.DIAGNOSTIC_KEYS. tracker, here: the states of the start pose's and the measured
-    position's path trackers; floors (FLOOR_ROWS) and filters (FILTER_ROWS, 9: `DiscreteLeadFilter.coefficients`)
-    NaN where not made yet; buffers, scores, results: the search's work arrays (`lookahead.py`); scratch:
-    SCRATCH_SIZE floats; history: the delay predictor's commands sent (`delay_predictor.history_length` slots; any
-    size without it)."""
-    p = params
+    """(steering-wheel command rad, status) of one step (`controller.py` documents what it does) of the measurement
+    (MEASUREMENT), with the parameters (PARAMS) and the state (STATE, advanced) on the compiled path
+    (`path_search.CompiledPath`'s table and record); diagnostics (16) in the order of controller.DIAGNOSTIC_KEYS.
+    scores, results: the search's work arrays (`lookahead.py`); history: the delay predictor's commands sent
+    (`delay_predictor.history_length` slots; any size without it)."""
+    m, p, st = measurement[0], params[0], state[0]
+    t_s, x_m, y_m, vx_mps, vy_mps = m.t, m.x, m.y, m.vx, m.vy
+    yaw_rad, yaw_rate_rad_s, steer_wheel_rad = m.yaw, m.yaw_rate, m.steer_wheel
+    floors, filters, buffers, scratch = st.floors, st.filters, st.buffers, st.scratch
     speed = math.hypot(vx_mps, vy_mps)  # Measurement.speed_mps
-    spacing, length = p[P_PATH_SPACING], p[P_PATH_LENGTH]
+    spacing = record[0].spacing
     filtered = schedule.shape[0] > 0
 
     # What the step needs that Python makes, asked before any state changes.
@@ -196,44 +263,44 @@ def clothoid_step(
     if filtered:
         kmh = round(speed * 3.6) if schedule.shape[0] > 1 else 0
         if math.isnan(filters[kmh, 0]):
-            state[S_NEED] = kmh
+            st.need = kmh
             return 0.0, NEED_FILTER
-    x_band = speed * 3.6 / p[P_BAND_KMH]
-    band, held = max(1, round(x_band)), int(state[S_HELD_BAND])
-    if held >= 0 and band < held and x_band > held - 0.5 - p[P_BAND_HYSTERESIS_KMH] / p[P_BAND_KMH]:
+    x_band = speed * 3.6 / p.band_kmh
+    band, held = max(1, round(x_band)), int(st.held_band)
+    if held >= 0 and band < held and x_band > held - 0.5 - p.band_hysteresis_kmh / p.band_kmh:
         band = held
     if math.isnan(floors[band]):
-        state[S_NEED] = band
+        st.need = band
         return 0.0, NEED_FLOOR
 
-    wheelbase, ratio = p[P_WHEELBASE], p[P_STEERING_RATIO]
+    wheelbase, ratio = p.wheelbase, p.steering_ratio
     steering_kappa = math.tan(steer_wheel_rad / ratio) / wheelbase
-    inverting = p[P_FEEDFORWARD] != 0.0 and p[P_FEEDFORWARD_INVERSION] != 0.0
-    first = math.isnan(state[S_KAPPA_CMD])
+    inverting = p.feedforward and p.feedforward_inversion
+    first = math.isnan(st.kappa_cmd)
     if first:  # first step: continue from the vehicle's current steering
-        state[S_KAPPA_CMD] = steering_kappa
-        state[S_FILTER_X] = state[S_FILTER_X + 1] = state[S_FILTER_X + 2] = steer_wheel_rad
+        st.kappa_cmd = steering_kappa
+        st.filter_x[:] = steer_wheel_rad
     table_row(limit_speeds, limits, speed * 3.6, False, scratch[:2])
     kappa_max, rate_max = scratch[0], scratch[1]
-    mode0 = int(p[P_INITIAL_CURVATURE])
-    if mode0 == KAPPA0_YAW_RATE and speed > p[P_MIN_SPEED]:
+    mode0 = int(p.initial_curvature)
+    if mode0 == KAPPA0_YAW_RATE and speed > p.min_speed:
         kappa0 = yaw_rate_rad_s / speed
     elif mode0 == KAPPA0_STEERING:
         kappa0 = steering_kappa
     else:
-        kappa0 = state[S_KAPPA_CMD]
-        if inverting and not math.isnan(state[S_FEEDFORWARD_KAPPA]):  # the curvature sent: feedback + feed-forward
-            kappa0 += state[S_FEEDFORWARD_KAPPA]
+        kappa0 = st.kappa_cmd
+        if inverting and not math.isnan(st.feedforward_kappa):  # the curvature sent: feedback + feed-forward
+            kappa0 += st.feedforward_kappa
     kappa0 = min(max(kappa0, -kappa_max), kappa_max)
 
     # Sections 2 and 3: the start pose, the lookahead, then the hyper-clothoid to the target (Eq. 3).
     heading = yaw_rad
-    if p[P_COURSE] != 0.0 and vx_mps > p[P_MIN_SPEED]:
+    if p.course and vx_mps > p.min_speed:
         heading += math.atan2(vy_mps, vx_mps)
     px, py, ph = x_m, y_m, heading
-    horizon = p[P_HORIZON]
-    model = state[S_MODEL : S_MODEL + dp.MODEL_SIZE]
-    predicting = p[P_DELAY_MODEL] != 0.0
+    horizon = p.horizon
+    model = st.model
+    predicting = p.delay_model
     if predicting:  # over the known delay with the identified lags and the commands sent (`delay_predictor.py`)
         path_lag, measured_lag = scratch[LAG_ROWS : LAG_ROWS + 4], scratch[LAG_ROWS + 4 : LAG_ROWS + 8]
         table_row(lag_speeds, lags, speed * 3.6, False, path_lag)
@@ -241,83 +308,71 @@ def clothoid_step(
             table_row(lag_speeds, measured_lags, speed * 3.6, False, measured_lag)
         else:
             measured_lag[:] = path_lag
-        delay = p[P_KNOWN_DELAY]
-        dp.record_and_advance(model, history, t_s, p[P_DT], path_lag, measured_lag, delay, steering_kappa)
+        delay = p.known_delay
+        dp.record_and_advance(model, history, t_s, p.dt, path_lag, measured_lag, delay, steering_kappa)
         px, py, ph, kappa0 = dp.predicted_start(
-            model, history, x_m, y_m, heading, kappa0, speed, p[P_DT], path_lag, measured_lag, delay
+            model, history, x_m, y_m, heading, kappa0, speed, p.dt, path_lag, measured_lag, delay
         )
         kappa0 = min(max(kappa0, -kappa_max), kappa_max)
         horizon -= delay
     if horizon > 0.0:
         px, py, ph = along_arc(px, py, ph, kappa0, speed * horizon)
     foot = scratch[4 : 4 + TRACK_OUT_SIZE]
-    track(
-        path_x, path_y, path_heading, path_curvature, spacing, length, closed, p[P_PATH_EXTENT],
-        p[P_TRACKER_WINDOW], tracker, px, py, foot,
-    )  # fmt: skip
+    track(path, record, st.tracker, px, py, foot)
     foot_index, cte = foot[0] / spacing, foot[6]
-    max_segment = p[P_PATH_MAX_SEGMENT]
 
-    state[S_HELD_BAND] = band
-    floor = max(floors[band], p[P_MIN_LOOKAHEAD], p[P_MIN_PREVIEW] * speed)
-    top = max(p[P_MAX_LOOKAHEAD], floor)
-    mode = int(p[P_LOOKAHEAD_MODE])
+    st.held_band = band
+    floor = max(floors[band], p.min_lookahead, p.min_preview * speed)
+    top = max(p.max_lookahead, floor)
+    mode = int(p.lookahead_mode)
     evaluations, reused = 0, -1
     if mode == MODE_FIXED:
-        lookahead = searched = p[P_FIXED_LOOKAHEAD]
+        lookahead = searched = p.fixed_lookahead
     else:
-        if p[P_MAX_TURN_RAD] > 0.0:  # the geometric ceiling (ClothoidConfig.max_target_turn_deg)
-            ceiling = turn_limited_lookahead(
-                path_x, path_y, path_heading, closed, foot_index, px, py, p[P_MAX_TURN_RAD], top, max_segment
-            )
+        if p.max_turn > 0.0:  # the geometric ceiling (ClothoidConfig.max_target_turn_deg)
+            ceiling = turn_limited_lookahead(path, record, foot_index, px, py, p.max_turn, top)
             top = max(floor, ceiling)
         if mode == MODE_SPEED:
-            lookahead = searched = min(max(p[P_LOOKAHEAD_GAIN] * speed, floor), top)
+            lookahead = searched = min(max(p.lookahead_gain * speed, floor), top)
         else:
-            threshold = p[P_FRECHET_THRESHOLD] + (abs(cte) if p[P_EXCESS] != 0.0 else 0.0)
+            threshold = p.frechet_threshold + (abs(cte) if p.excess else 0.0)
             searched, evaluations = adaptive_search(
-                path_x, path_y, closed, foot_index, px, py, ph, kappa0, floor, top, p[P_LOOKAHEAD_STEP], threshold,
-                p[P_TOLERANCE_X], p[P_TOLERANCE_Y], p[P_KDOT_MAX], p[P_POINT_SPACING], buffers, scores, results,
-                max_segment, state[S_SEARCHED] if p[P_WARM_SEARCH] != 0.0 else np.nan,
+                path, record, params, foot_index, px, py, ph, kappa0, floor, top, threshold,
+                st.searched if p.warm_search else np.nan, buffers, scores, results,
             )  # fmt: skip
-            state[S_SEARCHED] = searched
+            st.searched = searched
             lookahead = filtered_lookahead(
-                state[S_LOOKAHEAD : S_LOOKAHEAD + 2], searched, floor, top, speed * p[P_DT], p[P_HYSTERESIS],
-                p[P_MAX_GROWTH], p[P_MAX_SHRINK],
-            )  # fmt: skip
-            reused = evaluated(scores, results, floor, p[P_LOOKAHEAD_STEP], lookahead)
+                st.lookahead, searched, floor, top, speed * p.dt, p.hysteresis, p.max_growth, p.max_shrink
+            )
+            reused = evaluated(scores, results, floor, p.lookahead_step, lookahead)
     if reused >= 0:  # the search evaluated this very lookahead: the same fit again
         row = results[reused]
         frechet, kdot, clothoid_length, tx, ty, ex, ey = row[0], row[1], row[2], row[3], row[4], row[5], row[6]
         status = int(row[7])
     else:
         frechet, kdot, clothoid_length, tx, ty, ex, ey, status = evaluate_candidate(
-            path_x, path_y, closed, foot_index, px, py, ph, kappa0, lookahead, p[P_KDOT_MAX], p[P_POINT_SPACING],
-            buffers, max_segment, np.inf,
-        )  # fmt: skip
+            path, record, foot_index, px, py, ph, kappa0, lookahead, p.kdot_max, p.point_spacing, buffers, np.inf
+        )
     clothoid_kdot = reference_kdot = feedforward_kdot = kdot
     feedforward_kappa = 0.0
-    if p[P_FEEDFORWARD] != 0.0:  # path_feedforward.py: feedback relative to the path's own clothoid, plus its rate
-        track(
-            path_x, path_y, path_heading, path_curvature, spacing, length, closed, p[P_PATH_EXTENT],
-            p[P_TRACKER_WINDOW], here, x_m, y_m, foot,
-        )  # fmt: skip
+    if p.feedforward:  # path_feedforward.py: feedback relative to the path's own clothoid, plus its rate
+        track(path, record, st.here, x_m, y_m, foot)
         ff_time, reference_lead, gain = feedforward_timing(
-            speed, p, lags, measured_lags, lag_speeds, schedule, schedule_speeds, scratch[:4]
+            speed, params, lags, measured_lags, lag_speeds, schedule, schedule_speeds, scratch[:4]
         )
-        if inverting and p[P_LAG_MODEL_REFERENCE] != 0.0 and lags.shape[0] > 0:
+        if inverting and p.lag_model_reference and lags.shape[0] > 0:
             reference_kappa = reference_curvature(
-                path_curvature, spacing, length, closed, foot[0] + speed * (p[P_HORIZON] - horizon), speed, lags,
-                measured_lags, lag_speeds, p[P_FEEDFORWARD_WINDOW], scratch[LAG_ROWS : LAG_ROWS + 8],
+                path, record, foot[0] + speed * (p.horizon - horizon), speed, lags, measured_lags, lag_speeds,
+                p.feedforward_window, scratch[LAG_ROWS : LAG_ROWS + 8],
             )  # fmt: skip
             kdot, reference_kdot, feedforward_kdot = two_degree_of_freedom_rate(
-                kdot, path_x, path_y, path_heading, path_curvature, spacing, length, closed, foot, tx, ty, speed,
-                horizon, ff_time, 0.0, gain, p[P_FEEDFORWARD_WINDOW], p[P_HORIZON] - horizon, reference_kappa,
+                kdot, path, record, foot, tx, ty, speed,
+                horizon, ff_time, 0.0, gain, p.feedforward_window, p.horizon - horizon, reference_kappa,
             )  # fmt: skip
         else:
             kdot, reference_kdot, feedforward_kdot = two_degree_of_freedom_rate(
-                kdot, path_x, path_y, path_heading, path_curvature, spacing, length, closed, foot, tx, ty, speed,
-                horizon, ff_time, reference_lead, gain, p[P_FEEDFORWARD_WINDOW], p[P_HORIZON] - horizon,
+                kdot, path, record, foot, tx, ty, speed,
+                horizon, ff_time, reference_lead, gain, p.feedforward_window, p.horizon - horizon,
             )  # fmt: skip
         if inverting:  # the lag inverted, added after the lead filter; the integrator holds the feedback alone
             kdot = clothoid_kdot - reference_kdot
@@ -326,37 +381,36 @@ def clothoid_step(
                 table_row(lag_speeds, lags, speed * 3.6, False, scratch[:4])
                 omega_n, zeta, dead_time, gain = scratch[0], scratch[1], scratch[2], scratch[3]
             feedforward_kappa, feedforward_kdot = lag_inverse_curvature(
-                path_curvature, spacing, length, closed, foot[0], speed, dead_time + p[P_KNOWN_DELAY], omega_n, zeta,
-                gain, p[P_FEEDFORWARD_WINDOW],
-            )  # fmt: skip
+                path, record, foot[0], speed, dead_time + p.known_delay, omega_n, zeta, gain, p.feedforward_window
+            )
             feedforward_kappa = min(max(feedforward_kappa, -kappa_max), kappa_max)
-            state[S_FEEDFORWARD_KAPPA] = feedforward_kappa
+            st.feedforward_kappa = feedforward_kappa
             if first:  # the feedback's share of the steering now (bumpless)
-                state[S_KAPPA_CMD] = steering_kappa - feedforward_kappa
-                steer_feedback = math.atan(wheelbase * state[S_KAPPA_CMD]) * ratio
-                state[S_FILTER_X] = state[S_FILTER_X + 1] = state[S_FILTER_X + 2] = steer_feedback
+                st.kappa_cmd = steering_kappa - feedforward_kappa
+                steer_feedback = math.atan(wheelbase * st.kappa_cmd) * ratio
+                st.filter_x[:] = steer_feedback
 
     # Figure 2: kappa' x V integrated to curvature, under the rate and curvature limits (section 4).
     rate = min(max(kdot * speed, -rate_max), rate_max)
     if inverting:  # the feedback integrated within what the feed-forward leaves of the curvature limit
-        kappa_fb = state[S_KAPPA_CMD] + rate * p[P_DT]
+        kappa_fb = st.kappa_cmd + rate * p.dt
         kappa_fb = min(max(kappa_fb, -kappa_max - feedforward_kappa), kappa_max - feedforward_kappa)
-        state[S_KAPPA_CMD] = kappa_fb
+        st.kappa_cmd = kappa_fb
         kappa_cmd = kappa_fb + feedforward_kappa
         steer_feedback = math.atan(wheelbase * kappa_fb) * ratio
         steer = math.atan(wheelbase * kappa_cmd) * ratio
         command = steer
         if filtered:  # Eq. 6 on the feedback's steering; the feed-forward's share added after it
-            command = lead_step(filters[kmh], state[S_FILTER_X : S_FILTER_X + 3], steer_feedback)
+            command = lead_step(filters[kmh], st.filter_x, steer_feedback)
             command += steer - steer_feedback
     else:
-        kappa_cmd = min(max(state[S_KAPPA_CMD] + rate * p[P_DT], -kappa_max), kappa_max)
-        state[S_KAPPA_CMD] = kappa_cmd
+        kappa_cmd = min(max(st.kappa_cmd + rate * p.dt, -kappa_max), kappa_max)
+        st.kappa_cmd = kappa_cmd
         steer = math.atan(wheelbase * kappa_cmd) * ratio  # Ackermann: tan(phi) = L kappa
         command = steer
         if filtered:  # Eq. 6: this km/h's filter, on the state the last one left (the same lag-chain signals)
-            command = lead_step(filters[kmh], state[S_FILTER_X : S_FILTER_X + 3], steer)
-    limit = p[P_MAX_STEER]
+            command = lead_step(filters[kmh], st.filter_x, steer)
+    limit = p.max_steer
     command = min(max(command, -limit), limit)
     if predicting:
         dp.send(model, history, math.tan(command / ratio) / wheelbase)

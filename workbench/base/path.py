@@ -26,6 +26,7 @@ from workbench.base.path_search import (
     TRACK_PROGRESS,
     TRACK_S,
     TRACK_STATE_SIZE,
+    CompiledPath,
     closest_in_window,
     first_beyond,
     slope_at,
@@ -34,6 +35,8 @@ from workbench.base.path_search import (
 )
 from workbench.base.waypoints import Waypoints
 
+#: The least window a path tracker searches each way about its last foot point (m).
+DEFAULT_TRACKER_WINDOW_M = 5.0
 #: Default spacing of the path's samples along s (m). Linear interpolation between samples is then exact to
 #: kappa * h^2 / 8, i.e. 0.06 mm at a 20 m radius.
 DEFAULT_SAMPLE_SPACING_M = 0.1
@@ -176,6 +179,7 @@ class ReferencePath:
         self.length_m = float(self.s_m[-1])
         #: The longest chord between neighbouring samples (m): what `first_beyond` may skip by.
         self.max_segment_m = float(np.hypot(np.diff(self.x_m), np.diff(self.y_m)).max()) if self.x_m.size > 1 else 0.0
+        self._compiled: dict[float, CompiledPath] = {}
         for label, arr in (("heading", self.heading_rad), ("curvature", self.curvature_1pm)):
             if arr.shape != self.x_m.shape:
                 raise WorkbenchInputError(f"{name}: {label} has {arr.size} samples, positions have {self.x_m.size}")
@@ -365,6 +369,18 @@ class ReferencePath:
         j, t, _ = closest_in_window(self.x_m, self.y_m, float(x_m), float(y_m), 0, self.x_m.size - 2, False)
         return float((j + t) * self.spacing_m)
 
+    def compiled(self, min_window_m: float = DEFAULT_TRACKER_WINDOW_M) -> CompiledPath:
+        """The path as the compiled kernels read it (`path_search.CompiledPath`), its trackers searching at least
+        min_window_m each way; made once per window and kept."""
+        compiled = self._compiled.get(min_window_m)
+        if compiled is None:
+            samples = (self.x_m, self.y_m, self.heading_rad, self.curvature_1pm, self.speed_mps)
+            compiled = CompiledPath.of(
+                samples, self.spacing_m, self.length_m, self.closed, self.max_segment_m, float(min_window_m)
+            )
+            self._compiled[min_window_m] = compiled
+        return compiled
+
     def tracker(self, initial_s_m: float | None = None) -> PathTracker:
         """A progress-following projector; starts at initial_s_m or, if None, at the global closest point."""
         return PathTracker(self, initial_s_m)
@@ -383,11 +399,13 @@ class PathTracker:
     distance to the path falls continuously toward it.
     """
 
-    def __init__(self, path: ReferencePath, initial_s_m: float | None = None, min_window_m: float = 5.0) -> None:
+    def __init__(
+        self, path: ReferencePath, initial_s_m: float | None = None, min_window_m: float = DEFAULT_TRACKER_WINDOW_M
+    ) -> None:
         self.path = path
         self.min_window_m = float(min_window_m)
-        #: The diagonal of the path's bounding box (m): a move longer than this can land anywhere on the path.
-        self._extent_m = float(math.hypot(np.ptp(path.x_m), np.ptp(path.y_m)))
+        #: The path as the compiled update reads it, with this tracker's window.
+        self.compiled = path.compiled(self.min_window_m)
         #: The compiled update's state (`path_search.track`) and its output row.
         self.state = np.empty(TRACK_STATE_SIZE)
         self.out = np.empty(TRACK_OUT_SIZE)
@@ -403,7 +421,7 @@ class PathTracker:
     @property
     def extent_m(self) -> float:
         """The diagonal of the path's bounding box (m): a move longer than this searches the whole path."""
-        return self._extent_m
+        return self.compiled.extent_m
 
     @property
     def progress_m(self) -> float:
@@ -422,8 +440,5 @@ class PathTracker:
     def advance(self, x_m: float, y_m: float) -> None:
         """`update` without the checks and the Projection, for a hot loop: the projection is left in `out`
         (`path_search.TRACK_OUT_SIZE` values in Projection's order, at_end as 1.0 / 0.0)."""
-        path = self.path
-        track(
-            path.x_m, path.y_m, path.heading_rad, path.curvature_1pm, path.spacing_m, path.length_m, path.closed,
-            self._extent_m, self.min_window_m, self.state, x_m, y_m, self.out,
-        )  # fmt: skip
+        compiled = self.compiled
+        track(compiled.table, compiled.record, self.state, x_m, y_m, self.out)

@@ -8,9 +8,68 @@ overhead. Indices of a closed loop's segments wrap modulo the segment count.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 from numba import njit
+
+#: Rows of a compiled path's table (`CompiledPath.table`, shape (PATH_ROWS, n)): the samples' x, y (m), heading
+#: (rad, unwrapped), curvature (1/m) and planned speed (m/s; NaN when the path carries none).
+PATH_X, PATH_Y, PATH_HEADING, PATH_CURVATURE, PATH_SPEED = range(5)
+PATH_ROWS = 5
+#: A compiled path's scalars (`CompiledPath.record`, one record): the sample spacing (m), the length (m), whether it
+#: is a closed loop, its bounding box's diagonal (m: a move longer than this searches the whole path), the least
+#: window a tracker searches each way (m) and the longest chord between neighbouring samples (m, `first_beyond`).
+PATH_RECORD = np.dtype(
+    [(name, np.float64) for name in ("spacing", "length")]
+    + [("closed", np.bool_)]
+    + [(name, np.float64) for name in ("extent", "window", "max_segment")]
+)
+
+
+@dataclass(frozen=True, eq=False)
+class CompiledPath:
+    """A path as the compiled kernels read it: its samples as one table (rows PATH_*) and its scalars as one
+    record (PATH_RECORD, a structured array of one element), handed together to every kernel that walks the path.
+    Made by `ReferencePath.compiled`."""
+
+    table: np.ndarray
+    record: np.ndarray
+
+    @classmethod
+    def of(
+        cls,
+        samples: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray | None],
+        spacing_m: float,
+        length_m: float,
+        closed: bool,
+        max_segment_m: float,
+        min_window_m: float,
+    ) -> CompiledPath:
+        """The compiled form of samples (x, y, heading, curvature, speed or None) spaced spacing_m apart over
+        length_m."""
+        x, y, heading, curvature, speed = samples
+        table = np.empty((PATH_ROWS, x.size))
+        table[PATH_X], table[PATH_Y], table[PATH_HEADING], table[PATH_CURVATURE] = x, y, heading, curvature
+        table[PATH_SPEED] = np.nan if speed is None else speed
+        record = np.zeros(1, PATH_RECORD)
+        record["spacing"] = spacing_m
+        record["length"] = length_m
+        record["closed"] = closed
+        record["extent"] = float(math.hypot(np.ptp(x), np.ptp(y)))
+        record["window"] = min_window_m
+        record["max_segment"] = max_segment_m
+        return cls(table, record)
+
+    @property
+    def extent_m(self) -> float:
+        """The diagonal of the path's bounding box (m)."""
+        return float(self.record[0]["extent"])
+
+    @property
+    def min_window_m(self) -> float:
+        """The least window a tracker searches each way (m)."""
+        return float(self.record[0]["window"])
 
 
 @njit(cache=True)
@@ -117,24 +176,17 @@ TRACK_OUT_SIZE = 10
 
 @njit(cache=True)
 def track(
-    x: np.ndarray,
-    y: np.ndarray,
-    heading: np.ndarray,
-    curvature: np.ndarray,
-    spacing: float,
-    length: float,
-    closed: bool,
-    extent: float,
-    min_window: float,
-    state: np.ndarray,
-    px: float,
-    py: float,
-    out: np.ndarray,
+    table: np.ndarray, record: np.ndarray, state: np.ndarray, px: float, py: float, out: np.ndarray
 ) -> None:  # pragma: no cover - compiled
-    """One `path.PathTracker.update` of the finite position (px, py): the foot point searched in a window about the
-    last (sized by how far the position moved, at least min_window each way; over the whole path on the first
-    update or after a jump longer than `extent`, the path's bounding-box diagonal), the progress advanced (the
-    shortest way round a loop's seam) in `state`, and the projection written to `out` (TRACK_OUT_SIZE)."""
+    """One `path.PathTracker.update` of the finite position (px, py) on the compiled path (`CompiledPath`'s table
+    and record): the foot point searched in a window about the last (sized by how far the position moved, at
+    least the record's window each way; over the whole path on the first update or after a jump longer than the
+    record's extent, the path's bounding-box diagonal), the progress advanced (the shortest way round a loop's
+    seam) in `state`, and the projection written to `out` (TRACK_OUT_SIZE)."""
+    x, y, heading, curvature = table[PATH_X], table[PATH_Y], table[PATH_HEADING], table[PATH_CURVATURE]
+    shape = record[0]
+    spacing, length, closed = shape.spacing, shape.length, shape.closed
+    extent, min_window = shape.extent, shape.window
     n_seg = x.size - 1
     s_old = state[TRACK_S]
     moved = 0.0
@@ -180,15 +232,8 @@ def track(
 
 @njit(cache=True)
 def track_sequence(
-    x: np.ndarray,
-    y: np.ndarray,
-    heading: np.ndarray,
-    curvature: np.ndarray,
-    spacing: float,
-    length: float,
-    closed: bool,
-    extent: float,
-    min_window: float,
+    table: np.ndarray,
+    record: np.ndarray,
     state: np.ndarray,
     px: np.ndarray,
     py: np.ndarray,
@@ -199,7 +244,7 @@ def track_sequence(
     point's arc length and signed CTE to s_out and cte_out: one call for a whole trace instead of one per step."""
     out = np.empty(TRACK_OUT_SIZE)
     for k in range(px.size):
-        track(x, y, heading, curvature, spacing, length, closed, extent, min_window, state, px[k], py[k], out)
+        track(table, record, state, px[k], py[k], out)
         s_out[k] = out[0]
         cte_out[k] = out[6]
 

@@ -46,8 +46,8 @@ from workbench.simulation.step_kernel import (
     PROJECTED_OFF_PATH,
     PROJECTED_PAST_END,
     SIGNALS,
+    compiled_path,
     finish_step,
-    path_table,
     project_pose,
     run_settings,
 )
@@ -200,7 +200,7 @@ class Simulation:
         seen = not conditions.is_ideal
         speed_gains = PISpeedGains()
         settings = run_settings(  # the kernels' constants and the PI speed controller's state
-            tracker, cfg.max_past_end_m, cfg.max_abs_cte_m, total_length, dt, cfg.speed_feedforward, speed_gains
+            cfg.max_past_end_m, cfg.max_abs_cte_m, total_length, dt, cfg.speed_feedforward, speed_gains
         )
 
         log = _TraceLog(vehicle.output_names, controller.diagnostic_names, max_steps, seen)
@@ -215,7 +215,8 @@ class Simulation:
         # from one table and writes the tracker's arrays and the trace's table in place.
         outputs, advance, step_controller = vehicle.outputs, vehicle.advance, controller.step
         clock, hypot, isfinite, measured = time.perf_counter, math.hypot, math.isfinite, _MEASURED
-        samples, track_state, foot = path_table(path), tracker.state, tracker.out
+        compiled, track_state, foot = compiled_path(tracker), tracker.state, tracker.out
+        samples, shape = compiled.table, compiled.record
         substeps = cfg.substeps
         table = log.table
         t = 0.0
@@ -224,7 +225,7 @@ class Simulation:
             x, y, yaw, vx, vy, yaw_rate, steer_wheel = measured(out)
             if step == 0 and actuator is not None:
                 actuator.reset(float(steer_wheel))
-            where = project_pose(x, y, samples, track_state, foot, settings)
+            where = project_pose(x, y, samples, shape, track_state, foot, settings)
             if where == PROJECTED_NOT_FINITE:
                 raise WorkbenchInputError(f"position must be finite to project onto {path.name}; got ({x}, {y})")
             if road_varies:  # the foot point's arc length on the path, within a lap on a closed one
@@ -258,7 +259,7 @@ class Simulation:
             # corner is on time; without it a PI lags a braking ramp by ~0.76 x the deceleration in m/s), the PI
             # speed command and the trace's row.
             accel_cmd = finish_step(
-                table, step, t, out, steer_cmd, speed, step_time, diagnostics, foot, samples, settings
+                table, step, t, out, steer_cmd, speed, step_time, diagnostics, foot, samples, shape, settings
             )
             if accel_cmd != accel_cmd:  # NaN: the speed, its reference or the reference's rate is not finite
                 s_m = float(foot[FOOT_S])

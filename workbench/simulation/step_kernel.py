@@ -9,9 +9,9 @@ and the trace's row written into the preallocated table: the time, the plant's o
 (SIGNALS) and the controller's diagnostics. Each computes what the Python loop computed, in the same order, so
 a run's trace is the same bit for bit.
 
-A compiled call costs about 0.1 us per array and 0.04 us per number it is handed, so the kernels take the path's
-samples as one table (`path_table`) and the run's constants with the speed controller's state as one array
-(`run_settings`).
+A compiled call costs about 0.1 us per array and 0.04 us per number it is handed, so the kernels take the path in
+its compiled form (`path_search.CompiledPath`: the samples as one table, the scalars as one record, `compiled_path`)
+and the run's constants with the speed controller's state as one array (`run_settings`).
 
 What stays in Python: the speed over ground (`math.hypot`, whose rounding differs from the C library's that numba
 calls in about one case in 500), the measurement and the controller, the conditions' models, and the messages of
@@ -30,8 +30,8 @@ import numpy as np
 from numba import njit
 
 from workbench.base.errors import WorkbenchInputError
-from workbench.base.path import PathTracker, ReferencePath
-from workbench.base.path_search import slope_at, track, value_at
+from workbench.base.path import PathTracker
+from workbench.base.path_search import PATH_SPEED, CompiledPath, slope_at, track, value_at
 from workbench.simulation.speed_control import PI_STATE_SIZE, PISpeedGains, pi_speed_step, pi_state
 
 #: Indices into a tracker's output (`path_search.track`, `PathTracker.out`): the foot point's arc length (m),
@@ -70,39 +70,31 @@ SIGNALS = (
 )
 N_SIGNALS = len(SIGNALS)
 
-#: Rows of `path_table`: the path's samples of x, y (m), heading (rad), curvature (1/m) and planned speed (m/s).
-PATH_X, PATH_Y, PATH_HEADING, PATH_CURVATURE, PATH_SPEED = range(5)
-
-#: Layout of `run_settings`: the path's sample spacing and length (m) and whether it is closed (1.0 / 0.0); the
-#: tracker's jump distance and least search window each way (m); the limits that end a run: how far past an end
-#: of an open path, how far from the path (m), and the distance to cover (m, the laps of a closed path); the
-#: controller's step (s) and whether the planned speed's rate is fed forward (1.0 / 0.0); then the PI speed
-#: controller's state (`speed_control.pi_state`, PI_STATE_SIZE values from SET_PI).
+#: Layout of `run_settings`: the limits that end a run: how far past an end of an open path, how far from the path
+#: (m), and the distance to cover (m, the laps of a closed path); the controller's step (s) and whether the planned
+#: speed's rate is fed forward (1.0 / 0.0); then the PI speed controller's state (`speed_control.pi_state`,
+#: PI_STATE_SIZE values from SET_PI).
 (
-    SET_SPACING,
-    SET_LENGTH,
-    SET_CLOSED,
-    SET_EXTENT,
-    SET_WINDOW,
     SET_MAX_PAST_END,
     SET_MAX_DISTANCE,
     SET_TOTAL_LENGTH,
     SET_DT,
     SET_FEEDFORWARD,
     SET_PI,
-) = range(11)
+) = range(6)
 SETTINGS_SIZE = SET_PI + PI_STATE_SIZE
 
 
-def path_table(path: ReferencePath) -> np.ndarray:
-    """The path's samples as one (5, n) table, rows PATH_* (a copy); the path must carry a planned speed."""
+def compiled_path(tracker: PathTracker) -> CompiledPath:
+    """The compiled form of the tracker's path with its window (`ReferencePath.compiled`: the samples as one
+    table, rows `path_search.PATH_*`, the scalars as one record); the path must carry a planned speed."""
+    path = tracker.path
     if path.speed_mps is None:
         raise WorkbenchInputError(f"{path.name}: the path carries no planned speed (`plan_path_speed`)")
-    return np.stack((path.x_m, path.y_m, path.heading_rad, path.curvature_1pm, path.speed_mps))
+    return tracker.compiled
 
 
 def run_settings(
-    tracker: PathTracker,
     max_past_end_m: float,
     max_abs_cte_m: float,
     total_length_m: float,
@@ -110,12 +102,8 @@ def run_settings(
     speed_feedforward: bool,
     speed_gains: PISpeedGains,
 ) -> np.ndarray:
-    """The settings array (layout SET_*) of a run on the tracker's path, its speed controller's integrator at 0."""
-    path = tracker.path
+    """The settings array (layout SET_*) of a run, its speed controller's integrator at 0."""
     settings = np.empty(SETTINGS_SIZE)
-    settings[SET_SPACING], settings[SET_LENGTH] = path.spacing_m, path.length_m
-    settings[SET_CLOSED] = 1.0 if path.closed else 0.0
-    settings[SET_EXTENT], settings[SET_WINDOW] = tracker.extent_m, tracker.min_window_m
     settings[SET_MAX_PAST_END], settings[SET_MAX_DISTANCE] = max_past_end_m, max_abs_cte_m
     settings[SET_TOTAL_LENGTH], settings[SET_DT] = total_length_m, dt_s
     settings[SET_FEEDFORWARD] = 1.0 if speed_feedforward else 0.0
@@ -128,19 +116,22 @@ _TWO_PI = 2.0 * math.pi
 
 @njit(cache=True)
 def project_pose(
-    px: float, py: float, path: np.ndarray, tracker_state: np.ndarray, foot: np.ndarray, settings: np.ndarray
+    px: float,
+    py: float,
+    path: np.ndarray,
+    record: np.ndarray,
+    tracker_state: np.ndarray,
+    foot: np.ndarray,
+    settings: np.ndarray,
 ) -> int:  # pragma: no cover - compiled
-    """`PathTracker.update` of the position (px, py) on the `path_table` into `tracker_state` and `foot` (the
-    tracker's `state` and `out`), then the simulator's checks in its order: past an end by more than
-    SET_MAX_PAST_END, further than SET_MAX_DISTANCE, at the end of an open path or SET_TOTAL_LENGTH travelled. A
-    PROJECTED_* code; PROJECTED_NOT_FINITE leaves the tracker as it was."""
+    """`PathTracker.update` of the position (px, py) on the compiled path (`compiled_path`'s table and record)
+    into `tracker_state` and `foot` (the tracker's `state` and `out`), then the simulator's checks in its order:
+    past an end by more than SET_MAX_PAST_END, further than SET_MAX_DISTANCE, at the end of an open path or
+    SET_TOTAL_LENGTH travelled. A PROJECTED_* code; PROJECTED_NOT_FINITE leaves the tracker as it was."""
     if not (math.isfinite(px) and math.isfinite(py)):
         return PROJECTED_NOT_FINITE
-    closed = settings[SET_CLOSED] == 1.0
-    track(
-        path[PATH_X], path[PATH_Y], path[PATH_HEADING], path[PATH_CURVATURE], settings[SET_SPACING],
-        settings[SET_LENGTH], closed, settings[SET_EXTENT], settings[SET_WINDOW], tracker_state, px, py, foot,
-    )  # fmt: skip
+    closed = record[0].closed
+    track(path, record, tracker_state, px, py, foot)
     if foot[FOOT_PAST_END] > settings[SET_MAX_PAST_END]:
         return PROJECTED_PAST_END
     if foot[FOOT_DISTANCE] > settings[SET_MAX_DISTANCE]:
@@ -171,18 +162,18 @@ def finish_step(
     diagnostics: np.ndarray,
     foot: np.ndarray,
     path: np.ndarray,
+    record: np.ndarray,
     settings: np.ndarray,
 ) -> float:  # pragma: no cover - compiled
     """The acceleration command of this step, its trace row written: `table[row]` = (t, outputs, SIGNALS,
     diagnostics), the columns after them untouched. The speed reference at the foot point (`foot`, the tracker's
-    output) on the `path_table`'s planned speed, its rate speed x dv_ref/ds fed forward when SET_FEEDFORWARD, the
-    PI command on the speed controller's state in `settings` (advanced). NaN, with nothing written and the
-    integrator untouched, when the speed, the reference or its rate is not finite (the Python `PISpeedController`
-    says why)."""
+    output) on the compiled path's planned speed (`compiled_path`'s table and record), its rate speed x dv_ref/ds
+    fed forward when SET_FEEDFORWARD, the PI command on the speed controller's state in `settings` (advanced).
+    NaN, with nothing written and the integrator untouched, when the speed, the reference or its rate is not
+    finite (the Python `PISpeedController` says why)."""
     s = foot[FOOT_S]
-    speed_ref, slope = speed_reference(
-        path[PATH_SPEED], settings[SET_SPACING], settings[SET_LENGTH], settings[SET_CLOSED] == 1.0, s
-    )
+    shape = record[0]
+    speed_ref, slope = speed_reference(path[PATH_SPEED], shape.spacing, shape.length, shape.closed, s)
     speed_ref_rate = speed * slope if settings[SET_FEEDFORWARD] == 1.0 else 0.0
     if not (math.isfinite(speed_ref) and math.isfinite(speed) and math.isfinite(speed_ref_rate)):
         return math.nan

@@ -276,10 +276,7 @@ def trailer_feet(path: ReferencePath, x_m: np.ndarray, y_m: np.ndarray) -> tuple
     if bad.size:
         tracker.update(float(x_m[bad[0]]), float(y_m[bad[0]]))  # raises, naming the position
     s, cte = np.empty(x_m.size), np.empty(x_m.size)
-    track_sequence(
-        path.x_m, path.y_m, path.heading_rad, path.curvature_1pm, path.spacing_m, path.length_m, path.closed,
-        tracker.extent_m, tracker.min_window_m, tracker.state, x_m, y_m, s, cte,
-    )  # fmt: skip
+    track_sequence(tracker.compiled.table, tracker.compiled.record, tracker.state, x_m, y_m, s, cte)
     return s, cte
 
 

@@ -92,17 +92,9 @@ def test_the_ceiling_on_a_circle_is_the_chord_of_the_turn(turn_deg: float, chord
     path = _circle(radius)
     s = start_angle * radius
     x, y = path.position(s)
+    compiled = path.compiled()
     ceiling = turn_limited_lookahead(
-        path.x_m,
-        path.y_m,
-        path.heading_rad,
-        True,
-        s / path.spacing_m,
-        float(x),
-        float(y),
-        math.radians(turn_deg),
-        100.0,
-        path.max_segment_m,
+        compiled.table, compiled.record, s / path.spacing_m, float(x), float(y), math.radians(turn_deg), 100.0
     )
     assert ceiling == pytest.approx(chord * radius, abs=0.1)
 
@@ -111,9 +103,10 @@ def test_the_ceiling_is_the_most_on_a_straight_and_past_an_open_end() -> None:
     """No turn within reach: max_m, on a straight and beyond an open path's end (its straight extension)."""
     path = ClothoidChain().straight(30.0).to_path("straight")
     x, y = path.position(25.0)
-    args = (path.x_m, path.y_m, path.heading_rad, False, 25.0 / path.spacing_m, float(x), float(y), math.pi / 3)
-    assert turn_limited_lookahead(*args, 40.0, path.max_segment_m) == 40.0
-    assert turn_limited_lookahead(*args, 3.0, path.max_segment_m) == 3.0
+    compiled = path.compiled()
+    args = (compiled.table, compiled.record, 25.0 / path.spacing_m, float(x), float(y), math.pi / 3)
+    assert turn_limited_lookahead(*args, 40.0) == 40.0
+    assert turn_limited_lookahead(*args, 3.0) == 3.0
 
 
 @settings(max_examples=60, deadline=None)
@@ -132,8 +125,13 @@ def test_the_ceiling_measures_only_where_it_must_and_finds_the_same(
     px, py = float(x) - offset * math.sin(heading), float(y) + offset * math.cos(heading)
     for path in (LOOP_BEND, OPEN_BEND):
         turn = math.radians(turn_deg)
-        args = (path.x_m, path.y_m, path.heading_rad, path.closed, s / path.spacing_m, px, py, turn, max_m)
-        assert turn_limited_lookahead(*args, path.max_segment_m) == turn_limited_lookahead(*args, math.inf)
+        compiled = path.compiled()
+        unbounded = compiled.record.copy()
+        unbounded["max_segment"] = math.inf  # no bound known: every sample measured
+        args = (s / path.spacing_m, px, py, turn, max_m)
+        assert turn_limited_lookahead(compiled.table, compiled.record, *args) == turn_limited_lookahead(
+            compiled.table, unbounded, *args
+        )
 
 
 def test_a_falling_floor_takes_the_lookahead_down_keeping_its_excess() -> None:

@@ -155,7 +155,8 @@ def test_filter_file_is_read_and_a_schedule_follows_speed(tmp_path: Path) -> Non
     controller.step(_m(10.0, 0.0, 0.0, 50.0 / 3.6), STRAIGHT)
     # the step runs the schedule's filter of its whole km/h, discretised at the period
     made = DiscreteLeadFilter(schedule.at_speed(50.0), 0.02).coefficients
-    assert np.array_equal(controller._filter_table[50], made) and np.isnan(controller._filter_table[49, 0])
+    filters = controller._state["filters"][0]  # the step's state record (step_kernel.STATE)
+    assert np.array_equal(filters[50], made) and np.isnan(filters[49, 0])
     # Without a file: the tuning's (the truck's shipped schedule), none without a tuning, and never DEFAULT_FILTER,
     # the truck's old filter, for another vehicle.
     own = tuned_controller("clothoid", TRUCK).filter_schedule

@@ -17,6 +17,7 @@ from controllers.clothoid.path_feedforward import lag_inverse_curvature
 from tuning.own_tuning import tuning_for
 from workbench.base.clothoid_chain import ClothoidChain
 from workbench.base.errors import WorkbenchInputError
+from workbench.base.path_search import CompiledPath
 from workbench.vehicles import make_vehicle
 
 TRUCK = make_vehicle("tractor-semitrailer")
@@ -27,12 +28,19 @@ S_GRID = np.arange(0.0, 200.0 + SPACING_M / 2, SPACING_M)
 RATE_1PM2 = 4e-4
 
 
+def _compiled(curvature: np.ndarray) -> CompiledPath:
+    """An open path of S_GRID's samples with this curvature, compiled (only its curvature is read here)."""
+    zeros = np.zeros_like(curvature)
+    return CompiledPath.of((zeros, zeros, zeros, curvature, None), SPACING_M, float(S_GRID[-1]), False, 0.0, 5.0)
+
+
 def _inverse(curvature: np.ndarray, s_m: float, **lag: float) -> tuple[float, float]:
     timing = {"speed_mps": 8.0, "dead_time_s": 0.25, "omega_n_rad_s": 20.0, "zeta": 1.5, "gain": 0.9, "window_m": 2.0}
     timing |= lag
+    compiled = _compiled(curvature)
     return lag_inverse_curvature(
-        curvature, SPACING_M, float(S_GRID[-1]), False, s_m, timing["speed_mps"], timing["dead_time_s"],
-        timing["omega_n_rad_s"], timing["zeta"], timing["gain"], timing["window_m"],
+        compiled.table, compiled.record, s_m, timing["speed_mps"], timing["dead_time_s"], timing["omega_n_rad_s"],
+        timing["zeta"], timing["gain"], timing["window_m"],
     )  # fmt: skip
 
 
@@ -53,8 +61,8 @@ def test_on_by_default_and_the_form_of_the_path_feedforward() -> None:
         0.0, float(path.x_m[i]), float(path.y_m[i]), speed, 0.0, float(path.heading_rad[i]), speed * kappa, steer
     )
     controller.step(m, path)
-    assert math.isnan(controller._state[sk.S_FEEDFORWARD_KAPPA])
-    assert abs(controller._state[sk.S_KAPPA_CMD] - kappa) < 0.05 * kappa  # one step of Eq. 3 from the steering
+    assert math.isnan(controller._state["feedforward_kappa"][0])
+    assert abs(controller._state["kappa_cmd"][0] - kappa) < 0.05 * kappa  # one step of Eq. 3 from the steering
 
 
 def test_a_constant_curvature_rate_is_the_curvature_ahead_plus_the_lags_first_order_lead() -> None:
@@ -98,10 +106,10 @@ def test_the_step_sends_the_inverted_lag_of_the_vehicles_own_tuning() -> None:
     s_ahead = float(path.s_m[i]) + speed * (lag.delay_s + known)
     kappa_ahead = float(np.interp(s_ahead, path.s_m, path.curvature_1pm))
     expected = (kappa_ahead + 2 * lag.zeta / lag.omega_n_rad_s * speed * RATE_1PM2) / lag.steady_state_gain
-    state = controller._state
-    assert state[sk.S_FEEDFORWARD_KAPPA] == pytest.approx(expected, rel=1e-3)
+    state = controller._state[0]
+    assert state["feedforward_kappa"] == pytest.approx(expected, rel=1e-3)
     kappa_measured = math.tan(steer / g.steering_ratio) / g.wheelbase_m
-    feedback_step = abs(state[sk.S_KAPPA_CMD] - (kappa_measured - expected))
+    feedback_step = abs(state["kappa_cmd"] - (kappa_measured - expected))
     assert feedback_step < 0.05 * abs(expected)  # one step's integrated feedback only
 
 
@@ -141,10 +149,10 @@ def test_the_lag_model_reference_is_on_by_default_and_acts_only_with_the_inversi
 
 def _reference(curvature: np.ndarray, s_m: float, measured: np.ndarray) -> float:
     path_lag = np.array([[20.0, 1.5, 0.25, 0.9]])  # wn, zeta, delay, K
+    compiled = _compiled(curvature)
     return sk.reference_curvature(
-        curvature, SPACING_M, float(S_GRID[-1]), False, s_m, 8.0, path_lag, measured, np.array([30.0]), 2.0,
-        np.empty(8),
-    )  # fmt: skip
+        compiled.table, compiled.record, s_m, 8.0, path_lag, measured, np.array([30.0]), 2.0, np.empty(8)
+    )
 
 
 def test_the_reference_curvature_is_the_measured_lag_of_the_inverted_path_lag() -> None:

@@ -17,6 +17,7 @@ from controllers.clothoid.lookahead import (
     candidate_lookaheads,
     evaluate_candidate,
     evaluated,
+    search_settings,
 )
 from workbench.base.clothoid_chain import ClothoidChain
 
@@ -54,9 +55,10 @@ HINTS = st.one_of(st.just(math.nan), st.floats(0.0, 30.0))
 
 def _search(s: float, pose, kappa: float, threshold: float, hint: float, size: int):
     scores, results = np.empty(size), np.empty((size, 8))
+    compiled = BEND.compiled()
     chosen, evaluations = adaptive_search(
-        BEND.x_m, BEND.y_m, BEND.closed, s / BEND.spacing_m, *pose, kappa, 5.0, 20.0, 0.5, threshold,
-        10.0, 10.0, KDOT_MAX, 0.5, np.empty((4, MAX_CURVE_POINTS)), scores, results, BEND.max_segment_m, hint,
+        compiled.table, compiled.record, search_settings(0.5, 10.0, 10.0, KDOT_MAX, 0.5), s / BEND.spacing_m, *pose,
+        kappa, 5.0, 20.0, threshold, hint, np.empty((4, MAX_CURVE_POINTS)), scores, results,
     )  # fmt: skip
     return chosen, evaluations, scores, results
 
@@ -85,9 +87,10 @@ def test_the_search_equals_brute_force_where_the_distance_is_monotone(
     # what the search kept of each candidate is what evaluate_candidate gives for it
     k = evaluated(scores, results, 5.0, 0.5, chosen)
     assert k >= 0 and results[k, 0] == scores[k]
+    compiled = BEND.compiled()
     again = evaluate_candidate(
-        BEND.x_m, BEND.y_m, BEND.closed, s / BEND.spacing_m, *pose, kappa, chosen, KDOT_MAX, 0.5,
-        np.empty((4, MAX_CURVE_POINTS)), BEND.max_segment_m, np.inf,
+        compiled.table, compiled.record, s / BEND.spacing_m, *pose, kappa, chosen, KDOT_MAX, 0.5,
+        np.empty((4, MAX_CURVE_POINTS)), np.inf,
     )  # fmt: skip
     assert tuple(results[k]) == tuple(float(v) for v in again)
     assert evaluated(scores, results, 5.0, 0.5, chosen + 0.25) == -1  # off the grid: not evaluated

@@ -13,12 +13,12 @@ from hypothesis import strategies as st
 from workbench.base.clothoid_chain import ClothoidChain
 from workbench.base.errors import WorkbenchInputError
 from workbench.base.path import ReferencePath, wrap_angle
+from workbench.base.path_search import PATH_RECORD, PATH_SPEED
 from workbench.simulation.speed_control import PI_INTEGRAL, PISpeedController, PISpeedGains
 from workbench.simulation.step_kernel import (
     FOOT_AT_END,
     FOOT_S,
     N_SIGNALS,
-    PATH_SPEED,
     PROJECTED_COMPLETED,
     PROJECTED_NOT_FINITE,
     PROJECTED_OFF_PATH,
@@ -26,8 +26,8 @@ from workbench.simulation.step_kernel import (
     PROJECTED_PAST_END,
     SET_PI,
     SIGNALS,
+    compiled_path,
     finish_step,
-    path_table,
     project_pose,
     run_settings,
     speed_reference,
@@ -47,25 +47,31 @@ CLOSED = _with_speed(ClothoidChain(curvature_1pm=1 / 15).arc(2 * math.pi * 15).t
 
 def _settings(tracker, limits=(5.0, 30.0, math.inf), feedforward: bool = True) -> np.ndarray:
     """A run's settings: (max_past_end_m, max_abs_cte_m, the distance to cover), the default PI gains."""
-    return run_settings(tracker, *limits, DT_S, feedforward, PISpeedGains())
+    return run_settings(*limits, DT_S, feedforward, PISpeedGains())
 
 
 def _project(path: ReferencePath, tracker, x: float, y: float, limits=(5.0, 30.0, math.inf)) -> int:
-    return project_pose(x, y, path_table(path), tracker.state, tracker.out, _settings(tracker, limits))
+    compiled = compiled_path(tracker)
+    return project_pose(x, y, compiled.table, compiled.record, tracker.state, tracker.out, _settings(tracker, limits))
 
 
 def test_the_tables_hold_the_paths_samples_and_the_runs_settings() -> None:
-    table = path_table(CLOSED)
+    """The simulator reads the tracker's compiled path, the one its controllers read (made once per path and
+    window), and the run's own constants."""
+    tracker = CLOSED.tracker(0.0)
+    compiled = compiled_path(tracker)
+    assert compiled is CLOSED.compiled() is tracker.compiled
+    table = compiled.table
     assert table.shape == (5, CLOSED.s_m.size) and table.flags.c_contiguous
     assert table[PATH_SPEED].tolist() == CLOSED.speed_mps.tolist()
-    tracker = CLOSED.tracker(0.0)
-    settings = run_settings(tracker, 5.0, 30.0, 2 * CLOSED.length_m, DT_S, False, PISpeedGains(kp_per_s=0.5))
-    assert settings.tolist() == [
-        CLOSED.spacing_m, CLOSED.length_m, 1.0, tracker.extent_m, tracker.min_window_m, 5.0, 30.0,
-        2 * CLOSED.length_m, DT_S, 0.0, 0.5, 0.2, 2.0, 4.0, 0.0,
-    ]  # fmt: skip
+    assert compiled.record.dtype == PATH_RECORD and compiled.record.shape == (1,)
+    assert compiled.record[0].tolist() == (
+        CLOSED.spacing_m, CLOSED.length_m, True, tracker.extent_m, tracker.min_window_m, CLOSED.max_segment_m
+    )
+    settings = run_settings(5.0, 30.0, 2 * CLOSED.length_m, DT_S, False, PISpeedGains(kp_per_s=0.5))
+    assert settings.tolist() == [5.0, 30.0, 2 * CLOSED.length_m, DT_S, 0.0, 0.5, 0.2, 2.0, 4.0, 0.0]
     with pytest.raises(WorkbenchInputError, match="carries no planned speed"):
-        path_table(ClothoidChain().straight(10.0).to_path("bare"))
+        compiled_path(ClothoidChain().straight(10.0).to_path("bare").tracker(0.0))
 
 
 @settings(max_examples=300, deadline=None)
@@ -139,7 +145,7 @@ def test_the_row_is_what_the_python_loop_logged(path: ReferencePath, feedforward
     n_out, n_diag, n_after = 9, 3, 2
     table = np.full((60, 1 + n_out + N_SIGNALS + n_diag + n_after), np.nan)
     tracker, python_pi = path.tracker(0.0), PISpeedController()
-    samples, settings = path_table(path), _settings(tracker, feedforward=feedforward)
+    compiled, settings = compiled_path(tracker), _settings(tracker, feedforward=feedforward)
     s = np.linspace(0.0, 0.9 * path.length_m, table.shape[0])
     for row, (px, py) in enumerate(zip(*path.position(s), strict=True)):
         outputs = rng.normal(size=n_out)
@@ -150,7 +156,8 @@ def test_the_row_is_what_the_python_loop_logged(path: ReferencePath, feedforward
         expected_ref, rate = path.speed(foot.s_m), speed * path.speed_gradient(foot.s_m) if feedforward else 0.0
         expected_accel = python_pi.step(expected_ref, speed, DT_S, rate)
         accel = finish_step(
-            table, row, t, outputs, steer, speed, step_time, diagnostics, tracker.out, samples, settings
+            table, row, t, outputs, steer, speed, step_time, diagnostics, tracker.out, compiled.table,
+            compiled.record, settings,
         )  # fmt: skip
         assert accel == expected_accel
         signals = dict(
@@ -183,8 +190,10 @@ def test_a_speed_not_finite_writes_nothing_and_keeps_the_integrator(speed: float
     settings = _settings(tracker)
     settings[SET_PI + PI_INTEGRAL] = 0.25
     before = settings.copy()
+    compiled = compiled_path(tracker)
     accel = finish_step(
-        table, 1, 0.02, np.zeros(9), 0.0, speed, 1e-5, np.zeros(2), tracker.out, path_table(OPEN), settings
+        table, 1, 0.02, np.zeros(9), 0.0, speed, 1e-5, np.zeros(2), tracker.out, compiled.table, compiled.record,
+        settings,
     )  # fmt: skip
     assert math.isnan(accel)
     assert np.isnan(table).all() and settings.tolist() == before.tolist()
