@@ -16,7 +16,7 @@ from pathlib import Path
 from typing import Any
 
 from controllers.clothoid.filter_schedule import FilterSchedule
-from controllers.clothoid.vehicle_tuning import VehicleTuning
+from controllers.clothoid.vehicle_tuning import FloorDesign, VehicleTuning
 from tuning.filter_file import read_filter_file
 from tuning.limits_file import read_limits_file
 from workbench.base.errors import WorkbenchInputError, shown_all, value_text
@@ -180,13 +180,20 @@ def read_manifest(directory: str | Path) -> dict[str, Any]:
     return doc
 
 
+def _design(path: Path) -> Mapping[str, Any]:
+    """The lead file's design table (`tuning.schedule.ScheduleResult.write`), read at the boundary into the typed
+    lags and floors of a `VehicleTuning` (`_lags`, `_floors`); the file is a valid lead-filter file
+    (`read_filter_file` read it first)."""
+    design = read_json(path, f"lead filter file {str(path)!r}").get("design", {})
+    return design if isinstance(design, Mapping) else {}
+
+
 def _lags(
-    path: Path, schedule: FilterSchedule
+    path: Path, design: Mapping[str, Any], schedule: FilterSchedule
 ) -> tuple[tuple[tuple[float, SteeringLag], ...], tuple[tuple[float, SteeringLag], ...]]:
     """(the path lags, the measured lags) of design.per_speed; the measured ones empty when no row has them (files
     made before they were recorded), refused when only some rows have them."""
-    design = schedule.metadata.get("design", {})
-    rows = design.get("per_speed") if isinstance(design, Mapping) else None
+    rows = design.get("per_speed")
     if not isinstance(rows, list) or not rows:
         raise WorkbenchInputError(f"{path}: design.per_speed (the lag identified at each speed) is missing")
     lags, measured = [], []
@@ -216,6 +223,29 @@ def _lags(
             f"{path}: the lags' speeds {shown_all(speeds)} differ from the schedule's {shown_all(schedule.speeds_kmh)}"
         )
     return tuple(lags), tuple(measured)
+
+
+#: The design keys that say how the margins design computed its floors (`tuning.schedule.ScheduleResult.write`).
+FLOOR_DESIGN_KEYS = ("controller_rate_hz", "prediction_time_s", "arc_lateral_accel_g", "lookahead_range_m")
+
+
+def _floors(path: Path, design: Mapping[str, Any]) -> tuple[tuple[tuple[float, float], ...], FloorDesign | None]:
+    """((speed_kmh, lookahead_floor_m) of the rows of design.per_speed that have one, what they were computed for):
+    ((), None) unless the design is "margins" with its loop (FLOOR_DESIGN_KEYS). The margins kept are
+    `loop_requirements`' (the design keeps them; its file does not name them)."""
+    if design.get("method") != "margins" or any(k not in design for k in FLOOR_DESIGN_KEYS):
+        return (), None
+    try:
+        rate_hz, prediction_s, arc_g = (float(design[k]) for k in FLOOR_DESIGN_KEYS[:3])
+        low, high, step = (float(v) for v in design["lookahead_range_m"])
+        floors = tuple(
+            (float(row["speed_kmh"]), float(row["lookahead_floor_m"]))
+            for row in design["per_speed"]
+            if "lookahead_floor_m" in row
+        )
+    except (TypeError, ValueError) as exc:
+        raise WorkbenchInputError(f"{path}: design's floors ({list(FLOOR_DESIGN_KEYS)}, per_speed): {exc}") from None
+    return floors, FloorDesign(1.0 / rate_hz, prediction_s, arc_g, (low, high, step))
 
 
 def _row_lag(path: Path, i: int, row: Mapping[str, Any], prefix: str, speed: float) -> SteeringLag:
@@ -262,8 +292,13 @@ def _read(directory: str, _stamp: tuple[int, ...]) -> VehicleTuning:
     limits = read_limits_file(path / LIMITS_FILE)
     who = f"preset {manifest['preset']!r}" if manifest["preset"] else f"vehicle {manifest['vehicle']!r}"
     source = f"{path} ({who}, params sha256 {str(manifest['params_sha256'])[:12]}, made {manifest['date']})"
-    lags, measured = _lags(lead, schedule)
-    return VehicleTuning(schedule, limits, lags, source, measured)
+    design = _design(lead)
+    lags, measured = _lags(lead, design, schedule)
+    floors, floor_design = _floors(lead, design)
+    try:
+        return VehicleTuning(schedule, limits, lags, source, measured, floors, floor_design)
+    except WorkbenchInputError as exc:
+        raise WorkbenchInputError(f"{lead}: {exc}") from None
 
 
 def read_vehicle_tuning(directory: str | Path) -> VehicleTuning:

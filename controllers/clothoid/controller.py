@@ -42,6 +42,7 @@ import numpy as np
 from scipy.constants import g as G_MPS2  # standard gravity, 9.80665 m/s^2
 
 from controllers.base import Controller, Measurement
+from controllers.clothoid import loop_requirements as requirements
 from controllers.clothoid import step_kernel as sk
 from controllers.clothoid.curvature_limits import CurvatureLimits
 from controllers.clothoid.delay_predictor import history_length
@@ -49,17 +50,8 @@ from controllers.clothoid.filter_schedule import FilterSchedule
 from controllers.clothoid.lead_filter import DiscreteLeadFilter
 from controllers.clothoid.lookahead import MAX_CURVE_POINTS, candidate_count
 from controllers.clothoid.lookahead_filter import RATE_LIMIT
-from controllers.clothoid.loop_requirements import (
-    DELAY_COMPENSATIONS,
-    DELAY_UNCERTAINTY_S,
-    REQUIRED_DELAYED_GAIN_MARGIN_DB,
-    REQUIRED_DELAYED_PHASE_MARGIN_DEG,
-    REQUIRED_GAIN_MARGIN_DB,
-    REQUIRED_PHASE_MARGIN_DEG,
-    predicts_with_model,
-)
 from controllers.clothoid.path_feedforward import FeedforwardTiming
-from controllers.clothoid.vehicle_tuning import VehicleTuning
+from controllers.clothoid.vehicle_tuning import FloorInputs, VehicleTuning
 from controllers.config_checks import Choice, Flag, Instance, Number, check_options, option
 from controllers.search_space import Tunable
 from workbench.base.errors import WorkbenchInputError, value_text
@@ -168,30 +160,30 @@ class ClothoidConfig:
         RATE_LIMIT,
     )
     min_phase_margin_deg: float = option(
-        REQUIRED_PHASE_MARGIN_DEG,
+        requirements.REQUIRED_PHASE_MARGIN_DEG,
         "the phase margin the lookahead floor keeps (`loop_analysis.py`; 0 here and in min_gain_margin_db: no floor; "
         "with a known delay compensated by the lags' model, the delay-free loop's)",
         Number(0.0, 89.0, "deg"),
     )
     min_gain_margin_db: float = option(
-        REQUIRED_GAIN_MARGIN_DB,
+        requirements.REQUIRED_GAIN_MARGIN_DB,
         "the gain margin the lookahead floor keeps (as min_phase_margin_deg)",
         Number(0.0, 40.0, "dB"),
     )
     min_delayed_phase_margin_deg: float = option(
-        REQUIRED_DELAYED_PHASE_MARGIN_DEG,
+        requirements.REQUIRED_DELAYED_PHASE_MARGIN_DEG,
         'with delay_compensation "model" and a known delay, the phase margin the loop with its delay and the '
         "predictor keeps besides, for dead times within known_delay_uncertainty_s of the known one "
         "(`loop_analysis.DelayRobustness`)",
         Number(0.0, 89.0, "deg"),
     )
     min_delayed_gain_margin_db: float = option(
-        REQUIRED_DELAYED_GAIN_MARGIN_DB,
+        requirements.REQUIRED_DELAYED_GAIN_MARGIN_DB,
         "the gain margin kept as min_delayed_phase_margin_deg is",
         Number(0.0, 40.0, "dB"),
     )
     known_delay_uncertainty_s: float = option(
-        DELAY_UNCERTAINTY_S,
+        requirements.DELAY_UNCERTAINTY_S,
         "how far the vehicle's dead time may be from known_delay_s (either way) with the min_delayed_* margins kept",
         Number(0.0, 1.0, "s"),
     )
@@ -272,7 +264,7 @@ class ClothoidConfig:
         'how the pose is predicted over known_delay_s: "model" (the identified lags driven by the commands already '
         'sent, a Smith predictor, `delay_predictor.py`; needs the tuning and initial_curvature "yaw-rate") or "arc" '
         "(on kappa(0); the delay stays in the loop, and the floor is the delayed loop's)",
-        Choice(DELAY_COMPENSATIONS),
+        Choice(requirements.DELAY_COMPENSATIONS),
     )
     path_feedforward: bool = option(
         True,
@@ -343,7 +335,7 @@ class ClothoidConfig:
     @property
     def predicts_with_model(self) -> bool:
         """Whether the pose is predicted over a known delay with the identified lags (`delay_predictor.py`)."""
-        return predicts_with_model(self.delay_compensation, self.known_delay_s)
+        return requirements.predicts_with_model(self.delay_compensation, self.known_delay_s)
 
     def __post_init__(self) -> None:
         # Every field on its own first (its rule, `config_checks.check_options`), then what relates them.
@@ -471,7 +463,6 @@ class ClothoidController(Controller):
         self._state = sk.initial_state()  # both path trackers at the path's start
         self._params["dt"] = self._dt
         self._diag = self._declare_diagnostics(DIAGNOSTIC_KEYS)
-        self._tables()  # read again: limits, tuning and schedule are the controller's attributes
         if self.config.predicts_with_model:
             longest = self.config.known_delay_s + float(
                 max(self._lags[:, 2].max(), self._measured_lags[:, 2].max(initial=0.0))
@@ -489,7 +480,8 @@ class ClothoidController(Controller):
 
     def _tables(self) -> None:
         """The tables the compiled step reads (step_kernel.py): the limits, the identified lags and the lead
-        filter's schedule (no rows: untuned, no lead filter), each against speed."""
+        filter's schedule (no rows: untuned, no lead filter), each against speed; built once, with the controller
+        (they depend on its config alone, not on the path or the period)."""
         self._limit_speeds, self._limits = self.limits.table
         if self.tuning is not None:
             self._lag_speeds, self._lags, self._measured_lags = self.tuning.lag_tables
@@ -577,15 +569,33 @@ class ClothoidController(Controller):
             if inputs is None:
                 floor = cfg.min_lookahead_m
             else:
-                from controllers.clothoid.loop_analysis import lookahead_floor  # python-control: imported when used
-
                 lags, settings, v, curvatures, delayed = inputs
-                floor = lookahead_floor(
-                    lags, settings, v, cfg.min_lookahead_m, self._floor_search_top_m, cfg.lookahead_step_m,
-                    curvatures, cfg.min_phase_margin_deg, cfg.min_gain_margin_db, delayed,
-                )  # fmt: skip
+                floor = self._recorded_floor_m(band * FLOOR_SPEED_BAND_KMH, settings, curvatures)
+                if floor is None:
+                    from controllers.clothoid.loop_analysis import lookahead_floor  # python-control: when used
+
+                    floor = lookahead_floor(
+                        lags, settings, v, cfg.min_lookahead_m, self._floor_search_top_m, cfg.lookahead_step_m,
+                        curvatures, cfg.min_phase_margin_deg, cfg.min_gain_margin_db, delayed,
+                    )  # fmt: skip
             self._floors[band] = floor
         return floor
+
+    def _recorded_floor_m(
+        self, speed_kmh: float, settings: LoopSettings, curvatures: tuple[float, float]
+    ) -> float | None:
+        """The floor the tuning's margins design computed at this speed (km/h), when it is the one this analysis
+        computes: the tuning's lags there (`plant_lags`), the same lead filter, loop settings, path curvatures,
+        search grid and margins (`VehicleTuning.recorded_floor_m`); None otherwise (the floor is computed)."""
+        if self.tuning is None:
+            return None
+        cfg, g = self.config, self.geometry
+        inputs = FloorInputs(
+            speed_kmh, settings.lead, settings.sample_time_s, settings.prediction_time_s, settings.known_delay_s,
+            curvatures, (cfg.min_lookahead_m, self._floor_search_top_m, cfg.lookahead_step_m),
+            cfg.min_phase_margin_deg, cfg.min_gain_margin_db,
+        )  # fmt: skip
+        return self.tuning.recorded_floor_m(inputs, math.tan(g.max_road_wheel_angle_rad) / g.wheelbase_m)
 
     @property
     def _floor_search_top_m(self) -> float:

@@ -1,7 +1,9 @@
 """The clothoid controller's tuning of one vehicle (`VehicleTuning`): its lead filter against speed, its curvature
-limits and the Eq. 5 lags identified at each speed, interpolated in speed. The steered vehicle's own tuning is made
-by the project's tuning chain and found by `tuning/tuning_dirs.py` (shipped for the presets, cached for any other
-vehicle); a controller config holds it (`ClothoidConfig.tuning`), so the controller reads no file."""
+limits, the Eq. 5 lags identified at each speed, interpolated in speed, and the lookahead floors the tuning's margins
+design computed (`FloorDesign`: what they were computed for, so that the controller uses them only where it would
+compute the same). The steered vehicle's own tuning is made by the project's tuning chain and found by
+`tuning/tuning_dirs.py` (shipped for the presets, cached for any other vehicle); a controller config holds it
+(`ClothoidConfig.tuning`), so the controller reads no file."""
 
 from __future__ import annotations
 
@@ -12,9 +14,12 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.constants import g as G_MPS2  # standard gravity, 9.80665 m/s^2
 
 from controllers.clothoid.curvature_limits import CurvatureLimits
 from controllers.clothoid.filter_schedule import FilterSchedule
+from controllers.clothoid.lead_filter import LeadFilterParams
+from controllers.clothoid.loop_requirements import REQUIRED_GAIN_MARGIN_DB, REQUIRED_PHASE_MARGIN_DEG
 from controllers.clothoid.speed_tables import table_row
 from workbench.base.errors import WorkbenchInputError, shown_all, value_text
 from workbench.vehicles.steering_lag import SteeringLag
@@ -24,18 +29,65 @@ LAG_COLUMNS = ("omega_n_rad_s", "zeta", "delay_s", "steady_state_gain")
 
 
 @dataclass(frozen=True)
+class FloorInputs:
+    """What a lookahead floor at one speed is computed from (`loop_analysis.lookahead_floor`), besides the lags of
+    that speed: speed_kmh (km/h), lead (the lead filter there; None: none), sample_time_s (controller period, s),
+    prediction_time_s (s), known_delay_s (s), path_curvatures_1pm (the straight and the arc it is checked about,
+    1/m), lookahead_grid_m (the search's shortest and longest lookahead and its step, m), phase_margin_deg and
+    gain_margin_db (the margins kept). Two floors with equal inputs and lags are equal."""
+
+    speed_kmh: float
+    lead: LeadFilterParams | None
+    sample_time_s: float
+    prediction_time_s: float
+    known_delay_s: float
+    path_curvatures_1pm: tuple[float, ...]
+    lookahead_grid_m: tuple[float, float, float]
+    phase_margin_deg: float
+    gain_margin_db: float
+
+
+@dataclass(frozen=True)
+class FloorDesign:
+    """How the tuning's margins design computed its floors (`tuning schedule --design margins`): the loop at
+    sample_time_s (s) with prediction_time_s (s) and no known delay, about a straight and an arc of
+    arc_lateral_accel_g (g) capped at the steering lock, searched over lookahead_grid_m (shortest, longest, step;
+    m), keeping phase_margin_deg and gain_margin_db (those of `loop_requirements`, which the design keeps)."""
+
+    sample_time_s: float
+    prediction_time_s: float
+    arc_lateral_accel_g: float
+    lookahead_grid_m: tuple[float, float, float]
+    phase_margin_deg: float = REQUIRED_PHASE_MARGIN_DEG
+    gain_margin_db: float = REQUIRED_GAIN_MARGIN_DB
+
+    def inputs(self, speed_kmh: float, lead: LeadFilterParams, lock_curvature_1pm: float) -> FloorInputs:
+        """The inputs of its floor at speed_kmh (km/h) with this lead filter, the arc capped at the steered
+        vehicle's lock curvature (1/m), as `tuning.schedule.margins_arc_curvature_1pm` caps it."""
+        v = speed_kmh / 3.6
+        arc = min(lock_curvature_1pm, self.arc_lateral_accel_g * G_MPS2 / (v * v))
+        return FloorInputs(
+            speed_kmh, lead, self.sample_time_s, self.prediction_time_s, 0.0, (0.0, arc), self.lookahead_grid_m,
+            self.phase_margin_deg, self.gain_margin_db,
+        )  # fmt: skip
+
+
+@dataclass(frozen=True)
 class VehicleTuning:
     """The clothoid controller's tuning of one vehicle: filter_schedule (the lead filter against speed), limits
     (curvature and curvature-rate limits against speed), lags ((speed_kmh, the Eq. 5 lag to the path curvature
     identified there), speeds increasing, the same speeds as the schedule), source (which files, made for which
     vehicle), measured_lags (the same for the lag to the measured curvature, yaw rate / speed, at the same speeds;
-    empty when not identified)."""
+    empty when not identified), floors ((speed_kmh, the lookahead floor the margins design computed there, m), at
+    some of the lags' speeds) and floor_design (what they were computed for; None: no floors)."""
 
     filter_schedule: FilterSchedule
     limits: CurvatureLimits
     lags: tuple[tuple[float, SteeringLag], ...]
     source: str
     measured_lags: tuple[tuple[float, SteeringLag], ...] = ()
+    floors: tuple[tuple[float, float], ...] = ()
+    floor_design: FloorDesign | None = None
 
     def __post_init__(self) -> None:
         if not isinstance(self.filter_schedule, FilterSchedule):
@@ -53,6 +105,26 @@ class VehicleTuning:
                 f"{shown_all(self.lag_speeds_kmh)}"
             )
         object.__setattr__(self, "measured_lags", measured)
+        floors = tuple((float(speed), float(floor)) for speed, floor in self.floors)
+        for speed, floor in floors:
+            if speed not in self.lag_speeds_kmh or not (math.isfinite(floor) and floor > 0.0):
+                raise WorkbenchInputError(
+                    f"floors must be (one of the lags' speeds {shown_all(self.lag_speeds_kmh)}, a lookahead > 0 m); "
+                    f"got ({value_text(speed)}, {value_text(floor)})"
+                )
+        if floors and self.floor_design is None:
+            raise WorkbenchInputError("floors need their floor_design (what they were computed for)")
+        object.__setattr__(self, "floors", floors)
+
+    def recorded_floor_m(self, inputs: FloorInputs, lock_curvature_1pm: float) -> float | None:
+        """The lookahead floor (m) this tuning computed at inputs.speed_kmh, when it was computed from exactly
+        these inputs (the steered vehicle's lock curvature, 1/m, caps its arc) and this tuning's lags there (both
+        lags identified); None otherwise: then the floor is to be computed."""
+        design, floor = self.floor_design, dict(self.floors).get(inputs.speed_kmh)
+        if design is None or floor is None or not self.measured_lags:
+            return None
+        lead = self.filter_schedule.at_speed(inputs.speed_kmh)
+        return floor if design.inputs(inputs.speed_kmh, lead, lock_curvature_1pm) == inputs else None
 
     @functools.cached_property
     def lag_tables(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

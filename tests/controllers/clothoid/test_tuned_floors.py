@@ -1,0 +1,111 @@
+"""The lookahead floors the tuning's margins design computed (lead.json's `lookahead_floor_m` per speed) are used
+by the controller where they are the floors it would compute (the tuning's lags and lead filter, the same loop,
+arc, search grid and margins), and computed where not; the floors used equal those computed."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+from controllers.clothoid import loop_analysis
+from controllers.clothoid.controller import FLOOR_SPEED_BAND_KMH, ClothoidConfig, ClothoidController
+from controllers.clothoid.vehicle_tuning import FloorDesign
+from tuning.own_tuning import tuning_for
+from workbench.base.errors import WorkbenchInputError
+from workbench.base.path import ReferencePath
+from workbench.vehicles import make_vehicle
+
+STRAIGHT = ReferencePath.from_xy(np.linspace(0.0, 100.0, 11), np.zeros(11), name="straight")
+#: The search grid of the shipped tunings' margins design (tuning.schedule.MARGINS_LOOKAHEAD_M).
+TUNING_GRID = {"min_lookahead_m": 3.0, "lookahead_step_m": 0.5}
+
+
+def _controller(vehicle_name: str, **options: object) -> ClothoidController:
+    """A controller of the preset with its shipped tuning and these options, reset at 50 Hz."""
+    vehicle = make_vehicle(vehicle_name)
+    controller = ClothoidController(vehicle.geometry, ClothoidConfig(tuning=tuning_for(vehicle), **options))
+    controller.reset(STRAIGHT, 0.02)
+    return controller
+
+
+@pytest.fixture
+def computed(monkeypatch: pytest.MonkeyPatch) -> list[tuple[float, float]]:
+    """(speed m/s, floor m) of every floor `loop_analysis.lookahead_floor` computes during the test."""
+    calls: list[tuple[float, float]] = []
+    compute = loop_analysis.lookahead_floor
+
+    def counted(*args: object, **kwargs: object) -> float:
+        floor = compute(*args, **kwargs)
+        calls.append((float(args[2]), floor))  # type: ignore[arg-type]
+        return floor
+
+    monkeypatch.setattr(loop_analysis, "lookahead_floor", counted)
+    return calls
+
+
+@pytest.mark.parametrize("vehicle_name", ["tractor-semitrailer", "dynamic-bicycle"])
+def test_recorded_floors_are_used_where_they_are_the_analysis_own_and_equal_it(
+    vehicle_name: str, computed: list[tuple[float, float]]
+) -> None:
+    controller = _controller(vehicle_name, **TUNING_GRID)
+    tuning = controller.tuning
+    assert tuning is not None and tuning.floor_design is not None and len(tuning.floors) == 10
+    used = []
+    for speed_kmh, recorded in tuning.floors:
+        band = round(speed_kmh / FLOOR_SPEED_BAND_KMH)
+        before = len(computed)
+        floor = controller._band_floor_m(band)
+        if len(computed) == before:  # not computed: the recorded floor, which the analysis must reproduce
+            used.append(speed_kmh)
+            assert floor == recorded
+            lags, settings, v, curvatures, delayed = controller._floor_inputs(band)
+            cfg = controller.config
+            assert floor == loop_analysis.lookahead_floor(
+                lags, settings, v, cfg.min_lookahead_m, controller._floor_search_top_m, cfg.lookahead_step_m,
+                curvatures, cfg.min_phase_margin_deg, cfg.min_gain_margin_db, delayed,
+            )  # fmt: skip
+    # most speeds reuse their floor; where the controller's arc (capped by its curvature limit, v**2) differs from
+    # the design's by as little as a rounding, the floor is computed
+    assert len(used) >= 6, used
+
+
+def test_floors_are_computed_where_the_controller_analyses_another_loop(computed: list[tuple[float, float]]) -> None:
+    """The default search grid (from min_lookahead_m = 5 m) is not the design's (from 3 m); another prediction time
+    or margin is another loop; a speed between the identified ones has interpolated lags."""
+    for options in (
+        {},
+        {**TUNING_GRID, "prediction_time_s": 0.3},
+        {**TUNING_GRID, "min_phase_margin_deg": 50.0},
+        {**TUNING_GRID, "use_lead_filter": False},
+    ):
+        controller = _controller("tractor-semitrailer", **options)
+        before = len(computed)
+        controller._band_floor_m(round(30.0 / FLOOR_SPEED_BAND_KMH))
+        assert len(computed) == before + 1, options
+    controller = _controller("tractor-semitrailer", **TUNING_GRID)
+    before = len(computed)
+    controller._band_floor_m(7)  # 35 km/h, between the identified 30 and 40
+    assert len(computed) == before + 1
+
+
+def test_a_tuning_refuses_floors_it_cannot_use() -> None:
+    tuning = tuning_for(make_vehicle("tractor-semitrailer"))
+    with pytest.raises(WorkbenchInputError, match=r"floors must be \(one of the lags' speeds .*got \(35\.0, 8\.0\)"):
+        dataclasses.replace(tuning, floors=((35.0, 8.0),))
+    with pytest.raises(WorkbenchInputError, match="floors need their floor_design"):
+        dataclasses.replace(tuning, floors=((30.0, 8.0),), floor_design=None)
+    assert tuning.floor_design == FloorDesign(0.02, 0.2, 0.4, (3.0, 40.0, 0.5))
+
+
+def test_the_step_tables_are_built_once(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The limits', lags' and lead filter's tables depend on the config alone: built with the controller, not again
+    at each reset."""
+    built = []
+    build = ClothoidController._tables
+    monkeypatch.setattr(ClothoidController, "_tables", lambda self: built.append(1) or build(self))
+    controller = _controller("tractor-semitrailer")
+    controller.reset(STRAIGHT, 0.01)
+    assert len(built) == 1
+    assert controller._lags is controller.tuning.lag_tables[1]
