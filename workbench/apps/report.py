@@ -24,7 +24,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from datetime import UTC, datetime
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, TypeGuard
 
 import numpy as np
 import pandas as pd
@@ -127,20 +127,20 @@ def number_text(value: float | None, missing: str = MISSING) -> str:
     return f"{value:.3g}"
 
 
-def _is_number(value: object) -> bool:
+def _is_number(value: object) -> TypeGuard[float | int | np.number]:
     """Whether a cell holds a number (not a flag: True shows as True)."""
     return isinstance(value, float | int | np.number) and not isinstance(value, bool | np.bool_)
 
 
 def _is_missing(value: object) -> bool:
-    return value is None or value is pd.NA or (_is_number(value) and math.isnan(float(value)))  # type: ignore[arg-type]
+    return value is None or value is pd.NA or (_is_number(value) and math.isnan(float(value)))
 
 
 def _cell(value: object, missing: str = MISSING) -> str:
     if _is_missing(value):
         return missing
     if _is_number(value):
-        return number_text(float(value), missing)  # type: ignore[arg-type]
+        return number_text(float(value), missing)
     return html.escape(str(value))
 
 

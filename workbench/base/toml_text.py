@@ -10,7 +10,7 @@ from __future__ import annotations
 import json
 import numbers
 import re
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 from pathlib import Path
 
 from workbench.base.errors import value_text
@@ -33,7 +33,9 @@ def toml_value(value: object) -> str:
         return json.dumps(str(value), ensure_ascii=False).replace("\x7f", "\\u007f")
     if isinstance(value, Mapping):
         return "{" + ", ".join(f"{toml_key(k)} = {toml_value(v)}" for k, v in value.items()) + "}"
-    return "[" + ", ".join(toml_value(v) for v in value) + "]"  # type: ignore[attr-defined]
+    if not isinstance(value, Iterable):
+        raise TypeError(f"{type(value).__name__} {value!r} has no TOML form")
+    return "[" + ", ".join(toml_value(v) for v in value) + "]"
 
 
 def toml_key(key: str) -> str:

@@ -142,10 +142,12 @@ class SensorModel:
             self._n_yaw_rate,
             self._n_steer,
         ) = streams
-        self._buffer: list[Measurement | None] = [None] * self._capacity
+        #: The last true measurements, a ring of `_capacity` once full (it fills by appending).
+        self._buffer: list[Measurement] = []
         self._count = 0
         self._epoch: int | None = None
-        self._held: tuple[float, float, float, float, float] | None = None
+        #: The pose the controller is shown (x, y, yaw, vx, vy); NaN until the first step refreshes it.
+        self._held: tuple[float, float, float, float, float] = (math.nan,) * 5
         self._drift_x = self._drift_y = 0.0
         self._drift_started = False
 
@@ -157,7 +159,10 @@ class SensorModel:
             return true
         t = true.t_s
         if self._buffered:
-            self._buffer[self._count % self._capacity] = true
+            if self._count < self._capacity:
+                self._buffer.append(true)
+            else:
+                self._buffer[self._count % self._capacity] = true
             self._count += 1
         if self._pose_active:
             rate = self._rate
@@ -169,7 +174,7 @@ class SensorModel:
                     skipped = 1 if self._epoch is None else epoch - self._epoch
                     self._epoch = epoch
                     self._refresh_pose(true, epoch / rate - self._pose_latency, skipped)
-            x, y, yaw, vx, vy = self._held  # type: ignore[misc]
+            x, y, yaw, vx, vy = self._held
         else:
             x, y, yaw, vx, vy = true.x_m, true.y_m, true.yaw_rad, true.vx_mps, true.vy_mps
 
@@ -243,22 +248,22 @@ class SensorModel:
         (f = 0 and b = a at or beyond either end of the buffer: its last, or the run's first measurement)."""
         buf, cap, count = self._buffer, self._capacity, self._count
         last = buf[(count - 1) % cap]
-        if when_s >= last.t_s:  # type: ignore[union-attr]
-            return last, last, 0.0  # type: ignore[return-value]
+        if when_s >= last.t_s:
+            return last, last, 0.0
         oldest = count - cap if count > cap else 0
-        j = count - 1 - math.ceil((last.t_s - when_s) / self.sample_time_s - 1e-9)  # type: ignore[union-attr]
+        j = count - 1 - math.ceil((last.t_s - when_s) / self.sample_time_s - 1e-9)
         j = max(j, oldest)
         a = buf[j % cap]
-        while a.t_s > when_s and j > oldest:  # type: ignore[union-attr]
+        while a.t_s > when_s and j > oldest:
             j -= 1
             a = buf[j % cap]
-        if a.t_s > when_s:  # type: ignore[union-attr]
-            return a, a, 0.0  # type: ignore[return-value]  # before the first measurement: hold it
+        if a.t_s > when_s:  # before the first measurement: hold it
+            return a, a, 0.0
         b = buf[(j + 1) % cap]
-        while b.t_s <= when_s:  # type: ignore[union-attr]  # ends: b is at most `last`, later than when_s
+        while b.t_s <= when_s:  # ends: b is at most `last`, later than when_s
             j += 1
             a, b = b, buf[(j + 1) % cap]
-        return a, b, (when_s - a.t_s) / (b.t_s - a.t_s)  # type: ignore[union-attr, return-value]
+        return a, b, (when_s - a.t_s) / (b.t_s - a.t_s)
 
 
 class ActuatorModel:
