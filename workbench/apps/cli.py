@@ -240,19 +240,7 @@ def _parser(command: str | None = None) -> argparse.ArgumentParser:
     )
     fmu.add_argument("--track", type=Path, metavar="FILE", help="track CSV for the zandvoort scenario")
     _circuit_ranges_option(fmu)
-    fmu.add_argument(
-        "--speed", type=float, default=30.0, metavar="KMH", help="target speed of the path's plan, km/h (default 30)"
-    )
-    fmu.add_argument(
-        "--lat-accel-g", type=float, default=0.3, metavar="G", help="speed-profile lateral bound (default 0.3 g)"
-    )
-    fmu.add_argument(
-        "--controller-rate-hz",
-        type=float,
-        default=50.0,
-        metavar="HZ",
-        help="controller rate (default 50 Hz): the FMU's step is its period",
-    )
+    _plan_options(fmu, "target speed of the path's plan, km/h", "controller rate: the FMU's step is its period")
     _allow_infeasible_option(fmu, "pack")
     fmu.add_argument("--out", type=Path, required=True, metavar="FILE.fmu", help="the FMU to write")
     fmu.add_argument("--overwrite", action="store_true", help="replace an existing FILE.fmu")
@@ -359,19 +347,13 @@ def _run_options(parser: argparse.ArgumentParser, several: bool) -> None:
         )
         payload = "payload of vehicles that carry one (tractor-semitrailer)"
     parser.add_argument("--payload-kg", type=float, metavar="KG", help=payload)
-    parser.add_argument("--speed", type=float, default=30.0, metavar="KMH", help="target speed, km/h (default 30)")
+    _plan_options(parser, "target speed, km/h", "controller rate")
     parser.add_argument("--out", type=Path, required=True, metavar="DIR", help="output directory")
     parser.add_argument("--track", type=Path, metavar="FILE", help="track CSV for the zandvoort scenario")
     _circuit_ranges_option(parser)
     parser.add_argument("--laps", type=int, default=1, metavar="N", help="laps of a closed path (default 1)")
     parser.add_argument(
-        "--controller-rate-hz", type=float, default=50.0, metavar="HZ", help="controller rate (default 50 Hz)"
-    )
-    parser.add_argument(
         "--plant-rate-hz", type=float, default=1000.0, metavar="HZ", help="plant integration rate (default 1 kHz)"
-    )
-    parser.add_argument(
-        "--lat-accel-g", type=float, default=0.3, metavar="G", help="speed-profile lateral bound (default 0.3 g)"
     )
     parser.add_argument(
         "--max-time-s",
@@ -391,6 +373,19 @@ def _run_options(parser: argparse.ArgumentParser, several: bool) -> None:
     what = "trace and metrics" if not several else "traces, metrics and summary.csv, without figures or report.html"
     parser.add_argument("--no-plots", action="store_true", help=f"write the {what} only")
     _overwrite_option(parser)
+
+
+def _plan_options(parser: argparse.ArgumentParser, speed_help: str, rate_help: str) -> None:
+    """--speed, --lat-accel-g and --controller-rate-hz: the speed plan's target and lateral bound and the
+    controller's rate, as `run`, `compare` and `export-fmu` take them (`speed_help`, `rate_help`: what each means
+    there; the defaults are said after)."""
+    parser.add_argument("--speed", type=float, default=30.0, metavar="KMH", help=f"{speed_help} (default 30)")
+    parser.add_argument(
+        "--lat-accel-g", type=float, default=0.3, metavar="G", help="speed-profile lateral bound (default 0.3 g)"
+    )
+    parser.add_argument(
+        "--controller-rate-hz", type=float, default=50.0, metavar="HZ", help=f"{rate_help} (default 50 Hz)"
+    )
 
 
 def _circuit_ranges_option(parser: argparse.ArgumentParser) -> None:

@@ -54,3 +54,19 @@ def test_an_unknown_controller_is_refused_without_building_one(argv, tmp_path: P
     argv = [str(tmp_path / a) if a.startswith("OUT") else a for a in argv]
     assert cli.main(argv) == 2
     assert "workbench: error: unknown controller 'magic'; choose one of clothoid" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["run", "dlc", "--out", "o"],
+        ["compare", "dlc", "--controllers", "stanley", "--out", "o"],
+        ["export-fmu", "stanley", "--path", "dlc", "--out", "o.fmu"],
+    ],
+)
+def test_the_speed_plan_and_rate_options_are_one_set_with_one_set_of_defaults(argv) -> None:
+    args = cli._parser(argv[0]).parse_args(argv)
+    assert (args.speed, args.lat_accel_g, args.controller_rate_hz) == (30.0, 0.3, 50.0)
+    options = ["--speed", "45", "--lat-accel-g", "0.2", "--controller-rate-hz", "100"]
+    changed = cli._parser(argv[0]).parse_args([*argv, *options])
+    assert (changed.speed, changed.lat_accel_g, changed.controller_rate_hz) == (45.0, 0.2, 100.0)
