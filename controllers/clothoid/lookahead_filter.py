@@ -17,36 +17,14 @@ L / V. So:
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import numpy as np
 from numba import njit
 
 from controllers.config_checks import Number
-from workbench.base.errors import require_in_range
 
 #: A rate limit in metres of lookahead per metre travelled: None (unlimited) or a number in (0, 100].
 RATE_LIMIT = Number(0.0, 100.0, "m per m", low_open=True, none_means="unlimited")
-
-
-def require_rate(name: str, value: float | None) -> None:
-    """Refuse a rate limit `RATE_LIMIT` does not allow."""
-    RATE_LIMIT.check(name, value)
-
-
-@dataclass(frozen=True)
-class LookaheadFilterSettings:
-    """hysteresis_m: changes of the search's choice smaller than this are ignored (m, >= 0); max_growth_m_per_m,
-    max_shrink_m_per_m: the most the lookahead lengthens / shortens per metre travelled (m/m; None: at once)."""
-
-    hysteresis_m: float = 0.5
-    max_growth_m_per_m: float | None = 0.3
-    max_shrink_m_per_m: float | None = 0.5
-
-    def __post_init__(self) -> None:
-        require_in_range("hysteresis_m", self.hysteresis_m, 0.0, 50.0, "m")
-        require_rate("max_growth_m_per_m", self.max_growth_m_per_m)
-        require_rate("max_shrink_m_per_m", self.max_shrink_m_per_m)
 
 
 @njit(cache=True)

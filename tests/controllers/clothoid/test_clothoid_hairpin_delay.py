@@ -25,7 +25,6 @@ from lookahead_follower import LookaheadFilter
 from controllers.base import Measurement
 from controllers.clothoid import ClothoidConfig
 from controllers.clothoid.lookahead import turn_limited_lookahead
-from controllers.clothoid.lookahead_filter import LookaheadFilterSettings
 from controllers.clothoid.loop_analysis import clothoid_law_gains
 from tuning.own_tuning import tuned_controller
 from workbench.base.clothoid_chain import ClothoidChain
@@ -138,7 +137,7 @@ def test_a_falling_floor_takes_the_lookahead_down_keeping_its_excess() -> None:
     """The floor is applied at once both ways: the lookahead falls with it by as much (22 -> 10.5 m: braking into
     the hairpin), keeping its excess over it (25 m over a 22 m floor -> 13.5 m); the search's own choices are still
     followed at the rate limits (0.5 m/m shorter: 0.1 m in a 0.2 m step)."""
-    f = LookaheadFilter(LookaheadFilterSettings())
+    f = LookaheadFilter(ClothoidConfig())
     assert f.step(22.0, 22.0, 40.0, 0.2) == 22.0
     assert f.step(10.5, 10.5, 40.0, 0.2) == 10.5
     f.reset()

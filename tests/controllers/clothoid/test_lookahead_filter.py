@@ -1,4 +1,5 @@
-"""How the lookahead follows the adaptive search's choice: floor at once, hysteresis, rate limits both ways."""
+"""How the lookahead follows the adaptive search's choice: floor at once, hysteresis, rate limits both ways (the
+options ClothoidConfig.lookahead_hysteresis_m, max_lookahead_growth_m_per_m and max_lookahead_shrink_m_per_m)."""
 
 from __future__ import annotations
 
@@ -7,19 +8,29 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from lookahead_follower import LookaheadFilter
 
-from controllers.clothoid.lookahead_filter import LookaheadFilterSettings
+from controllers.clothoid import ClothoidConfig
 from workbench.base.errors import WorkbenchInputError
+
+#: How a refused rate limit's range reads.
+RATE_RANGE = "must be a finite number in (0, 100] m per m"
+
+
+def _config(hysteresis_m: float, growth: float | None, shrink: float | None) -> ClothoidConfig:
+    """The clothoid controller's options with this lookahead hysteresis (m) and these rate limits (m per m)."""
+    return ClothoidConfig(
+        lookahead_hysteresis_m=hysteresis_m, max_lookahead_growth_m_per_m=growth, max_lookahead_shrink_m_per_m=shrink
+    )
 
 
 def test_first_choice_is_taken_within_the_floor_and_ceiling() -> None:
-    f = LookaheadFilter(LookaheadFilterSettings())
+    f = LookaheadFilter(ClothoidConfig())
     assert f.step(3.0, 8.0, 20.0, 0.2) == 8.0
     f.reset()
     assert f.step(12.0, 8.0, 20.0, 0.2) == 12.0
 
 
 def test_small_changes_are_ignored_and_large_ones_followed_at_the_rates() -> None:
-    f = LookaheadFilter(LookaheadFilterSettings(hysteresis_m=0.5, max_growth_m_per_m=0.3, max_shrink_m_per_m=1.0))
+    f = LookaheadFilter(_config(0.5, 0.3, 1.0))
     f.step(10.0, 5.0, 20.0, 0.2)
     assert f.step(10.4, 5.0, 20.0, 0.2) == 10.0  # inside the hysteresis band
     assert f.step(20.0, 5.0, 20.0, 0.2) == pytest.approx(10.06)  # grows 0.3 m per m travelled
@@ -27,13 +38,13 @@ def test_small_changes_are_ignored_and_large_ones_followed_at_the_rates() -> Non
 
 
 def test_a_rising_floor_applies_at_once() -> None:
-    f = LookaheadFilter(LookaheadFilterSettings(max_growth_m_per_m=0.01))
+    f = LookaheadFilter(ClothoidConfig(max_lookahead_growth_m_per_m=0.01))
     f.step(6.0, 5.0, 20.0, 0.2)
     assert f.step(6.0, 9.0, 20.0, 0.2) == 9.0
 
 
 def test_unlimited_rates_follow_at_once() -> None:
-    f = LookaheadFilter(LookaheadFilterSettings(hysteresis_m=0.0, max_growth_m_per_m=None, max_shrink_m_per_m=None))
+    f = LookaheadFilter(_config(0.0, None, None))
     f.step(5.0, 5.0, 20.0, 0.2)
     assert f.step(20.0, 5.0, 20.0, 0.2) == 20.0
     assert f.step(5.0, 5.0, 20.0, 0.2) == 5.0
@@ -49,7 +60,7 @@ def test_unlimited_rates_follow_at_once() -> None:
 def test_steps_stay_bounded_and_within_the_range(
     choices: list[float], floor: float, growth: float, shrink: float
 ) -> None:
-    f = LookaheadFilter(LookaheadFilterSettings(0.5, growth, shrink))
+    f = LookaheadFilter(_config(0.5, growth, shrink))
     distance = 0.2
     previous = None
     for choice in choices:
@@ -62,17 +73,18 @@ def test_steps_stay_bounded_and_within_the_range(
 
 @pytest.mark.parametrize(
     ("kwargs", "needle"),
-    [({"hysteresis_m": -1.0}, "hysteresis_m"), ({"max_growth_m_per_m": 0.0}, "max_growth_m_per_m"),
-     ({"max_shrink_m_per_m": True}, "max_shrink_m_per_m")],
+    [({"lookahead_hysteresis_m": -1.0}, "lookahead_hysteresis_m"),
+     ({"max_lookahead_growth_m_per_m": 0.0}, "max_lookahead_growth_m_per_m"),
+     ({"max_lookahead_shrink_m_per_m": True}, "max_lookahead_shrink_m_per_m")],
 )  # fmt: skip
 def test_bad_settings_are_refused(kwargs: dict, needle: str) -> None:
     with pytest.raises(WorkbenchInputError, match=needle):
-        LookaheadFilterSettings(**kwargs)
+        ClothoidConfig(**kwargs)
 
 
 # ------------------------------------------------------------------ each threshold and rate limit at its boundary
-def _started(at_m: float, settings: LookaheadFilterSettings | None = None) -> LookaheadFilter:
-    f = LookaheadFilter(settings or LookaheadFilterSettings())
+def _started(at_m: float, settings: ClothoidConfig | None = None) -> LookaheadFilter:
+    f = LookaheadFilter(settings or ClothoidConfig())
     assert f.step(at_m, 5.0, 20.0, 0.2) == at_m
     return f
 
@@ -104,7 +116,7 @@ def test_the_rate_limit_scales_with_the_distance_travelled() -> None:
 
 
 def test_a_falling_floor_takes_the_lookahead_down_by_as_much() -> None:
-    f = _started(12.0, LookaheadFilterSettings(max_growth_m_per_m=0.3))
+    f = _started(12.0, ClothoidConfig(max_lookahead_growth_m_per_m=0.3))
     assert f.step(12.0, 10.0, 20.0, 0.0) == 12.0  # a floor below the lookahead changes nothing
     assert f.step(12.0, 8.0, 20.0, 0.0) == 10.0  # the floor fell by 2 m: so does the lookahead (and no growth at 0 m)
     assert f.step(12.0, 8.0, 20.0, 0.0) == 10.0  # the same floor again: no further fall
@@ -112,43 +124,43 @@ def test_a_falling_floor_takes_the_lookahead_down_by_as_much() -> None:
 
 
 def test_a_ceiling_below_the_floor_yields_the_floor() -> None:
-    assert LookaheadFilter(LookaheadFilterSettings()).step(15.0, 10.0, 5.0, 0.2) == 10.0
+    assert LookaheadFilter(ClothoidConfig()).step(15.0, 10.0, 5.0, 0.2) == 10.0
 
 
 @pytest.mark.parametrize(
     ("kwargs", "allowed"),
     [
-        ({"hysteresis_m": 0.0}, True),
-        ({"hysteresis_m": 50.0}, True),
-        ({"hysteresis_m": 50.000001}, False),
-        ({"hysteresis_m": -1e-9}, False),
-        ({"max_growth_m_per_m": 100.0}, True),
-        ({"max_growth_m_per_m": 100.000001}, False),
-        ({"max_growth_m_per_m": 1e-9}, True),
-        ({"max_shrink_m_per_m": 100.0}, True),
-        ({"max_shrink_m_per_m": 100.000001}, False),
-        ({"max_shrink_m_per_m": 0.0}, False),
-        ({"max_shrink_m_per_m": None}, True),
-        ({"max_growth_m_per_m": None}, True),
+        ({"lookahead_hysteresis_m": 0.0}, True),
+        ({"lookahead_hysteresis_m": 50.0}, True),
+        ({"lookahead_hysteresis_m": 50.000001}, False),
+        ({"lookahead_hysteresis_m": -1e-9}, False),
+        ({"max_lookahead_growth_m_per_m": 100.0}, True),
+        ({"max_lookahead_growth_m_per_m": 100.000001}, False),
+        ({"max_lookahead_growth_m_per_m": 1e-9}, True),
+        ({"max_lookahead_shrink_m_per_m": 100.0}, True),
+        ({"max_lookahead_shrink_m_per_m": 100.000001}, False),
+        ({"max_lookahead_shrink_m_per_m": 0.0}, False),
+        ({"max_lookahead_shrink_m_per_m": None}, True),
+        ({"max_lookahead_growth_m_per_m": None}, True),
     ],
 )
 def test_settings_are_allowed_up_to_their_bounds(kwargs: dict, allowed: bool) -> None:
     if allowed:
-        LookaheadFilterSettings(**kwargs)
+        ClothoidConfig(**kwargs)
     else:
         with pytest.raises(WorkbenchInputError, match=next(iter(kwargs))):
-            LookaheadFilterSettings(**kwargs)
+            ClothoidConfig(**kwargs)
 
 
 @pytest.mark.parametrize(
     ("kwargs", "message"),
     [
-        ({"hysteresis_m": 51.0}, "hysteresis_m must be a finite number in [0, 50] m; got 51.0"),
-        ({"max_growth_m_per_m": 0.0}, "max_growth_m_per_m must be a finite number in (0, 100] m per m"),
-        ({"max_shrink_m_per_m": 101.0}, "max_shrink_m_per_m must be a finite number in (0, 100] m per m"),
+        ({"lookahead_hysteresis_m": 51.0}, "lookahead_hysteresis_m must be a finite number in [0, 50] m; got 51.0"),
+        ({"max_lookahead_growth_m_per_m": 0.0}, f"max_lookahead_growth_m_per_m {RATE_RANGE}"),
+        ({"max_lookahead_shrink_m_per_m": 101.0}, f"max_lookahead_shrink_m_per_m {RATE_RANGE}"),
     ],
 )
 def test_a_refused_setting_is_named_with_its_unit_and_range(kwargs: dict, message: str) -> None:
     with pytest.raises(WorkbenchInputError) as refused:
-        LookaheadFilterSettings(**kwargs)
+        ClothoidConfig(**kwargs)
     assert str(refused.value).startswith(message)
