@@ -49,10 +49,6 @@ MODULES: dict[str, tuple[str, tuple[str, ...]]] = {
         ("tests/workbench/simulation/test_metrics.py", "tests/workbench/simulation/test_track_margin.py"),
     ),
     "limit_cycle": ("workbench/simulation/limit_cycle.py", ("tests/workbench/simulation/test_limit_cycle.py",)),
-    "lookahead_filter": (
-        "controllers/clothoid/lookahead_filter.py",
-        ("tests/controllers/clothoid/test_lookahead_filter.py",),
-    ),
     "controller_screen": ("controllers/base.py", ("tests/controllers/test_base.py",)),
 }
 
@@ -92,9 +88,6 @@ EQUIVALENT: dict[str, str] = {
     _LC + "x__longest_cycle__mutmut_52": "a tie is pruned before this test (<= best_s above): never reached",
     _LC + "x_detect_limit_cycle__mutmut_18": "2 turning points are one half-cycle: never 3 cycles",
     _LC + "x_detect_limit_cycle__mutmut_19": "2 turning points are one half-cycle: never 3 cycles",
-    # the lookahead filter
-    "controllers.clothoid.lookahead_filter.xǁLookaheadFilterǁ__init____mutmut_15": "a third state entry, never read",
-    "controllers.clothoid.lookahead_filter.xǁLookaheadFilterǁreset__mutmut_1": "None stored in a float array is NaN",
     # the controllers' measurement screen
     "controllers.base.xǁControllerǁ_why_implausible__mutmut_5": "8 fields and 8 values: zip's strictness never acts",
     "controllers.base.xǁControllerǁ_why_implausible__mutmut_8": "8 fields and 8 values: zip's strictness never acts",
