@@ -213,12 +213,4 @@ class DynamicBicycle(CompiledVehicleModel):
             tyre_shape_factor=p.tyre_shape_factor,
             tyre_curvature_factor=p.tyre_curvature_factor,
         )
-        return PredictionParams(
-            wheelbase_m=a + b,
-            steering_ratio=p.steering_ratio,
-            max_road_wheel_angle_rad=p.max_road_wheel_angle_rad,
-            max_road_wheel_rate_rad_s=p.max_road_wheel_rate_rad_s,
-            steering_time_constant_s=p.steering_time_constant_s,
-            single_track=track,
-            source=source or f"the {self.name} model's parameters",
-        )
+        return PredictionParams.from_actuator(p, a + b, source or f"the {self.name} model's parameters", track)

@@ -100,16 +100,8 @@ class FmuPlant(VehicleModel):
             )
         lag = read_lag_file(p.lag_file) if p.lag_file is not None else None
         what = "single track" if track is not None else "kinematic single track"
-        return PredictionParams(
-            wheelbase_m=p.wheelbase_m,
-            steering_ratio=p.steering_ratio,
-            max_road_wheel_angle_rad=p.max_road_wheel_angle_rad,
-            max_road_wheel_rate_rad_s=p.max_road_wheel_rate_rad_s,
-            steering_time_constant_s=p.steering_time_constant_s,
-            single_track=track,
-            lag=lag,
-            source=(source or f"the {self.name} vehicle file") + f" ({what}{', identified lag' if lag else ''})",
-        )
+        source = (source or f"the {self.name} vehicle file") + f" ({what}{', identified lag' if lag else ''})"
+        return PredictionParams.from_actuator(p, p.wheelbase_m, source, track, lag)
 
     @property
     def rollover_threshold_g(self) -> float | None:

@@ -87,11 +87,4 @@ class KinematicBicycle(CompiledVehicleModel):
     def single_track(self, source: str | None = None) -> PredictionParams:
         """The kinematic single track with this model's actuator (no tyres)."""
         p = self.params
-        return PredictionParams(
-            wheelbase_m=p.wheelbase_m,
-            steering_ratio=p.steering_ratio,
-            max_road_wheel_angle_rad=p.max_road_wheel_angle_rad,
-            max_road_wheel_rate_rad_s=p.max_road_wheel_rate_rad_s,
-            steering_time_constant_s=p.steering_time_constant_s,
-            source=source or f"the {self.name} model's parameters",
-        )
+        return PredictionParams.from_actuator(p, p.wheelbase_m, source or f"the {self.name} model's parameters")

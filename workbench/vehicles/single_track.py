@@ -11,6 +11,7 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass
+from typing import Protocol
 
 import numpy as np
 
@@ -97,6 +98,23 @@ class SingleTrackParams:
         return float(np.max(np.abs(np.linalg.eigvals(mat))))
 
 
+class SteeringActuator(Protocol):
+    """The steering actuator as a model's params describe it: the steering-wheel to road-wheel ratio, the
+    road-wheel angle (rad) and rate (rad/s) limits and the first-order time constant (s)."""
+
+    @property
+    def steering_ratio(self) -> float: ...
+
+    @property
+    def max_road_wheel_angle_rad(self) -> float: ...
+
+    @property
+    def max_road_wheel_rate_rad_s(self) -> float: ...
+
+    @property
+    def steering_time_constant_s(self) -> float: ...
+
+
 @dataclass(frozen=True)
 class PredictionParams:
     """The vehicle as the MPC predicts it (SI units).
@@ -127,6 +145,29 @@ class PredictionParams:
                 f"single_track axle positions add up to {float(self.single_track.wheelbase_m):g} m; they must "
                 f"equal wheelbase_m = {float(self.wheelbase_m):g} m"
             )
+
+    @classmethod
+    def from_actuator(
+        cls,
+        actuator: SteeringActuator,
+        wheelbase_m: float,
+        source: str,
+        single_track: SingleTrackParams | None = None,
+        lag: SteeringLag | None = None,
+    ) -> PredictionParams:
+        """A model's prediction parameters: its steering actuator's (`actuator`: the steering ratio, the road-wheel
+        angle and rate limits, the time constant, which every model's params hold) with the wheelbase (m), single
+        track, identified lag and source the model gives."""
+        return cls(
+            wheelbase_m=wheelbase_m,
+            steering_ratio=actuator.steering_ratio,
+            max_road_wheel_angle_rad=actuator.max_road_wheel_angle_rad,
+            max_road_wheel_rate_rad_s=actuator.max_road_wheel_rate_rad_s,
+            steering_time_constant_s=actuator.steering_time_constant_s,
+            single_track=single_track,
+            lag=lag,
+            source=source,
+        )
 
     def with_lag(self, lag: SteeringLag | None) -> PredictionParams:
         """A copy with this identified lag (None removes it)."""

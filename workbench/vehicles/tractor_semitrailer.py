@@ -473,16 +473,10 @@ class TractorSemitrailer(CompiledVehicleModel):
             tyre_shape_factor=p.tyre_shape_factor,
             tyre_curvature_factor=0.0,
         )
-        source = source or f"the {self.name} model's parameters"
-        return PredictionParams(
-            wheelbase_m=l1,
-            steering_ratio=p.steering_ratio,
-            max_road_wheel_angle_rad=p.max_road_wheel_angle_rad,
-            max_road_wheel_rate_rad_s=p.max_road_wheel_rate_rad_s,
-            steering_time_constant_s=p.steering_time_constant_s,
-            single_track=track,
-            source=source + " (equivalent single track: tractor + kingpin share of the trailer at the fifth wheel)",
+        source = (source or f"the {self.name} model's parameters") + (
+            " (equivalent single track: tractor + kingpin share of the trailer at the fifth wheel)"
         )
+        return PredictionParams.from_actuator(p, l1, source, track)
 
     def describe(self) -> str:
         dv = self.derived

@@ -10,7 +10,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from workbench.vehicles import make_vehicle
-from workbench.vehicles.single_track import SingleTrackParams
+from workbench.vehicles.single_track import PredictionParams, SingleTrackParams
 
 TRACK = make_vehicle("dynamic-bicycle").single_track().single_track
 
@@ -46,3 +46,20 @@ def test_beyond_the_peak_the_slip_is_that_of_99_percent_of_it() -> None:
     assert _force(alpha_f, 7000.0, 80_000.0, shape) == pytest.approx(0.99 * 7000.0, rel=1e-9)
     assert _force(alpha_r, 8000.0, 90_000.0, shape) == pytest.approx(0.99 * 8000.0, rel=1e-9)
     assert track.steady_slip_angles_rad(-50.0) == (-alpha_f, -alpha_r)
+
+
+@pytest.mark.parametrize("name", ["kinematic-bicycle", "dynamic-bicycle", "tractor-semitrailer"])
+def test_a_models_prediction_carries_its_actuator_from_its_params(name: str) -> None:
+    model = make_vehicle(name)
+    prediction, p = model.single_track(), model.params
+    assert prediction == PredictionParams.from_actuator(
+        p, prediction.wheelbase_m, prediction.source, prediction.single_track, prediction.lag
+    )
+    assert (prediction.steering_ratio, prediction.max_road_wheel_angle_rad) == (
+        p.steering_ratio,
+        p.max_road_wheel_angle_rad,
+    )
+    assert (prediction.max_road_wheel_rate_rad_s, prediction.steering_time_constant_s) == (
+        p.max_road_wheel_rate_rad_s,
+        p.steering_time_constant_s,
+    )
