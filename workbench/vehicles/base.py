@@ -15,7 +15,7 @@ from __future__ import annotations
 import math
 from abc import ABC, abstractmethod
 from collections.abc import Callable
-from typing import Any, ClassVar
+from typing import ClassVar, Generic, Protocol, TypeVar
 
 import numpy as np
 
@@ -40,14 +40,33 @@ STANDARD_OUTPUTS: tuple[str, ...] = (
 #: road the tyre data describe (1.0): from about ice (0.05) to a road half as grippy again (1.5).
 ROAD_FRICTION_RANGE: tuple[float, float] = (0.05, 1.5)
 
+class VehicleParams(Protocol):
+    """What the base class reads of every model's parameters (a frozen dataclass per model): the steering ratio
+    and the longitudinal limits the acceleration command is clipped to."""
+
+    @property
+    def steering_ratio(self) -> float: ...
+
+    @property
+    def max_accel_mps2(self) -> float: ...
+
+    @property
+    def max_decel_mps2(self) -> float: ...
+
+
+#: A model's parameter dataclass (`VehicleModel[TheirParams]`).
+ParamsT = TypeVar("ParamsT", bound=VehicleParams)
+
+
 class PlantStepError(WorkbenchInputError):
     """A plant failed a step and cannot go on (an FMU plant's doStep returned an error): the message says when and
     why. The simulator ends the run with status `plant_failed`; any other caller shows it as an error."""
 
 
-class VehicleModel(ABC):
-    """A plant. Subclasses set `name`, `state_names`, `extra_output_names`, and in `__init__` `params` (a frozen
-    dataclass with max_accel_mps2 and max_decel_mps2) and `_geometry`; they implement `advance` and `outputs`.
+class VehicleModel(ABC, Generic[ParamsT]):
+    """A plant. Subclasses (`VehicleModel[TheirParams]`) set `name`, `state_names`, `extra_output_names`, and in
+    `__init__(params)` `params` (a frozen dataclass, `VehicleParams`) and `_geometry`; they implement `advance` and
+    `outputs`.
 
     The default `initial_state` suits models whose first four states are x_m, y_m, yaw_rad and the longitudinal
     speed, with every other state zero except those in `heading_states` (yaws of trailing units, in line).
@@ -67,10 +86,15 @@ class VehicleModel(ABC):
     #: Whether the model has tyres whose friction `set_road_friction` scales (a subclass setting True implements
     #: `_apply_road_friction`).
     has_tyres: ClassVar[bool] = False
-    params: Any
+    params: ParamsT
     _geometry: VehicleGeometry
     #: The road-friction scale in force; an instance attribute once `set_road_friction` has been called.
     _road_friction: float = 1.0
+
+    def __init__(self, params: ParamsT) -> None:
+        """A model is built from its parameters alone; a subclass's `__init__` (which need not call this one) also
+        sets `_geometry` and whatever it computes from them."""
+        self.params = params
 
     @property
     def geometry(self) -> VehicleGeometry:
@@ -164,7 +188,7 @@ class VehicleModel(ABC):
         )
 
 
-class CompiledVehicleModel(VehicleModel):
+class CompiledVehicleModel(VehicleModel[ParamsT]):
     """A model whose numerics are compiled with numba, on a parameter array `_p` built in `__init__`.
 
     Subclasses set `_advance_kernel = staticmethod(_advance)`, their module's cached
@@ -188,6 +212,7 @@ class CompiledVehicleModel(VehicleModel):
         return self._outputs_kernel(
             np.asarray(state, dtype=float), self._p, delta_cmd, accel, self.params.steering_ratio
         )
+
 
 def models_with_tyres() -> list[str]:
     """The names of the vehicle models with tyres (`VehicleModel.has_tyres`), sorted: those a road friction other

@@ -104,7 +104,7 @@ def _commonroad_parameters(vehicle_id: int) -> Any:
     return {1: parameters_vehicle1, 2: parameters_vehicle2, 3: parameters_vehicle3}[vehicle_id]()
 
 
-class CommonRoadMB(VehicleModel):
+class CommonRoadMB(VehicleModel[CommonRoadMBParams]):
     name: ClassVar[str] = "commonroad-mb"
     state_names: ClassVar[tuple[str, ...]] = _MB_STATES
     extra_output_names: ClassVar[tuple[str, ...]] = ("roll_rad", "path_curvature_1pm")

@@ -148,7 +148,7 @@ def _outputs(s, p, delta_cmd, accel, ratio):  # pragma: no cover - compiled
     return out
 
 
-class DynamicBicycle(CompiledVehicleModel):
+class DynamicBicycle(CompiledVehicleModel[DynamicBicycleParams]):
     name: ClassVar[str] = "dynamic-bicycle"
     state_names: ClassVar[tuple[str, ...]] = (
         "x_m",

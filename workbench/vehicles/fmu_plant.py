@@ -48,7 +48,7 @@ TIME_STATE = "fmu_time_s"
 _STEP_SLACK = 1e-9
 
 
-class FmuPlant(VehicleModel):
+class FmuPlant(VehicleModel[FmuPlantParams]):
     """A plant from the user's FMU (module docstring)."""
 
     name: ClassVar[str] = "fmu"
@@ -58,11 +58,13 @@ class FmuPlant(VehicleModel):
         self.params = p = params
         self._geometry = VehicleGeometry.from_params(p, p.wheelbase_m)
         self.interface = read_fmu_interface(p)
+        # has_tyres and the names are class constants of every other model; an FMU plant's follow from its file, so
+        # they are set per instance (the base class reads them through self either way)
         self.has_tyres = p.friction_parameter is not None  # type: ignore[misc]
         extras = tuple(OPTIONAL_OUTPUTS[f] for f in p.output_fields() if f in OPTIONAL_OUTPUTS)
         self._with_curvature = p.ltr_output is not None
-        self.extra_output_names = extras + ((PATH_CURVATURE,) if self._with_curvature else ())
-        self.state_names = (*STANDARD_OUTPUTS, *self.extra_output_names, TIME_STATE)
+        self.extra_output_names = extras + ((PATH_CURVATURE,) if self._with_curvature else ())  # type: ignore[misc]
+        self.state_names = (*STANDARD_OUTPUTS, *self.extra_output_names, TIME_STATE)  # type: ignore[misc]
         refs = self.interface.value_references
         self._input_refs = [refs[name] for name in p.input_names()]
         self._output_fields = p.output_fields()

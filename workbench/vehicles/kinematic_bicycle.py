@@ -65,7 +65,7 @@ def _advance(state, p, delta_cmd, accel, h, n):  # pragma: no cover - compiled
     return rk4(_rhs, state, p, delta_cmd, accel, h, n)
 
 
-class KinematicBicycle(CompiledVehicleModel):
+class KinematicBicycle(CompiledVehicleModel[KinematicBicycleParams]):
     name: ClassVar[str] = "kinematic-bicycle"
     state_names: ClassVar[tuple[str, ...]] = ("x_m", "y_m", "yaw_rad", "speed_mps", "road_wheel_angle_rad")
 
