@@ -263,8 +263,9 @@ class Simulation:
             )
             if accel_cmd != accel_cmd:  # NaN: the speed, its reference or the reference's rate is not finite
                 s_m = float(foot[FOOT_S])
-                rate = speed * path.speed_gradient(s_m) if cfg.speed_feedforward else 0.0
-                speeds = (float(path.speed(s_m)), speed, rate)
+                reference, slope = path.speed(s_m), path.speed_gradient(s_m)  # the run's path has its planned speed
+                rate = speed * slope if cfg.speed_feedforward and slope is not None else 0.0
+                speeds = (reference, speed, rate)
                 require_finite("the speed reference, the speed and the reference's rate (m/s, m/s, m/s^2)", speeds)
             log.n = step + 1
             try:
