@@ -1,5 +1,5 @@
 """The simulator's own work at each controller step, compiled: two calls a step around the controller's, no
-per-step Python objects (issue 19).
+per-step Python objects.
 
 `project_pose`, before the controller: the pose projected onto the path (`path_search.track` on a
 `PathTracker`'s state and output arrays, advanced in place) and whether the run ends there (PROJECTED_*).
