@@ -94,9 +94,8 @@ def compile_function(function: ca.Function, enabled: bool = True) -> CompiledFun
     generator = ca.CodeGenerator(f"{function.name()}.c", {"with_header": False})
     generator.add(function)
     source = generator.dump()
-    key = hashlib.sha256("\n".join((source, compiler, " ".join(COMPILE_FLAGS), ca.__version__)).encode()).hexdigest()[
-        :20
-    ]
+    version = ca.__version__  # type: ignore[attr-defined]  # (casadi's stubs omit it)
+    key = hashlib.sha256("\n".join((source, compiler, " ".join(COMPILE_FLAGS), version)).encode()).hexdigest()[:20]
     try:
         directory = cache_dir()
     except OSError as exc:
@@ -139,19 +138,20 @@ class FastFunction:
         self._evaluate = None
         if hasattr(function, "buffer"):
             self._buffer, self._evaluate = function.buffer()
+            # (casadi's stubs ask a size and a Buffer: the binding takes both from the array's memoryview)
             for i, array in enumerate(self.inputs):
-                self._buffer.set_arg(i, memoryview(array))
+                self._buffer.set_arg(i, memoryview(array))  # type: ignore[call-arg, arg-type]
             for i, array in enumerate(self.outputs):
-                self._buffer.set_res(i, memoryview(array))
+                self._buffer.set_res(i, memoryview(array))  # type: ignore[call-arg, arg-type]
 
     def __call__(self, *args: np.ndarray) -> list[np.ndarray]:
         for target, value in zip(self.inputs, args, strict=True):
             target[:] = value.ravel(order="F") if isinstance(value, np.ndarray) else np.ravel(value, order="F")
         if self._evaluate is None:  # pragma: no cover - CasADi < 3.6
-            results = self.function(*[np.reshape(a, self.function.size_in(i), order="F") for i, a in enumerate(args)])
-            results = results if isinstance(results, tuple) else (results,)
-            for target, value in zip(self.outputs, results, strict=True):
-                target[:] = np.ravel(np.asarray(value), order="F")
+            called = self.function(*[np.reshape(a, self.function.size_in(i), order="F") for i, a in enumerate(args)])
+            results = called if isinstance(called, tuple) else (called,)
+            for target, result in zip(self.outputs, results, strict=True):
+                target[:] = np.ravel(np.asarray(result), order="F")
             return self.outputs
         self._evaluate()
         if self._buffer.ret() != 0:

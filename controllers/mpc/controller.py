@@ -211,14 +211,15 @@ class MPCController(Controller[MPCConfigT]):
         along = self._preview.along(s0, progress, v0, ocp.min_speed_mps)
         kappa, speed = along[:, 0], along[:, 1]
         first = shifted is None
-        if first:
+        dual: tuple[np.ndarray, ...] = ()
+        if shifted is None:
             guess_inputs = np.zeros((ocp.N, ocp.nu))
             guess_states = ocp.rollout(x0, guess_inputs, kappa, speed)
-            dual: tuple[np.ndarray, ...] = ()
         else:
             guess_states, guess_inputs = shifted[0], shifted[1]
             # Only IPOPT returns multipliers; the QP solvers keep their own, so no positions are computed for them.
-            dual = self.solver.shift_dual(plan.dual, plan.positions(origin)) if plan.dual else ()
+            if plan is not None and plan.dual:  # (a shifted plan is there exactly when a plan is)
+                dual = self.solver.shift_dual(plan.dual, plan.positions(origin))
         result = self.solver.solve(x0, kappa, speed, guess_states, guess_inputs, dual, first)
 
         t_next = origin + self._sample_time_s

@@ -22,6 +22,7 @@ LATE and is not used.
 from __future__ import annotations
 
 import time
+from typing import Any
 
 import casadi as ca
 import numpy as np
@@ -60,7 +61,7 @@ class IpoptSolver:
         p = ca.vertcat(x0, kappa, speed)
         X = [w[self.ix[k]] for k in range(N + 1)]
         U = [w[self.iu[k]] for k in range(N)]
-        f = 0
+        f: ca.SX | float = 0  # the cost, summed over the stages
         g = [X[0] - x0]
         for k in range(N):
             pk = ca.vertcat(kappa[k], speed[k])
@@ -77,7 +78,7 @@ class IpoptSolver:
                 f += rho * eps * eps + rho * eps
         self.n_con = self.n_eq + 2 * ns
         self._nlp = {"x": w, "p": p, "f": f, "g": ca.vertcat(*g)}
-        self._options = {
+        self._options: dict[str, Any] = {
             "expand": True,
             "print_time": False,
             "error_on_fail": False,

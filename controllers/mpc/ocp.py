@@ -94,7 +94,7 @@ class TrackingOCP:
         self.u_upper = np.array([params.max_road_wheel_rate_rad_s])
         self.bounds_version = 0  # incremented whenever the bounds change, so solvers update only then
 
-    def sparse_qp(self, settings: OsqpSettings) -> SparseMPCQP:
+    def sparse_qp(self, settings: OsqpSettings | None) -> SparseMPCQP:
         """The OSQP problem of this OCP's weights and bounds (with the soft lateral-acceleration rows when the
         limit is set), built once; the solvers overwrite its dynamics each step."""
         slack = self.weights.lat_accel_slack

@@ -134,6 +134,7 @@ class PredictionModel:
         kappa, v = p[0], p[1]
         e_y, e_psi, delta_c = x[0], x[1], x[self.i_cmd]
         wheelbase = prm.wheelbase_m
+        v_rear: ca.SX | float  # the rear axle's lateral speed: 0 in the kinematic kinds
         if kind == "dynamic":
             st = prm.single_track
             assert st is not None

@@ -24,6 +24,7 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import osqp
@@ -230,7 +231,7 @@ class SparseMPCQP:
         self.solver.setup(
             P=P, q=self.q.copy(), A=A, l=self.lower.copy(), u=self.upper.copy(), **self.settings.as_kwargs()
         )
-        self._native = getattr(self.solver, "_solver", None)
+        self._native: Any = getattr(self.solver, "_solver", None)  # osqp 1.x's own object (checked below)
         #: Whether the last `update` held data OSQP cannot use (then `solve` reports NUMERICAL_ERROR).
         self.refused = False
         if not all(hasattr(self._native, name) for name in ("update_data_vec", "update_data_mat", "solve", "info")):
