@@ -9,7 +9,8 @@ Required: format, omega_z_rad_s, psi, omega_p_rad_s (Eq. 6; rad/s, -, rad/s). Op
 has unit DC gain), source (free text), plant (the Eq. 5 lag the filter was designed for), speed_kmh (the design
 speed of the top-level filter), schedule (filters against speed, km/h strictly increasing; when present it is what
 the controller uses, and the top-level filter is the nominal design kept for readers that ignore schedules) and
-design (free design metadata such as bandwidths, kept in `FilterSchedule.metadata` and otherwise ignored).
+design (free design metadata such as bandwidths; a tuning directory's lead file keeps its identified lags and
+floors there, which `tuning_dirs` reads into a `VehicleTuning`; the schedule itself ignores it).
 Any other key is an error, so that a misspelt key is not silently ignored.
 """
 
@@ -94,9 +95,8 @@ def read_filter_file(path: str | Path) -> FilterSchedule:
             raise _fail(path, f"plant.{exc}") from None
     if "design" in doc and not isinstance(doc["design"], Mapping):
         raise _fail(path, f"design must be a table/object; got {doc['design']!r}")
-    metadata = {k: doc[k] for k in OPTIONAL_KEYS if k in doc and k != "schedule"}
     if "schedule" not in doc:
-        return FilterSchedule((0.0 if speed is None else speed,), (nominal,), source, metadata)
+        return FilterSchedule((0.0 if speed is None else speed,), (nominal,), source)
     entries = doc["schedule"]
     if not isinstance(entries, list) or not entries:
         raise _fail(path, f"schedule must be a non-empty list of tables; got {entries!r}")
@@ -106,7 +106,7 @@ def read_filter_file(path: str | Path) -> FilterSchedule:
         speeds.append(_number(path, f"schedule[{i}].speed_kmh", entry["speed_kmh"]))
         params.append(_params(path, f"schedule[{i}].", entry))
     try:
-        return FilterSchedule(tuple(speeds), tuple(params), source, metadata)
+        return FilterSchedule(tuple(speeds), tuple(params), source)
     except WorkbenchInputError as exc:
         raise _fail(path, str(exc)) from None
 

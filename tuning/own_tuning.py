@@ -36,6 +36,8 @@ from workbench.vehicles.base import VehicleModel
 
 if TYPE_CHECKING:  # the clothoid controller and the tuning tools (python-control, SciPy: ~2 s to import) are
     # imported where a tuning is looked up, not by every run that imports this module (pure pursuit's)
+    from _typeshed import DataclassInstance
+
     from controllers.base import Controller
     from controllers.clothoid.vehicle_tuning import VehicleTuning
     from tuning.preset_tuning import PresetTuningOptions
@@ -232,7 +234,7 @@ def with_vehicle_tuning(config: ConfigT, vehicle: VehicleModel) -> ConfigT:
 
 
 def tuned_controller(
-    name: str, vehicle: VehicleModel, config: object | None = None, delays: KnownDelays | None = None
+    name: str, vehicle: VehicleModel, config: DataclassInstance | None = None, delays: KnownDelays | None = None
 ) -> Controller:
     """The controller registered under `name` for `vehicle`, its config (the default when None) given the
     vehicle's own tuning where it takes one (the clothoid controller), then told `delays` when given

@@ -34,6 +34,7 @@ from scipy.constants import g as G_MPS2  # standard gravity, 9.80665 m/s^2
 
 from controllers.clothoid.filter_schedule import FilterSchedule
 from controllers.clothoid.loop_analysis import LoopSettings, PlantLags
+from controllers.clothoid.loop_requirements import REQUIRED_GAIN_MARGIN_DB, REQUIRED_PHASE_MARGIN_DEG
 from tuning.data_generation import generate_open_loop_log
 from tuning.filter_file import write_filter_file
 from tuning.lag_fit import LagFit, LagFitOptions, fit_lag
@@ -216,6 +217,8 @@ class ScheduleResult:
                 prediction_time_s=self.prediction_time_s,
                 arc_lateral_accel_g=MARGINS_ARC_LATERAL_ACCEL_G,
                 lookahead_range_m=list(MARGINS_LOOKAHEAD_M),
+                phase_margin_deg=REQUIRED_PHASE_MARGIN_DEG,
+                gain_margin_db=REQUIRED_GAIN_MARGIN_DB,
             )
         design.update(
             lat_accel_g=self.lat_accel_g,

@@ -16,6 +16,7 @@ from pathlib import Path
 from typing import Any
 
 from controllers.clothoid.filter_schedule import FilterSchedule
+from controllers.clothoid.loop_requirements import REQUIRED_GAIN_MARGIN_DB, REQUIRED_PHASE_MARGIN_DEG
 from controllers.clothoid.vehicle_tuning import FloorDesign, VehicleTuning
 from tuning.filter_file import read_filter_file
 from tuning.limits_file import read_limits_file
@@ -231,8 +232,9 @@ FLOOR_DESIGN_KEYS = ("controller_rate_hz", "prediction_time_s", "arc_lateral_acc
 
 def _floors(path: Path, design: Mapping[str, Any]) -> tuple[tuple[tuple[float, float], ...], FloorDesign | None]:
     """((speed_kmh, lookahead_floor_m) of the rows of design.per_speed that have one, what they were computed for):
-    ((), None) unless the design is "margins" with its loop (FLOOR_DESIGN_KEYS). The margins kept are
-    `loop_requirements`' (the design keeps them; its file does not name them)."""
+    ((), None) unless the design is "margins" with its loop (FLOOR_DESIGN_KEYS). The margins kept are the design's
+    phase_margin_deg and gain_margin_db; a file without them was made with `loop_requirements`' (the shipped
+    files: the margins design keeps those)."""
     if design.get("method") != "margins" or any(k not in design for k in FLOOR_DESIGN_KEYS):
         return (), None
     try:
@@ -245,7 +247,12 @@ def _floors(path: Path, design: Mapping[str, Any]) -> tuple[tuple[tuple[float, f
         )
     except (TypeError, ValueError) as exc:
         raise WorkbenchInputError(f"{path}: design's floors ({list(FLOOR_DESIGN_KEYS)}, per_speed): {exc}") from None
-    return floors, FloorDesign(1.0 / rate_hz, prediction_s, arc_g, (low, high, step))
+    try:
+        phase_deg = float(design.get("phase_margin_deg", REQUIRED_PHASE_MARGIN_DEG))
+        gain_db = float(design.get("gain_margin_db", REQUIRED_GAIN_MARGIN_DB))
+    except (TypeError, ValueError) as exc:
+        raise WorkbenchInputError(f"{path}: design's phase_margin_deg, gain_margin_db: {exc}") from None
+    return floors, FloorDesign(1.0 / rate_hz, prediction_s, arc_g, (low, high, step), phase_deg, gain_db)
 
 
 def _row_lag(path: Path, i: int, row: Mapping[str, Any], prefix: str, speed: float) -> SteeringLag:

@@ -7,10 +7,7 @@ import bisect
 import functools
 import itertools
 import math
-from collections.abc import Mapping
-from dataclasses import dataclass, field
-from types import MappingProxyType
-from typing import Any
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -32,12 +29,11 @@ DEFAULT_FILTER = LeadFilterParams.from_lag(4.44, 0.80)
 @dataclass(frozen=True)
 class FilterSchedule:
     """Lead filters against speed: speeds_kmh (km/h, strictly increasing; one entry: the same filter at every
-    speed) and one LeadFilterParams per speed. metadata holds the file's other content (source, plant, design...)."""
+    speed) and one LeadFilterParams per speed; source says where they come from."""
 
     speeds_kmh: tuple[float, ...]
     params: tuple[LeadFilterParams, ...]
     source: str = ""
-    metadata: Mapping[str, Any] = field(default_factory=dict, compare=False, repr=False)
 
     def __post_init__(self) -> None:
         speeds, params = tuple(self.speeds_kmh), tuple(self.params)
@@ -54,7 +50,6 @@ class FilterSchedule:
             raise WorkbenchInputError(f"schedule speeds_kmh must be strictly increasing; got {list(speeds)}")
         object.__setattr__(self, "speeds_kmh", tuple(float(s) for s in speeds))
         object.__setattr__(self, "params", params)
-        object.__setattr__(self, "metadata", MappingProxyType(dict(self.metadata)))
 
     @classmethod
     def single(cls, params: LeadFilterParams, speed_kmh: float = 0.0, source: str = "") -> FilterSchedule:

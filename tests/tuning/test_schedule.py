@@ -10,6 +10,7 @@ from tuning.filter_file import read_filter_file
 from tuning.lag_fit import DELAY_FIT_MAX_ZETA, LagFitOptions
 from tuning.schedule import identify_schedule, steer_amplitude_deg
 from workbench.base.errors import WorkbenchInputError
+from workbench.base.input_files import read_json, read_toml
 
 
 def test_the_trucks_lag_slows_with_speed(result) -> None:
@@ -29,8 +30,9 @@ def test_the_schedule_round_trips_through_read_filter_file(result, tmp_path: Pat
     schedule = read_filter_file(path)
     assert schedule.speeds_kmh == (30.0, 60.0, 90.0)
     assert schedule.params == tuple(e.design.params for e in result.entries)
-    assert schedule.metadata["plant"]["omega_n_rad_s"] == result.entries[0].fit.lag.omega_n_rad_s
-    per_speed = schedule.metadata["design"]["per_speed"]
+    doc = (read_json if suffix == ".json" else read_toml)(path, "the schedule file")  # the rest, as written
+    assert doc["plant"]["omega_n_rad_s"] == result.entries[0].fit.lag.omega_n_rad_s
+    per_speed = doc["design"]["per_speed"]
     assert [row["speed_kmh"] for row in per_speed] == [30.0, 60.0, 90.0]
     mid = schedule.at_speed(45.0)
     p30, p60 = result.entries[0].design.params, result.entries[1].design.params
@@ -38,9 +40,10 @@ def test_the_schedule_round_trips_through_read_filter_file(result, tmp_path: Pat
 
 
 def test_the_nominal_filter_is_the_one_of_the_nominal_speed(result, tmp_path: Path) -> None:
-    schedule = read_filter_file(result.write(tmp_path / "s60.json", nominal_speed_kmh=60.0))
-    assert schedule.metadata["speed_kmh"] == 60.0
-    assert schedule.metadata["plant"]["omega_n_rad_s"] == result.entries[1].fit.lag.omega_n_rad_s
+    path = result.write(tmp_path / "s60.json", nominal_speed_kmh=60.0)
+    doc = read_json(path, "the schedule file")
+    assert read_filter_file(path).speeds_kmh == (30.0, 60.0, 90.0) and doc["speed_kmh"] == 60.0
+    assert doc["plant"]["omega_n_rad_s"] == result.entries[1].fit.lag.omega_n_rad_s
 
 
 @pytest.mark.parametrize("speed", [50.0, 59.9, 0.0, float("nan")])
@@ -79,10 +82,11 @@ def test_the_margins_design_records_both_lags_and_the_floors(margins_result, tmp
     floors = [e.margins.floor_m for e in result.entries]
     assert floors == pytest.approx([8.5, 17.5], abs=1.0)
     path = result.write(tmp_path / "lead.json")
-    schedule = read_filter_file(path)
-    design = schedule.metadata["design"]
+    read_filter_file(path)
+    design = read_json(path, "the schedule file")["design"]
     assert design["method"] == "margins" and "max_cascade_peak_db" not in design
     assert design["controller_rate_hz"] == 50.0 and design["prediction_time_s"] == 0.2
+    assert (design["phase_margin_deg"], design["gain_margin_db"]) == (45.0, 6.0)  # the floors' margins
     assert design["maneuvers"] == ["dlc", "step-series", "chirp"]
     for row, e in zip(design["per_speed"], result.entries, strict=True):
         assert row["measured_omega_n_rad_s"] == e.measured_fit.lag.omega_n_rad_s

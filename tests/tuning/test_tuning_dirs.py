@@ -98,7 +98,8 @@ def test_the_shipped_files_parse_and_the_lags_are_sane(name: str) -> None:
     assert tuning.lag_speeds_kmh == schedule.speeds_kmh
     assert schedule.speeds_kmh == PRESET_TUNING_OPTIONS.schedule_speeds_kmh, "a speed was dropped; see the manifest"
     assert [s for s, _ in tuning.measured_lags] == list(schedule.speeds_kmh)
-    design = schedule.metadata["design"]
+    design = json.loads((shipped_tuning_root() / name / LEAD_FILE).read_text())["design"]
+    assert tuning.floors == tuple((row["speed_kmh"], row["lookahead_floor_m"]) for row in design["per_speed"])
     assert design["method"] == "margins" and design["maneuvers"] == ["dlc", "step-series", "chirp"]
     for (speed, lag), (_, measured), row in zip(tuning.lags, tuning.measured_lags, design["per_speed"], strict=True):
         for one in (lag, measured):
@@ -242,7 +243,7 @@ def test_a_lead_file_with_the_measured_lag_at_some_speeds_only_is_refused(tmp_pa
 
 def test_the_shipped_measured_lags_are_read() -> None:
     tuning = read_vehicle_tuning(shipped_tuning_root() / "tractor-semitrailer")
-    rows = tuning.filter_schedule.metadata["design"]["per_speed"]
+    rows = json.loads((shipped_tuning_root() / "tractor-semitrailer" / LEAD_FILE).read_text())["design"]["per_speed"]
     at_60 = next(r for r in rows if r["speed_kmh"] == 60.0)
     measured = tuning.measured_lag_at(60.0)
     assert measured.omega_n_rad_s == at_60["measured_omega_n_rad_s"] and measured.zeta == at_60["measured_zeta"]

@@ -85,7 +85,7 @@ def require_in_range(
 
 def require_whole(name: str, value: object, low: int, high: int) -> None:
     """Raise WorkbenchInputError unless `value` is a whole number (not a boolean, not a float) in [low, high]."""
-    if not isinstance(value, numbers.Integral) or isinstance(value, bool | np.bool_) or not low <= value <= high:
+    if not isinstance(value, numbers.Integral) or isinstance(value, bool | np.bool_) or not low <= int(value) <= high:
         raise WorkbenchInputError(f"{name} must be a whole number in [{low}, {high}]; got {value_text(value)}")
 
 

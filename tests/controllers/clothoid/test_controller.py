@@ -113,12 +113,9 @@ def test_command_chain_of_figure_2() -> None:
 def test_curvature_rate_limit_bounds_the_integrator() -> None:
     """Section 4: |d kappa / dt| never exceeds the limit of the table, however large the fitted kappa'."""
     limits_rate = 0.01
-    controller = ClothoidController(GEOMETRY, ClothoidConfig(use_lead_filter=False, prediction_time_s=0.0))
-    object.__setattr__(
-        controller,
-        "limits",
-        CurvatureLimits((0.0, 100.0), (0.05, 0.05), (limits_rate, limits_rate), source="test"),
-    )
+    limits = CurvatureLimits((0.0, 100.0), (0.05, 0.05), (limits_rate, limits_rate), source="test")
+    config = ClothoidConfig(use_lead_filter=False, prediction_time_s=0.0, curvature_limits=limits)
+    controller = ClothoidController(GEOMETRY, config)
     controller.reset(BEND, 0.02)
     previous = 0.0
     for k in range(30):

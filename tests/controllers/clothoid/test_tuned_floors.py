@@ -5,6 +5,9 @@ arc, search grid and margins), and computed where not; the floors used equal tho
 from __future__ import annotations
 
 import dataclasses
+import json
+import shutil
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -12,7 +15,8 @@ import pytest
 from controllers.clothoid import loop_analysis
 from controllers.clothoid.controller import FLOOR_SPEED_BAND_KMH, ClothoidConfig, ClothoidController
 from controllers.clothoid.vehicle_tuning import FloorDesign
-from tuning.own_tuning import tuning_for
+from tuning.own_tuning import shipped_tuning_dir, tuning_for
+from tuning.tuning_dirs import LEAD_FILE, MANIFEST_FILE, files_sha256, read_vehicle_tuning
 from workbench.base.errors import WorkbenchInputError
 from workbench.base.path import ReferencePath
 from workbench.vehicles import make_vehicle
@@ -109,3 +113,26 @@ def test_the_step_tables_are_built_once(monkeypatch: pytest.MonkeyPatch) -> None
     controller.reset(STRAIGHT, 0.01)
     assert len(built) == 1
     assert controller._lags is controller.tuning.lag_tables[1]
+
+
+def test_a_design_with_other_margins_has_floors_the_controller_computes_with_its_own(
+    tmp_path: Path, computed: list[tuple[float, float]]
+) -> None:
+    """A lead file's design names the margins its floors keep; floors kept with other margins than the controller's
+    are not its floors."""
+    vehicle = make_vehicle("tractor-semitrailer")
+    copied = tmp_path / "tuning"
+    shutil.copytree(shipped_tuning_dir(vehicle), copied)
+    lead = copied / LEAD_FILE
+    doc = json.loads(lead.read_text())
+    doc["design"]["phase_margin_deg"] = 50.0
+    lead.write_text(json.dumps(doc))
+    manifest = json.loads((copied / MANIFEST_FILE).read_text())
+    manifest["files_sha256"] = files_sha256(copied)
+    (copied / MANIFEST_FILE).write_text(json.dumps(manifest))
+    tuning = read_vehicle_tuning(copied)
+    assert tuning.floor_design is not None and tuning.floor_design.phase_margin_deg == 50.0
+    controller = ClothoidController(vehicle.geometry, ClothoidConfig(tuning=tuning, **TUNING_GRID))
+    controller.reset(STRAIGHT, 0.02)
+    controller._band_floor_m(round(30.0 / FLOOR_SPEED_BAND_KMH))
+    assert len(computed) == 1
