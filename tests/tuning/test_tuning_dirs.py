@@ -392,3 +392,20 @@ def test_a_cache_others_may_write_is_refused(tmp_path: Path, private_cache: Path
 def test_the_cache_is_made_private(tmp_path: Path, private_cache: Path) -> None:
     tuning_for(make_vehicle(vehicle_file=_longer_car(tmp_path)), QUICK)
     assert private_cache.stat().st_mode & 0o777 == 0o700
+
+
+def test_only_a_margins_design_with_its_loop_gives_floors() -> None:
+    """A lead file's floors are read only from a margins design that names the loop they were computed for; a
+    malformed one is refused naming the file."""
+    from controllers.clothoid.vehicle_tuning import FloorDesign
+    from tuning.tuning_dirs import _floors
+
+    loop = {"controller_rate_hz": 50, "prediction_time_s": 0.2, "arc_lateral_accel_g": 0.4}
+    loop["lookahead_range_m"] = [3, 40, 0.5]
+    rows = [{"speed_kmh": 30, "lookahead_floor_m": 8.5}, {"speed_kmh": 60}]
+    assert _floors(Path("lead.json"), {"method": "cancel", **loop, "per_speed": rows}) == ((), None)
+    assert _floors(Path("lead.json"), {"method": "margins", "per_speed": rows}) == ((), None)
+    floors, design = _floors(Path("lead.json"), {"method": "margins", **loop, "per_speed": rows, "gain_margin_db": 8})
+    assert floors == ((30.0, 8.5),) and design == FloorDesign(0.02, 0.2, 0.4, (3.0, 40.0, 0.5), 45.0, 8.0)
+    with pytest.raises(WorkbenchInputError, match=r"^lead\.json: design's floors"):
+        _floors(Path("lead.json"), {"method": "margins", **loop, "lookahead_range_m": [3, 40], "per_speed": rows})
