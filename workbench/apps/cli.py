@@ -31,7 +31,7 @@ import sys
 from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 from pathlib import Path
-from typing import TYPE_CHECKING, cast
+from typing import TYPE_CHECKING, TypeVar
 
 from controllers import CONTROLLERS
 from workbench.base.console import console_exit, warn_on_stderr
@@ -40,11 +40,11 @@ from workbench.base.output_dir import MANIFEST
 from workbench.base.version import VersionAction
 
 if TYPE_CHECKING:
+    from _typeshed import DataclassInstance
+
     from workbench.apps.comparison import Comparison
     from workbench.apps.stage_progress import StageProgress
-    from workbench.apps.studies import StudySpec
     from workbench.apps.studies.backends import Backend
-    from workbench.apps.studies.tournament_spec import TournamentSpec
     from workbench.base.output_dir import OutputDir
     from workbench.simulation.circuit_ranges import CircuitRanges
     from workbench.simulation.plot_worker import PlotWorker
@@ -57,6 +57,9 @@ if TYPE_CHECKING:
 # Heavy modules (the simulator, the scenarios' paths, plotting, the controllers' solvers, the studies' backends)
 # are imported inside the command that needs them, so that `workbench --help` and `workbench scenarios` start
 # fast (issue 17; benchmarks/startup.py measures it).
+
+#: A study's spec, as its command loads it (`_start_study`).
+SpecT = TypeVar("SpecT")
 
 EXIT_INPUT_ERROR = 2
 EXIT_RUN_FAILED = 1
@@ -733,20 +736,16 @@ def _max_runs(args: argparse.Namespace) -> int | None:
     return args.max_runs
 
 
-def _start_study(args: argparse.Namespace, kind: str) -> tuple[StudySpec | TournamentSpec, Backend]:
-    """Check the output folder (a study's resumable store: `check_study_dir`) and the spec (every file it names,
-    the study's size), start nothing yet but the folder and the spec's copy in it."""
-    from workbench.apps.studies import load_spec, make_backend
+def _start_study(args: argparse.Namespace, load: Callable[[int | None], SpecT]) -> tuple[SpecT, Backend]:
+    """Check the output folder (a study's resumable store: `check_study_dir`) and the spec (`load` reads it, given
+    --max-runs: every file it names, the study's size), start nothing yet but the folder and the spec's copy in
+    it."""
+    from workbench.apps.studies import make_backend
     from workbench.base.output_dir import check_study_dir
 
     check_study_dir(args.out)
     _check_inputs(args)
-    if kind == "tournament":
-        from workbench.apps.studies.tournament_spec import load_tournament
-
-        spec = load_tournament(args.spec, max_runs=_max_runs(args))
-    else:
-        spec = load_spec(args.spec, kind, max_runs=_max_runs(args))
+    spec = load(_max_runs(args))
     backend = make_backend(args.backend, args.scheduler, args.workers)
     copy = args.out / "spec.toml"
     try:
@@ -820,9 +819,9 @@ def _robustness(args: argparse.Namespace) -> int:
 
 
 def _sweep(args: argparse.Namespace) -> int:
-    from workbench.apps.studies import run_sweep
+    from workbench.apps.studies import load_spec, run_sweep
 
-    spec, backend = _start_study(args, "sweep")
+    spec, backend = _start_study(args, lambda max_runs: load_spec(args.spec, "sweep", max_runs=max_runs))
     n = spec.run_count()
 
     def study() -> int:
@@ -851,10 +850,10 @@ def _sweep(args: argparse.Namespace) -> int:
 
 
 def _optimise(args: argparse.Namespace) -> int:
-    from workbench.apps.studies import run_optimisation
+    from workbench.apps.studies import load_spec, run_optimisation
     from workbench.apps.studies.optimise import objective_text
 
-    spec, backend = _start_study(args, "optimise")
+    spec, backend = _start_study(args, lambda max_runs: load_spec(args.spec, "optimise", max_runs=max_runs))
     trials = spec.optimise.trials if spec.optimise else 0
 
     def study() -> int:
@@ -888,9 +887,9 @@ _LEADERBOARD_COLUMNS = (
 def _tournament(args: argparse.Namespace) -> int:
     """`workbench tournament`: the stages on stderr, the leaderboard and what was written on stdout."""
     from workbench.apps.studies.tournament import run_tournament
+    from workbench.apps.studies.tournament_spec import load_tournament
 
-    study_spec, backend = _start_study(args, "tournament")
-    spec = cast("TournamentSpec", study_spec)
+    spec, backend = _start_study(args, lambda max_runs: load_tournament(args.spec, max_runs=max_runs))
 
     def study() -> int:
         print(
@@ -975,7 +974,9 @@ def _run_with(args: argparse.Namespace, plot_worker: PlotWorker | None) -> int:
     return 0
 
 
-def _vehicle_and_options(args: argparse.Namespace, warn: Callable[[str], None]) -> tuple[VehicleModel, object]:
+def _vehicle_and_options(
+    args: argparse.Namespace, warn: Callable[[str], None]
+) -> tuple[VehicleModel, DataclassInstance]:
     """The vehicle (--vehicle, --vehicle-file, --payload-kg) and the controller's options (--controller-config,
     --set; `read_controller_config`) of `run` and `export-fmu`; an unknown controller name is refused."""
     from workbench.apps.controller_config import read_controller_config
