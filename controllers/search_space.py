@@ -91,22 +91,26 @@ class Tunable:
             )
         low, high = self.low, self.high
         if self.scale == "integer":
-            whole = all(isinstance(v, int) and not isinstance(v, bool) for v in (low, high))
-            if not whole or low > high:  # type: ignore[operator]
+            # whole numbers (not booleans), low <= high; one condition, so that the checker narrows the bounds
+            if (
+                not (isinstance(low, int) and not isinstance(low, bool))
+                or not (isinstance(high, int) and not isinstance(high, bool))
+                or low > high
+            ):
                 raise WorkbenchInputError(
                     f"{where}: an integer scale needs whole-number bounds with low <= high; got low = "
                     f"{value_text(low)}, high = {value_text(high)}"
                 )
             return
-        if not all(is_number(v) and math.isfinite(v) for v in (low, high)) or not low < high:  # type: ignore[operator]
+        if not (is_number(low) and math.isfinite(low) and is_number(high) and math.isfinite(high)) or not low < high:
             raise WorkbenchInputError(
                 f"{where}: a {self.scale} scale needs finite bounds with low < high; got low = {value_text(low)}, "
                 f"high = {value_text(high)}"
             )
-        if self.scale == "log" and low <= 0:  # type: ignore[operator]
+        if self.scale == "log" and low <= 0:
             raise WorkbenchInputError(f"{where}: a log scale needs low > 0; got low = {value_text(low)}")
-        object.__setattr__(self, "low", float(low))  # type: ignore[arg-type]
-        object.__setattr__(self, "high", float(high))  # type: ignore[arg-type]
+        object.__setattr__(self, "low", float(low))
+        object.__setattr__(self, "high", float(high))
 
     def distribution_table(self) -> dict[str, list[Any]]:
         """The tunable in the studies' distribution form, a one-entry table `Distribution.parse` reads:
@@ -119,11 +123,11 @@ class Tunable:
         whole one on an integer scale)."""
         if self.scale == "choice":
             return any(type(value) is type(c) and value == c for c in self.choices)
-        if not is_number(value) or not math.isfinite(value):  # type: ignore[arg-type]
+        if not is_number(value) or not math.isfinite(value):
             return False
-        if self.scale == "integer" and value != int(value):  # type: ignore[arg-type]
+        if self.scale == "integer" and value != int(value):
             return False
-        return self.low <= value <= self.high  # type: ignore[operator]
+        return self.low <= value <= self.high  # type: ignore[operator]  # every scale but a choice has its bounds
 
 
 def controller_search_space(name: str) -> tuple[Tunable, ...]:

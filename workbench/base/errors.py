@@ -11,6 +11,7 @@ from __future__ import annotations
 import math
 import numbers
 from collections.abc import Iterable
+from typing import TypeGuard
 
 import numpy as np
 
@@ -19,8 +20,8 @@ class WorkbenchInputError(ValueError):
     """Input the workbench cannot use: a malformed file, an unknown name, an unphysical parameter, NaN."""
 
 
-def is_number(value: object) -> bool:
-    """A real number, Python's or numpy's, but not a boolean."""
+def is_number(value: object) -> TypeGuard[float]:
+    """A real number, Python's or numpy's, but not a boolean (a float to the type checker: what it computes with)."""
     if type(value) is float or type(value) is int:  # the common case, without the ABC check (these run per step)
         return True
     return isinstance(value, numbers.Real) and not isinstance(value, bool | np.bool_)
@@ -77,7 +78,7 @@ def require_in_range(
     """Raise WorkbenchInputError unless `value` is a finite number (not a boolean) in [low, high] ((low, high] when
     `low_open`). The message names `name`, the value and the range with its unit; `note` is added to what is
     allowed ("0: off", "or None: ...")."""
-    if is_number(value) and math.isfinite(value) and low <= value <= high and not (low_open and value == low):  # type: ignore[arg-type,operator]
+    if is_number(value) and math.isfinite(value) and low <= value <= high and not (low_open and value == low):
         return  # the message is built only for a value refused (parameters are checked on every controller step)
     allowed = range_text(low, high, unit, low_open=low_open, note=note)
     raise WorkbenchInputError(f"{name} must be a finite number in {allowed}; got {value_text(value)}")

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import overload
 
 import numpy as np
 from scipy.interpolate import BSpline, make_interp_spline
@@ -95,7 +96,8 @@ def _arc_length_spline(x: np.ndarray, y: np.ndarray, closed: bool) -> tuple[BSpl
                 break
             accepted, mismatch_before, t = (spline_x, spline_y, t), mismatch, arc
         else:
-            return accepted
+            if accepted is not None:  # always: no refit was rejected, and at least one ran
+                return accepted
         if degree > 3:  # the quintic is unstable on these waypoints: a cubic, natural at the ends of an open path
             degree, bc = 3, bc or "natural"
         elif accepted is not None:
@@ -104,6 +106,10 @@ def _arc_length_spline(x: np.ndarray, y: np.ndarray, closed: bool) -> tuple[BSpl
             return spline_x, spline_y, t_chord
 
 
+@overload
+def wrap_angle(angle_rad: float) -> float: ...
+@overload
+def wrap_angle(angle_rad: np.ndarray) -> np.ndarray: ...
 def wrap_angle(angle_rad: float | np.ndarray) -> float | np.ndarray:
     """Wrap an angle (rad) to [-pi, pi)."""
     if isinstance(angle_rad, float | int):
@@ -185,9 +191,9 @@ class ReferencePath:
                 raise WorkbenchInputError(f"{name}: {label} has {arr.size} samples, positions have {self.x_m.size}")
         if (self.width_right_m is None) != (self.width_left_m is None):
             raise WorkbenchInputError(f"{name}: give both track widths (right and left) or neither")
-        for label, arr in (("right track width", self.width_right_m), ("left track width", self.width_left_m)):
-            if arr is not None and arr.shape != self.x_m.shape:
-                raise WorkbenchInputError(f"{name}: {label} has {arr.size} samples, positions have {self.x_m.size}")
+        for label, widths in (("right track width", self.width_right_m), ("left track width", self.width_left_m)):
+            if widths is not None and widths.shape != self.x_m.shape:
+                raise WorkbenchInputError(f"{name}: {label} has {widths.size} samples, positions have {self.x_m.size}")
 
     # ------------------------------------------------------------------ construction
     @classmethod
@@ -261,6 +267,10 @@ class ReferencePath:
         return cls.from_waypoints(Waypoints(x_m, y_m, speed_mps, closed, source=name), spacing_m, name)
 
     # ------------------------------------------------------------------ evaluation
+    @overload
+    def wrap_s(self, s_m: float) -> float: ...
+    @overload
+    def wrap_s(self, s_m: np.ndarray) -> np.ndarray: ...
     def wrap_s(self, s_m: float | np.ndarray) -> float | np.ndarray:
         """Map an arc length into [0, length]: modulo the length on a closed loop, clipped on an open path."""
         if isinstance(s_m, float | int):  # the per-step case: plain Python is 10x faster than numpy here
@@ -269,12 +279,20 @@ class ReferencePath:
             return np.mod(s_m, self.length_m)
         return np.clip(s_m, 0.0, self.length_m)
 
+    @overload
+    def _interp(self, values: np.ndarray, s_m: float) -> float: ...
+    @overload
+    def _interp(self, values: np.ndarray, s_m: np.ndarray) -> np.ndarray: ...
     def _interp(self, values: np.ndarray, s_m: float | np.ndarray) -> float | np.ndarray:
         if isinstance(s_m, float | int):  # the per-step case, compiled (`path_search.value_at`)
             return value_at(values, float(s_m), self.spacing_m, self.length_m, self.closed)
         return np.interp(self.wrap_s(s_m), self.s_m, values)
 
-    def position(self, s_m: float | np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    @overload
+    def position(self, s_m: float) -> tuple[float, float]: ...
+    @overload
+    def position(self, s_m: np.ndarray) -> tuple[np.ndarray, np.ndarray]: ...
+    def position(self, s_m: float | np.ndarray) -> tuple[float | np.ndarray, float | np.ndarray]:
         """Point(s) (x, y) on the path at arc length s (m)."""
         return self._interp(self.x_m, s_m), self._interp(self.y_m, s_m)
 
@@ -285,6 +303,14 @@ class ReferencePath:
     def curvature(self, s_m: float | np.ndarray) -> float | np.ndarray:
         """Path curvature (1/m, left turn positive) at arc length s."""
         return self._interp(self.curvature_1pm, s_m)
+
+    @property
+    def planned_speed_mps(self) -> np.ndarray:
+        """`speed_mps` of a path that must carry its planned speed (a run's: `Simulation` plans it); an error naming
+        the path when it carries none."""
+        if self.speed_mps is None:
+            raise WorkbenchInputError(f"{self.name}: the path carries no planned speed")
+        return self.speed_mps
 
     def speed(self, s_m: float | np.ndarray) -> float | np.ndarray | None:
         """Planned speed (m/s) at arc length s, or None when the path carries no speed."""

@@ -168,8 +168,8 @@ class VehicleLimits:
         that starts in a tight curve asks the steering to wind into it at once)."""
         if self.max_road_wheel_rate_rad_s is None:
             return None
-        angle = self.road_wheel_angle_rad(path.curvature_1pm, path.speed_mps)
-        speed = np.asarray(path.speed_mps, dtype=float)
+        speed = path.planned_speed_mps
+        angle = self.road_wheel_angle_rad(path.curvature_1pm, speed)
         step_s = np.diff(path.s_m) / (0.5 * (speed[1:] + speed[:-1]))
         n = angle.size
         if path.closed:  # once more round the loop (its last sample repeats the first), for windows past the seam
@@ -275,7 +275,7 @@ def _steering_rate_spans(path: ReferencePath, limits: VehicleLimits) -> list[Inf
     for first, last in _stretches(ratio > 1.0, path):
         index = _worst(ratio, first, last)
         window = np.arange(index, window_end[index] + 1) % wrap
-        speed = float(path.speed_mps[index])
+        speed = float(path.planned_speed_mps[index])
         span = InfeasibleSpan(
             start_s_m=float(path.s_m[first]),
             end_s_m=float(path.s_m[int(window_end[last]) % wrap]),

@@ -184,7 +184,7 @@ class Simulation:
         max_time, max_steps = self.max_time_s, self.max_steps
 
         x0, y0, yaw0 = self.scenario.initial_pose()
-        state = vehicle.initial_state(x0, y0, yaw0, float(path.speed_mps[0]))
+        state = vehicle.initial_state(x0, y0, yaw0, float(path.planned_speed_mps[0]))
         tracker = path.tracker(0.0)
         controller.reset(path, dt)
         # The conditions between plant and controller (`conditions.py`): each model is left out when ideal, so an

@@ -731,3 +731,12 @@ def test_a_zero_waypoint_speed_is_refused(speeds: list[float]) -> None:
     i = speeds.index(0.0)
     with pytest.raises(WorkbenchInputError, match=rf"speed must be > 0 m/s at every waypoint; waypoint {i} has 0"):
         Waypoints(np.arange(4.0), np.zeros(4), speed_mps=np.array(speeds))
+
+
+def test_the_planned_speed_is_the_paths_speed_and_a_path_without_one_is_refused_by_name() -> None:
+    path = straight_path(50.0)
+    with pytest.raises(WorkbenchInputError, match=r"^straight: the path carries no planned speed$"):
+        _ = path.planned_speed_mps
+    planned = path.with_speed(np.full(path.x_m.size, 7.5))
+    assert planned.planned_speed_mps is planned.speed_mps
+    np.testing.assert_array_equal(planned.planned_speed_mps, 7.5)
