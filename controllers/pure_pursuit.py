@@ -55,7 +55,7 @@ class PurePursuitConfig:
             )
 
 
-class PurePursuit(Controller):
+class PurePursuit(Controller[PurePursuitConfig]):
     name: ClassVar[str] = "pure-pursuit"
     config_type: ClassVar[type] = PurePursuitConfig
     search_space: ClassVar[tuple[Tunable, ...]] = (

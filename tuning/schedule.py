@@ -118,13 +118,13 @@ class ScheduleEntry:
             cascade_bandwidth_rad_s=d.cascade_bandwidth_rad_s,
         )
         if self.margins is not None:  # a floor left out: no lookahead up to MARGINS_MAX_LOOKAHEAD_M keeps the margins
-            m = self.margins
-            if math.isfinite(m.floor_m):
-                out["lookahead_floor_m"] = m.floor_m
+            margins = self.margins
+            if math.isfinite(margins.floor_m):
+                out["lookahead_floor_m"] = margins.floor_m
             else:
-                out["margin_score"] = m.margin_score
-            if math.isfinite(m.floor_without_lead_m):
-                out["floor_without_lead_m"] = m.floor_without_lead_m
+                out["margin_score"] = margins.margin_score
+            if math.isfinite(margins.floor_without_lead_m):
+                out["floor_without_lead_m"] = margins.floor_without_lead_m
         return out
 
 

@@ -430,13 +430,13 @@ def fit_hyper_clothoid(
     """Fit the hyper-clothoid from the pose (x0, y0, theta0 rad) with curvature kappa0 (1/m) to the target (x1, y1)
     under |kdot| <= max_curvature_rate_1pm2; see the module docstring."""
     args = {"x0": x0, "y0": y0, "theta0": theta0, "kappa0": kappa0, "x1": x1, "y1": y1}
-    values = [_finite(name, value) for name, value in args.items()]
+    x0, y0, theta0, kappa0, x1, y1 = (_finite(name, value) for name, value in args.items())
     rate = _finite("max_curvature_rate_1pm2", max_curvature_rate_1pm2)
     if rate <= 0.0:
         raise WorkbenchInputError(
             f"max_curvature_rate_1pm2 must be a finite number > 0; got {value_text(max_curvature_rate_1pm2)}"
         )
-    kdot, length, ex, ey, status = fit_kernel(*values, rate)
+    kdot, length, ex, ey, status = fit_kernel(x0, y0, theta0, kappa0, x1, y1, rate)
     return ClothoidFit(float(kdot), float(length), float(ex), float(ey), int(status))
 
 
@@ -445,12 +445,12 @@ def clothoid_points(
 ) -> tuple[np.ndarray, np.ndarray]:
     """n points (x, y) of the clothoid, evenly spaced in arc length over [0, length], both ends included."""
     args = {"x0": x0, "y0": y0, "theta0": theta0, "kappa0": kappa0, "kdot": kdot, "length": length}
-    values = [_finite(name, value) for name, value in args.items()]
-    if values[-1] < 0.0:
+    x0, y0, theta0, kappa0, kdot, arc_length = (_finite(name, value) for name, value in args.items())
+    if arc_length < 0.0:
         raise WorkbenchInputError(f"length must be >= 0 m; got {value_text(length)}")
     if isinstance(n, bool) or not isinstance(n, int | np.integer) or n < 1:
         raise WorkbenchInputError(f"n must be an integer >= 1; got {value_text(n)}")
     x = np.empty(int(n))
     y = np.empty(int(n))
-    sample_kernel(*values, int(n), x, y)
+    sample_kernel(x0, y0, theta0, kappa0, kdot, arc_length, int(n), x, y)
     return x, y

@@ -56,7 +56,7 @@ from controllers.config_checks import Choice, Flag, Instance, Number, check_opti
 from controllers.search_space import Tunable
 from workbench.base.errors import WorkbenchInputError, value_text
 from workbench.base.path import ReferencePath
-from workbench.vehicles.base import VehicleGeometry
+from workbench.vehicles.base import VehicleGeometry, VehicleModel
 
 if TYPE_CHECKING:  # the loop analysis (python-control, ~0.9 s to import) only where floors are computed
     from controllers.clothoid.loop_analysis import DelayRobustness, LoopSettings, PlantLags
@@ -364,7 +364,7 @@ class ClothoidConfig:
             )
 
 
-class ClothoidController(Controller):
+class ClothoidController(Controller[ClothoidConfig]):
     """The clothoid controller (Figure 2). Build once for a vehicle and a ClothoidConfig; `reset` for each path.
 
     Its tuning (the lead filter, the curvature limits and the identified lags the lookahead floor and the
@@ -415,7 +415,7 @@ class ClothoidController(Controller):
         return replace(config, known_delay_s=delays.loop_delay_s)
 
     def __init__(
-        self, geometry: VehicleGeometry, config: ClothoidConfig | None = None, vehicle: object | None = None
+        self, geometry: VehicleGeometry, config: ClothoidConfig | None = None, vehicle: VehicleModel | None = None
     ) -> None:
         super().__init__(geometry, config)
         cfg = self.config
@@ -721,5 +721,6 @@ class ClothoidController(Controller):
             if status == sk.NEED_FLOOR:
                 self._state["floors"][0, need] = self._band_floor_m(need)
             else:
-                params = self.filter_schedule.at_speed(float(need))
+                # the kernel asks for a lead filter only when there is a schedule to make it from
+                params = self.filter_schedule.at_speed(float(need))  # type: ignore[union-attr]
                 self._state["filters"][0, need] = DiscreteLeadFilter(params, self._dt).coefficients

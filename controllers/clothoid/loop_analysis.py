@@ -328,8 +328,8 @@ def _controller_step(
     dt, v = settings.sample_time_s, float(speed_mps)
     g_y, g_psi, g_k = gains
     if settings.lead is not None:
-        a_f, b_f, c_f, d_f = DiscreteLeadFilter(settings.lead, dt).state_space
-        a_f, b_f, c_f = np.array(a_f), np.array(b_f), np.array(c_f)
+        lead_a, lead_b, lead_c, d_f = DiscreteLeadFilter(settings.lead, dt).state_space
+        a_f, b_f, c_f = np.array(lead_a), np.array(lead_b), np.array(lead_c)
     measured = settings.initial_curvature == "yaw-rate"
     model = settings.predicts_with_model
     dp = v * (settings.prediction_time_s + (0.0 if model else settings.known_delay_s))

@@ -63,7 +63,8 @@ PARAMS = np.dtype(
 def parameters(**fields: float | int | bool | None) -> np.ndarray:
     """The step's parameters as one record (PARAMS, a structured array of one element), every field given by name
     (None: NaN, an option left out); a field missing or unknown is refused."""
-    missing, unknown = set(PARAMS.names) - set(fields), set(fields) - set(PARAMS.names)
+    known = set(PARAMS.names or ())  # a structured dtype always has names (numpy types them Optional)
+    missing, unknown = known - set(fields), set(fields) - known
     if missing or unknown:
         raise ValueError(f"clothoid step parameters: missing {sorted(missing)}, unknown {sorted(unknown)}")
     params = np.zeros(1, PARAMS)
@@ -118,7 +119,7 @@ def initial_state() -> np.ndarray:
     """The step's state before its first step (STATE, one record): nothing known (NaN), no band held, both path
     trackers at the path's start (`PathTracker.reset(0.0)`)."""
     state = np.zeros(1, STATE)
-    for name in STATE.names:
+    for name in STATE.names or ():  # a structured dtype always has names
         if STATE[name].base == np.float64:
             state[name] = np.nan
     state["held_band"], state["need"] = -1, 0

@@ -395,7 +395,7 @@ def _outputs(s, p, delta_cmd, accel, ratio):  # pragma: no cover - compiled
     return out
 
 
-class TractorSemitrailer(CompiledVehicleModel):
+class TractorSemitrailer(CompiledVehicleModel[TractorSemitrailerParams]):
     name: ClassVar[str] = "tractor-semitrailer"
     state_names: ClassVar[tuple[str, ...]] = (
         "x_m",
