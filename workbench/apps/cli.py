@@ -31,7 +31,7 @@ import sys
 from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 from pathlib import Path
-from typing import TYPE_CHECKING, TypeVar
+from typing import TYPE_CHECKING, Any, TypeVar
 
 from controllers import CONTROLLERS
 from workbench.base.console import console_exit, warn_on_stderr
@@ -440,8 +440,9 @@ def _conditions_options(parser: argparse.ArgumentParser) -> None:
     )
 
 
-def _simulation_config(args: argparse.Namespace, **fields: object) -> SimulationConfig:
-    """The SimulationConfig of a command's options: `fields` plus the conditions, seed and --inform-delays."""
+def _simulation_config(args: argparse.Namespace, **fields: Any) -> SimulationConfig:
+    """The SimulationConfig of a command's options: `fields` (SimulationConfig's, each of its own type) plus the
+    conditions, seed and --inform-delays."""
     from workbench.simulation.conditions import load_conditions
     from workbench.simulation.simulator import SimulationConfig
 
