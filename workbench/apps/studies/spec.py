@@ -41,7 +41,7 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import MappingProxyType
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from controllers import CONTROLLERS
 from workbench.apps.studies.circuit_parameters import (
@@ -72,6 +72,10 @@ from workbench.simulation.scenarios import (
 )
 from workbench.simulation.simulator import SimulationConfig
 from workbench.vehicles import VEHICLES
+
+if TYPE_CHECKING:
+    from workbench.vehicles.base import VehicleModel
+    from workbench.vehicles.geometry import VehicleGeometry
 
 #: Every run parameter and its type: SimulationConfig's fields (its conditions as `conditions`, a preset name or a
 #: file, and each scalar field of them, `condition_parameters.py`), then the extras.
@@ -719,7 +723,7 @@ class StudySpec:
         )
 
 
-def _has_payload(vehicle: Any) -> bool:
+def _has_payload(vehicle: VehicleModel | str) -> bool:
     """Whether a vehicle (a model, or a preset name) carries a payload."""
     from workbench.vehicles.presets import carries_payload
 
@@ -740,7 +744,7 @@ def _vehicle_models(vehicles: Sequence[str]) -> dict[str, Any]:
     return models
 
 
-def _check_option_file(where: str, key: str, path: Path, geometry: Any) -> None:
+def _check_option_file(where: str, key: str, path: Path, geometry: VehicleGeometry | None) -> None:
     """Read a file a controller option names, as the controller will (lead filters, curvature limits, steering
     lags, vehicle files); any other file must at least be readable."""
     from workbench.apps.controller_config import FILE_OPTIONS
