@@ -90,6 +90,8 @@ class FmuPlant(VehicleModel[FmuPlantParams]):
         p = self.params
         track = None
         if p.has_single_track:
+            # SINGLE_TRACK_FIELDS are given all together or not at all (FmuPlantParams checks): none is None here,
+            # which the checker cannot follow through has_single_track, hence the ignores
             track = SingleTrackParams(
                 mass_kg=float(p.mass_kg),  # type: ignore[arg-type]
                 yaw_inertia_kgm2=float(p.yaw_inertia_kgm2),  # type: ignore[arg-type]
@@ -124,13 +126,14 @@ class FmuPlant(VehicleModel[FmuPlantParams]):
 
     def _apply_road_friction(self, scale: float) -> None:
         p = self.params
-        if self._state is not None:
+        if self._state is not None:  # a model with tyres: its friction parameter and value are given (the ignore)
             ref = self.interface.value_references[str(p.friction_parameter)]
             self._fmu.set_parameter(ref, float(p.road_friction) * scale)  # type: ignore[arg-type]
 
     def _start_values(self) -> dict[int, float]:
         p, refs = self.params, self.interface.value_references
         values = {}
+        # a mapped parameter has its value (FmuPlantParams checks), which the checker cannot follow: the ignores
         if p.payload_parameter is not None:
             values[refs[p.payload_parameter]] = float(p.payload_kg)  # type: ignore[arg-type]
         if p.friction_parameter is not None:
