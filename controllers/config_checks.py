@@ -17,7 +17,7 @@ from __future__ import annotations
 import dataclasses
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from workbench.base.errors import (
     range_text,
@@ -27,6 +27,9 @@ from workbench.base.errors import (
     require_instance_or_none,
     require_whole,
 )
+
+if TYPE_CHECKING:
+    from _typeshed import DataclassInstance
 
 # ----------------------------------------------------------------------------------------------- option rules
 # A config field's rule says what it allows and checks it (`workbench.base.errors`); its field's metadata holds
@@ -140,10 +143,10 @@ def option_rule(f: dataclasses.Field[Any]) -> Rule | None:
     return f.metadata.get("rule")
 
 
-def check_options(config: object) -> None:
+def check_options(config: DataclassInstance) -> None:
     """Check every field of a config dataclass that has a rule, in declaration order (each refusal names the
     option, the value and what is allowed); relations between fields are the config's own `__post_init__`'s."""
-    for f in dataclasses.fields(config):  # type: ignore[arg-type]
+    for f in dataclasses.fields(config):
         rule = option_rule(f)
         if rule is not None:
             rule.check(f.name, getattr(config, f.name))

@@ -416,7 +416,7 @@ class ClothoidFit:
 
 def _finite(name: str, value: object) -> float:
     try:
-        number = float(value)  # type: ignore[arg-type]
+        number = float(value)  # type: ignore[arg-type]  # any object: what float() refuses is caught below
     except (TypeError, ValueError):
         raise WorkbenchInputError(f"{name} must be a finite number; got {value_text(value)}") from None
     if isinstance(value, bool) or not math.isfinite(number):

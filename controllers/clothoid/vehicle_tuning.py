@@ -164,6 +164,7 @@ def _check_speed(speed_kmh: float) -> None:
 
 def _checked_lags(name: str, value: object) -> tuple[tuple[float, SteeringLag], ...]:
     """(speed_kmh, SteeringLag) pairs as a tuple of float speeds, speeds increasing strictly."""
+    # the field as given (any object): taken as pairs here, each pair checked below
     lags = tuple((float(speed), lag) for speed, lag in value)  # type: ignore[attr-defined]
     for i, (speed, lag) in enumerate(lags):
         if not (math.isfinite(speed) and speed >= 0.0) or not isinstance(lag, SteeringLag):
