@@ -16,7 +16,7 @@ from typing import Any, ClassVar
 import numpy as np
 import pytest
 
-from controllers import CONTROLLERS, make_controller
+from controllers import CONTROLLERS, ControllerRegistry, make_controller
 from controllers.base import Controller
 from controllers.config_checks import option_rule
 from controllers.search_space import SCALES, Tunable, controller_search_space, search_space_toml
@@ -236,8 +236,8 @@ class _NotTunables(_Quiet):
 @pytest.fixture
 def registry(monkeypatch: pytest.MonkeyPatch) -> None:
     """The registered controllers with three stand-ins: one declaring no space, two declaring a malformed one."""
-    stand_ins = {cls.name: cls for cls in (_Quiet, _Twice, _NotTunables)}
-    registered = {**{n: CONTROLLERS[n] for n in NAMES}, **stand_ins}
+    classes = [CONTROLLERS[n] for n in NAMES] + [_Quiet, _Twice, _NotTunables]
+    registered = ControllerRegistry({cls.name: (cls.__module__, cls.__name__) for cls in classes})
     monkeypatch.setattr("controllers.CONTROLLERS", registered)
     monkeypatch.setattr("workbench.apps.cli.CONTROLLERS", registered)
 
