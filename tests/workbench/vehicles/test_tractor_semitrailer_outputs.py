@@ -1,4 +1,5 @@
-"""The tractor-semitrailer's outputs: the compiled kernel's array sized by the output names, not by a count of its own."""
+"""The tractor-semitrailer's outputs: the compiled kernel's array sized by the output names, not by a count of its
+own."""
 
 from __future__ import annotations
 
