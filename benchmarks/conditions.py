@@ -1,4 +1,4 @@
-"""Goals of issue 18 under real sensing and actuation: measured, printed and written as JSON.
+"""The controllers' goals under real sensing and actuation: measured, printed and written as JSON.
 
 1. The loaded truck at 30 km/h under the `automotive` conditions, each controller told the conditions' nominal
    delays (`Controller.informed_config` with `KnownDelays.from_conditions`, as `workbench run --inform-delays`

@@ -7,7 +7,7 @@ is sent one second after the fast runs' rows are written, both workers then busy
 is the wall time from the signal to the process's exit. It also checks that the exit code is 130, that the rows of
 the fast runs are kept and no other row was written, and that no worker process outlives the sweep.
 
-Goal (issue 30): on the local backend, exit within 2 s of either signal (every measurement). The Dask backend (a
+Goal: on the local backend, exit within 2 s of either signal (every measurement). The Dask backend (a
 LocalCluster of 2 workers, stopped through its nannies) is measured once per signal and reported without a goal.
 
 Prints the figures and writes JSON (like benchmarks/run.py); `--check` exits non-zero when a goal is missed.

@@ -48,7 +48,7 @@ class Entry:
     goal: str | None = None
     goal_met: bool | None = None
     note: str | None = None
-    #: A step-time ratio against the clothoid controller's on the same run (issue 19).
+    #: A step-time ratio against the clothoid controller's on the same run.
     ratio: float | None = None
 
 
@@ -170,7 +170,7 @@ def _run_entry(result: SimulationResult, wall: float, goals: RunGoals = RunGoals
     return entry
 
 
-#: Issue 19's goal: on fig17, the NMPC's step median at least this many times the clothoid controller's, on the same
+#: The goal on fig17: the NMPC's step median at least this many times the clothoid controller's, on the same
 #: runs, on both vehicles.
 RATIO_GOAL = 20.0
 
@@ -181,7 +181,7 @@ def bench_compared(scenario_name: str, options: ScenarioOptions, clothoid_goals:
     """The clothoid controller, the NMPC and the LTV-MPC on one scenario, timed in alternation: round k runs each
     once, so that the machine's speed, which drifts over minutes on a shared machine, is alike within a round.
     Each controller's entry is its round of least step median (timeit's convention: the others were slowed by
-    something else), each ratio the median over the rounds of that round's ratio (issue 19)."""
+    something else), each ratio the median over the rounds of that round's ratio."""
     names = ("clothoid", "nmpc", "lmpc")
     sims = {name: _simulation(scenario_name, name, vehicle_name, options) for name in names}
     timed = {name: [] for name in names}
@@ -250,7 +250,7 @@ def bench_simulator_overhead(vehicle_name: str, plant_us: float, goal_us: float 
     )
 
 
-#: Issue 19's goal for the whole command: the loaded truck's Zandvoort lap under pure pursuit, `workbench run` in a
+#: The goal for the whole command: the loaded truck's Zandvoort lap under pure pursuit, `workbench run` in a
 #: fresh process with its plots, at least this many times real time.
 CLI_LAP_GOAL_RTF = 150.0
 
@@ -311,22 +311,21 @@ def main(argv: list[str] | None = None) -> int:
     for vehicle in ("kinematic-bicycle", "dynamic-bicycle", "tractor-semitrailer"):
         plants[vehicle] = bench_plant(vehicle)
         entries.append(plants[vehicle])
-    # Issue 19's goal: the simulator's own work <= 20 us a step.
+    # Goal: the simulator's own work <= 20 us a step.
     entries.append(bench_simulator_overhead("tractor-semitrailer", plants["tractor-semitrailer"].median_us, 20.0))
     entries.append(bench_plant("commonroad-mb", calls=200))
     for name in scenarios:
         entries.append(bench_run(name, "pure-pursuit", "kinematic-bicycle", options))
     for name in scenarios:
-        # Issue 3's goal: the loaded truck laps Zandvoort at 30 km/h under pure pursuit >= 200x real time; issue
-        # 19's: >= 500x.
+        # Goal: the loaded truck laps Zandvoort at 30 km/h under pure pursuit >= 500x real time.
         goal = 500.0 if name == "zandvoort" else None
         entries.append(bench_run(name, "pure-pursuit", "tractor-semitrailer", options, goals=RunGoals(rtf=goal)))
-    if options.track_file:  # issue 19's: the same lap >= 150x real time as a command, start-up and plots included
+    if options.track_file:  # the same lap >= 150x real time as a command, start-up and plots included
         entries.append(bench_cli_lap(options.track_file, args.cli_runs))
 
-    # Issue 4's goals: the clothoid controller's step (adaptive search included) median <= 100 us; the loaded truck
-    # at 30 km/h within 0.2 m on figure8 and zandvoort and 0.1 m on the dlc; the lead filter helps on the dlc.
-    # Issue 19's: the step median <= 20 us on the dlc and Zandvoort, and on fig17 the NMPC's >= 20 times it on the
+    # Goals of the clothoid controller: its step (adaptive search included) median <= 100 us, <= 20 us on the dlc
+    # and Zandvoort; the loaded truck at 30 km/h within 0.2 m on figure8 and zandvoort and 0.1 m on the dlc; the
+    # lead filter helps on the dlc; on fig17 the NMPC's >= 20 times it on the
     # same runs, on both vehicles (each vehicle's clothoid, NMPC and LTV-MPC runs timed in alternation,
     # `bench_compared`; the other scenarios' ratios are reported).
     for name in scenarios:
@@ -340,7 +339,7 @@ def main(argv: list[str] | None = None) -> int:
     entries.append(bench_run("dlc", "clothoid", "tractor-semitrailer", options, overrides=("use_lead_filter=false",)))
     entries.append(bench_run("dlc", "clothoid", "kinematic-bicycle", options))
 
-    # Issue 5's goals, at N = 30 steps of 50 ms (the default), timed from Python with all overhead: the NMPC (RTI on
+    # The MPCs' goals, at N = 30 steps of 50 ms (the default), timed from Python with all overhead: the NMPC (RTI on
     # OSQP) step median <= 2 ms and p99 <= 10 ms, within 0.1 m on the dlc on the dynamic bicycle car at 30 km/h;
     # the LTV-MPC step median <= 0.5 ms. IPOPT (the converged reference) and the truck are reported without goals.
     car = "dynamic-bicycle"
@@ -348,7 +347,7 @@ def main(argv: list[str] | None = None) -> int:
     entries.append(bench_run("dlc", "nmpc", car, options, goals=nmpc_goals))
     entries.append(bench_run("dlc", "nmpc", car, options, overrides=("solver=ipopt",)))
     entries.append(bench_run("dlc", "lmpc", car, options, goals=RunGoals(step_us=500.0)))
-    if options.track_file:  # issue 19: a Zandvoort lap's real-time factor for every controller
+    if options.track_file:  # a Zandvoort lap's real-time factor for every controller
         entries.append(bench_run("zandvoort", "stanley", "tractor-semitrailer", options))
     peak_mb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0  # KiB on Linux
 

@@ -1,4 +1,4 @@
-"""Start-up benchmark of the command lines (issue 17): how long `workbench --help`, `workbench scenarios` (with and
+"""Start-up benchmark of the command lines: how long `workbench --help`, `workbench scenarios` (with and
 without the Zandvoort track) and `tuning --help` take, each in a fresh process, against a bare `python -c pass` in
 the same run.
 

@@ -2,7 +2,7 @@
 (examples/sweep_dlc.toml: 5 speeds x 8 Fréchet thresholds x 5 initial offsets) on 1 and on 2 local workers, and on
 a Dask LocalCluster of 2 worker processes.
 
-Goals (issue 8): 2 local workers at least 1.7 times faster than 1; the Dask backend gives the same results as the
+Goals: 2 local workers at least 1.7 times faster than 1; the Dask backend gives the same results as the
 local one, bit for bit. "Bit for bit" covers every column of results.parquet except the wall-clock ones
 (step_time_median_us, step_time_p99_us, run_time_s: they differ between any two runs of the same thing).
 Each time is the wall time of `run_sweep` into an empty folder, worker start-up included (with --repeat N, the

@@ -8,7 +8,7 @@ no per-step mapping on the hot path. The simulator records them as `ctrl_<name>`
 `diagnostic_names` / `diagnostic_values`; `diagnostics` gives them as a mapping. Controllers contain no plotting
 and no I/O.
 
-The contract (issue 16), kept here once for every controller: a real steering ECU holds its last command on a
+The contract, kept here once for every controller: a real steering ECU holds its last command on a
 bad sensor frame, and so does every controller. `Controller.step` is a template method:
 
   1. it screens the measurement against a plausible envelope (the constants below: every field a real number,
@@ -75,7 +75,7 @@ MAX_POSITION_M = 1e8
 MAX_TIME_S = 1e12
 #: Any finite yaw is plausible (a yaw angle integrated over many turns is still a heading); one beyond this
 #: magnitude (rad; about 1600 turns) is wrapped to [-pi, pi) before the controller sees it, so that its rounding
-#: does not swallow the small angles added to it. Below it the yaw is passed unchanged, as it always was.
+#: does not swallow the small angles added to it. Below it the yaw is passed unchanged.
 MAX_UNWRAPPED_YAW_RAD = 1e4
 #: A clock that runs backwards for this many frames in a row has been reset (a new time base), not glitched: the
 #: controller restarts (as `reset`, on the same path) and takes the frame. Fewer are single bad frames, rejected;

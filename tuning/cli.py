@@ -44,7 +44,7 @@ if TYPE_CHECKING:
 
 # The tuning modules (python-control, SciPy, the controllers, the simulator) are imported inside the command that
 # needs them and the parser builds only the options of the command being run, so that `tuning --help` starts fast
-# (issue 17; benchmarks/startup.py measures it).
+# (benchmarks/startup.py measures it).
 
 EXIT_INPUT_ERROR = 2
 FORMATS = ("json", "toml")

@@ -18,7 +18,7 @@ the loop; the chirp is logged because on dlc and steps alone delay and damping t
 `drop_refused=True` (`--drop-refused`) leaves a refused speed out, recorded with the reason in the file's
 `design.dropped_speeds`, instead of refusing the whole schedule.
 
-Whether the schedule tracks better than a fixed filter in closed loop (issue 6, item 5) is shown by
+Whether the schedule tracks better than a fixed filter in closed loop is shown by
 `tuning/filter_comparison.py`.
 """
 

@@ -13,7 +13,7 @@ differ from it by understeer and lag, and the fit then leaves a steady offset in
 along the rear axle's course, yaw plus sideslip, the direction the vehicle moves in; the Fréchet threshold is the
 paper's absolute one (off the path the search falls back to the shortest candidate, which returns fastest).
 
-Added to the paper so that the loop keeps its margins on the vehicle it steers (issue 15):
+Added to the paper so that the loop keeps its margins on the vehicle it steers:
   - a lookahead floor per speed: `loop_analysis.py` linearises the loop (Eq. 3 on the predicted pose, Figure 2's
     integrator, the lead filter, the lags of Eq. 5, sampling) and finds the shortest lookahead from which the
     phase and gain margins hold about a straight and an arc; the loop gain goes as L^-3, so the search's choice
@@ -25,7 +25,7 @@ Added to the paper so that the loop keeps its margins on the vehicle it steers (
   - the steered vehicle's own lead filter, curvature limits and lags (`vehicle_tuning.py`, made by `tuning
     schedule --design margins`; the config holds them); without them, no lead filter and no floor.
 
-A known dead time (issue 18, known_delay_s: measurement latency plus actuation dead time) is compensated by default
+A known dead time (known_delay_s: measurement latency plus actuation dead time) is compensated by default
 with the identified lags driven by the commands already sent (`delay_predictor.py`, a Smith predictor): the start
 pose and kappa(0) are where the vehicle will be when the command now sent takes effect, and the loop the clothoid law
 closes is the delay-free one. The floor keeps the margins on that loop, 30 deg and 3 dB on the loop with its delay,
@@ -474,7 +474,7 @@ class ClothoidController(Controller[ClothoidConfig]):
             self._limit_speeds, self._lags, self._measured_lags, self._lag_speeds, self._schedule,
             self._schedule_speeds, self._scores, self._results, self._diag, self._history,
         )  # fmt: skip
-        # The planned speeds' floors now, not in a step (~0.04 s a band, with the delay model 0.5 s).
+        # The planned speeds' floors at reset, not in a step (~0.04 s a band, with the delay model 0.5 s).
         for band in self._planned_bands(path):
             self._band_floor_m(band)
 

@@ -27,9 +27,9 @@ type 3, integrator and double integrator, so it always has one at low frequency)
 saturates kappa' V before the integrator: its describing function N(A) = (2 / pi) (asin(1 / a) + sqrt(1 - 1 / a^2)
 / a), a = A / limit, a real gain in (0, 1]. Where the linear loop is unstable (|L| > 1 at a phase crossover above
 the crossover), the saturated loop oscillates at that frequency with N(A) = 1 / |L|: the limit cycle this module
-predicts. With the old default filter at 5 m and 30 km/h it predicts 1.4 Hz on the loaded truck and 2.4 Hz on the
-dynamic bicycle, where the simulations showed about 1 Hz and 2 Hz; its amplitudes are about twice those seen (the
-actuator's own rate limit and lag, which also bound the cycle, are not in it).
+predicts. On loops that cycle in simulation (a lead filter at 5 m and 30 km/h, no floor) it predicts 1.4 Hz on the
+loaded truck and 2.4 Hz on the dynamic bicycle, where the simulations show about 1 Hz and 2 Hz; its amplitudes are
+about twice those seen (the actuator's own rate limit and lag, which also bound the cycle, are not in it).
 """
 
 from __future__ import annotations

@@ -17,7 +17,7 @@ realised (the vehicle's lag ahead), averaged over a window, is the feed-forward:
     kappa' = kappa'(vehicle pose -> target) - kappa'(reference pose -> target) + kappa_p'(s + V tau_ff) / K
 
 Linearised, the reference term depends on the path only, so the loop and its margins are those of Eq. 3 alone
-(`loop_analysis.py`); what changes is that the loop no longer has to produce the path's curvature by error. K is
+(`loop_analysis.py`); what changes is that the loop need not produce the path's curvature by error. K is
 the vehicle's steady-state gain (understeer) from its identified lag. The timings come from the identified lags:
 tau_ff is the low-frequency delay of lead filter and path lag (Eq. 6 and Eq. 5), and the reference lead is how much
 the path curvature lags the yaw-rate curvature that the controller measures as kappa(0) (a truck's tandem and

@@ -13,7 +13,7 @@ more iterations. `exact_hessian=True` restores it.
 The constraint Jacobian, evaluated at every IPOPT iteration, comes from the OCP's compiled linearisation (the
 same C code the RTI uses, `TrackingOCP.linearisation`) rather than CasADi's SX virtual machine. Compiling the whole
 NLP with CasADi's JIT instead took far longer to build and saved less, so it is not offered. The real-time variant
-is `rti.py`; the README's MPC section has the measured step times.
+is `rti.py`; benchmarks/run.py measures the step times.
 
 IPOPT's own wall-time limit (max_wall_time) enforces the real-time budget: a solve it cuts short returns status
 LATE and is not used.

@@ -56,7 +56,7 @@ if TYPE_CHECKING:
 
 # Heavy modules (the simulator, the scenarios' paths, plotting, the controllers' solvers, the studies' backends)
 # are imported inside the command that needs them, so that `workbench --help` and `workbench scenarios` start
-# fast (issue 17; benchmarks/startup.py measures it).
+# fast (benchmarks/startup.py measures it).
 
 #: A study's spec, as its command loads it (`_start_study`).
 SpecT = TypeVar("SpecT")

@@ -53,8 +53,9 @@ def keep_script_namespace(namespace: dict[str, Any]) -> None:
     PythonFMU's binary (0.7.0) runs the script module's code in the module's namespace each time it instantiates
     the FMU, then releases that namespace, which it only borrowed (`findClass` decrefs the `PyModule_GetDict`
     result): without a reference added back the namespace is freed, and a second instance in one process fails
-    or the interpreter crashes later (PythonFMU issue #228). Each run of the script balances one release; a run
-    without one (the first import, the builder's) keeps one small dict alive for good, which is harmless."""
+    or the interpreter crashes later (https://github.com/NTNU-IHB/PythonFMU/issues/228). Each run of the script
+    balances one release; a run without one (the first import, the builder's) keeps one small dict alive for good,
+    which is harmless."""
     ctypes.pythonapi.Py_IncRef(ctypes.py_object(namespace))
 
 

@@ -1,5 +1,5 @@
-"""A second process that draws a run's plots while the run goes on (issue 19: a Zandvoort lap from the CLI, plots
-included, at 150 times real time).
+"""A second process that draws a run's plots while the run goes on, so that a run's plots add little to its wall
+time (a Zandvoort lap from the CLI, plots included, is benchmarked against a real-time factor in benchmarks/run.py).
 
 A run's four plots take about as long as its simulation: matplotlib's import (~0.4 s) and drawing (~0.7 s). The
 worker is started before the run, imports matplotlib while the simulation runs, and draws the plots from a

@@ -7,7 +7,7 @@ style per vehicle, so that three controllers on two vehicles are six lines of th
 tracked trajectories overlap at the scale of the course, so `trajectories` can zoom an inset on a stretch of it
 (`Stretch`: the hardest, chosen by the caller).
 
-matplotlib is imported where a figure is drawn, not with this module (issue 17): `result.py` and the CLI's
+matplotlib is imported where a figure is drawn, not with this module, for a fast start-up: `result.py` and the CLI's
 startup need none of it; figures written to files are bare Figures (`file_figure`), without pyplot. A plotted run is
 anything with a `SimulationResult`'s fields (`PlottedRun`, its path and scenario read through `PlottedPath` and
 `PlottedCourse`), so this module does not import the result that draws itself with it; `RunDrawing` is such a run in

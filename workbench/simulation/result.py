@@ -127,7 +127,7 @@ class SimulationResult:
             "status": self.status.value,
             "message": self.message,
         }
-        if not self.config.conditions.is_ideal:  # an ideal run's file stays as it was before conditions existed
+        if not self.config.conditions.is_ideal:  # only a run under conditions records them
             c = self.config  # inform_delays: whether the controller was told the conditions' delays
             document |= {"conditions": c.conditions.name, "seed": c.seed, "inform_delays": c.inform_delays}
         written[1].write_text(json.dumps(document, indent=2) + "\n")

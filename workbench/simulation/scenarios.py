@@ -273,7 +273,7 @@ def _zandvoort_description(options: ScenarioOptions) -> str:
 def from_file(path: Path, options: ScenarioOptions) -> Scenario:
     """A scenario from any waypoint file (CSV x,y[,v]; TUMFTM racetrack CSV; GPS CSV with lat/lon columns)."""
     from workbench.base.path import ReferencePath
-    from workbench.base.waypoint_files import read_waypoints  # pyproj for a GPS file only (issue 17)
+    from workbench.base.waypoint_files import read_waypoints  # pyproj for a GPS file only (start-up time)
 
     waypoints = read_waypoints(path)
     ref = ReferencePath.from_waypoints(waypoints, name=path.stem)

@@ -30,7 +30,7 @@ class KinematicBicycleParams:
     limit 1.066 rad, road-wheel rate limit 0.4 rad/s).
     """
 
-    wheelbase_m: float = 2.579  # CommonRoad vehicle 2: a + b = 1.156 + 1.423 (2.578 until issue 20: a slip)
+    wheelbase_m: float = 2.579  # CommonRoad vehicle 2: a + b = 1.156 + 1.423
     width_m: float = 1.61  # CommonRoad vehicle 2: w
     steering_ratio: float = 15.0  # assumed: typical passenger-car rack (14-16:1); CommonRoad gives none
     max_road_wheel_angle_rad: float = 1.066  # CommonRoad vehicle 2: steering.max
