@@ -15,7 +15,7 @@ lag may have no design under a tight bound), so that T = wp^3 / (s + wp)^3 (no o
 the bandwidths are first crossings of a threshold, so its optimum jumps with the frequency grid; cancellation is
 unique and smooth in the lag. 6 is the smallest round bound that at least doubles the loaded truck's bandwidth at
 30 km/h; in closed loop less lead tracks better, as a larger peak gain turns the controller's fast command changes
-into steering rates at the actuator's limit (README.md, tuning section). `design_lead_for_margins` instead picks
+into steering rates at the actuator's limit (docs/guide/tuning.md). `design_lead_for_margins` instead picks
 Eq. 6 for the shortest lookahead floor of the clothoid loop: with a delay, cancelling leaves the delay untouched.
 
 Reported (and written to the filter file's `design` table) for plant and cascade: the -3 dB bandwidth w_B (where

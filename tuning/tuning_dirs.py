@@ -1,4 +1,4 @@
-"""A vehicle's clothoid-controller tuning directory: its files (the README's "Tuning directories"), the vehicle's
+"""A vehicle's clothoid-controller tuning directory: its files (docs/formats.md), the vehicle's
 identity it is made for (its canonical parameters and their sha256, the payload set to its preset's: the lag
 hardly depends on it), where the shipped and the cached directories live, and reading one into a `VehicleTuning`.
 Which directory a vehicle gets, and making one, is `own_tuning.py`."""

@@ -7,7 +7,7 @@ integrated into the curvature command under the speed-dependent curvature and cu
 `curvature_limits.py`); Ackermann, tan(phi) = L kappa, and the steering ratio; the lead filter of Eq. 6 against
 the steering-to-curvature lag of Eq. 5 (at the controller rate, scheduled on speed; `lead_filter.py`).
 
-Choices the paper leaves open are options (ClothoidConfig); the defaults, and why (measurements in README.md):
+Choices the paper leaves open are options (ClothoidConfig); the defaults, and why (measurements in docs/clothoid.md):
 kappa(0) is the curvature actually driven, yaw rate / speed (the command or the steering's kinematic curvature
 differ from it by understeer and lag, and the fit then leaves a steady offset in every bend); the clothoid starts
 along the rear axle's course, yaw plus sideslip, the direction the vehicle moves in; the Fréchet threshold is the

@@ -5,8 +5,8 @@ Why. Eq. 3 fits one clothoid from the vehicle's (predicted) pose to a target poi
 Even with the vehicle exactly on the path its curvature rate is not the path's: for a path whose curvature varies
 within L the fit through one point gives kappa' = kappa_p' + kappa_p'' L / 4 + ..., so the vehicle turns in ahead
 of the path by about L / 4 and cuts every transition; the feedback then fights that error with a gain that falls
-as L^-3 (README: the dlc's max |CTE| against a fixed lookahead). Tracking therefore asked for short lookaheads,
-and short lookaheads are where the loop loses its margins (`loop_analysis.py`) and falls into limit cycles.
+as L^-3 (docs/clothoid.md: the dlc's max |CTE| against a fixed lookahead). Tracking therefore asked for short
+lookaheads, and short lookaheads are where the loop loses its margins (`loop_analysis.py`) and falls into limit cycles.
 
 What. The same hyper-clothoid is fitted twice to the same target: from the vehicle's predicted pose (as Eq. 3)
 and from the reference pose, where a vehicle exactly on the path would be predicted to (the path's pose ahead by

@@ -2,7 +2,7 @@
 and seeded random draws; for `workbench optimise` also the objective and the search space.
 
 The format, tables [study], [grid], [grid.NAME], [random], [random.NAME] and [optimise] (with its objective and
-search), is described with an example in README.md ("Studies: sweeps and optimisation"). Run parameters
+search), is described with an example in docs/guide/studies.md ("Sweeps and optimisation"). Run parameters
 (RUN_PARAMETERS) are the fields of `SimulationConfig` (its conditions as a preset name or file, and each of their
 scalar fields, `condition_parameters.py`), payload_kg, controller_payload_kg (the payload the controller is built
 for; omitted: the plant's), initial_offset_m and initial_heading_error_deg (omitted: the scenario's own), and

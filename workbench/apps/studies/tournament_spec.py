@@ -8,8 +8,8 @@ failure_score, off_path_m, front_points, inform_delays, max_runs, track_file, de
 file whose [circuits] table the set's generated circuits are drawn within, the run parameter of that name, which
 may be the spec itself when it carries the table), [circuits] (`workbench.simulation.circuit_ranges`), [search.NAME] (a
 controller's search space: its own, `controllers.search_space.controller_search_space`, with the table's entries
-over it, key by key) and [fixed.NAME] (options fixed for every run of a controller). README.md ("Tournament") shows
-an annotated example.
+over it, key by key) and [fixed.NAME] (options fixed for every run of a controller). docs/guide/studies.md
+("Tournament") shows an annotated example.
 
 A case is one scenario (a generated circuit with the ranges file it is drawn within), vehicle, speed, conditions
 and seed; its id (`case_id`) is the same text across controllers and configurations. A case in both sets is
