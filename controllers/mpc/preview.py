@@ -10,7 +10,7 @@ s_k = s_0 + (p_k + p_{k+1}) / 2:
 with v_0 the measured speed: the prediction follows the speed profile's changes from where the vehicle is, not
 its absolute value. The path's samples are on a uniform arc-length grid, read by linear interpolation, wrapped
 on a closed loop and clipped at the ends of an open path. Compiled with numba: this runs on every MPC step, where
-the numpy version's small-array calls cost 30-40 us.
+the same work in small numpy calls costs 30-40 us.
 """
 
 from __future__ import annotations

@@ -15,7 +15,7 @@ vectors l, u, q) and OSQP re-factors without a new symbolic analysis. The previo
 start; `solve` accepts a better one (the previous plan shifted to the current time).
 
 The per-step calls go to the compiled solver that `osqp.OSQP` wraps (`OSQP._solver`, osqp 1.x): the wrapper's
-`update` and `solve` spent about 60 us a step in Python (a module lookup for OSQP_INFTY on every update, an info
+`update` and `solve` spend about 60 us a step in Python (a module lookup for OSQP_INFTY on every update, an info
 namespace built on every solve), a tenth of the LTV-MPC's whole step. Setup and settings go through the wrapper.
 """
 
