@@ -205,7 +205,7 @@ def bench_compared(scenario_name: str, options: ScenarioOptions, clothoid_goals:
             Entry(
                 f"{scenario_name}: {name} / clothoid step median, {vehicle_name}",
                 note=f"ratio {ratio:.1f}, the median of {rounds} rounds' ({', '.join(f'{r:.1f}' for r in ratios)})",
-                goal=None if goal is None else f"ratio >= {goal:g} (issue 19)",
+                goal=None if goal is None else f"ratio >= {goal:g}",
                 goal_met=None if goal is None else ratio >= goal,
                 ratio=ratio,
             )
@@ -244,7 +244,7 @@ def bench_simulator_overhead(vehicle_name: str, plant_us: float, goal_us: float 
         per_step,
         wall_s=wall,
         simulated_s=float(result.trace["t_s"][-1]),
-        goal=None if goal_us is None else f"overhead <= {goal_us:g} us (issue 19)",
+        goal=None if goal_us is None else f"overhead <= {goal_us:g} us",
         goal_met=None if goal_us is None else per_step <= goal_us,
         note=f"{steps} steps; wall per step {wall / steps * 1e6:.1f} us less the plant's {plant_us:.1f} us",
     )
@@ -285,7 +285,7 @@ def bench_cli_lap(track: Path, runs: int = 3) -> Entry:
         real_time_factor=rtf,
         wall_s=wall,
         simulated_s=simulated,
-        goal=f"real-time factor >= {CLI_LAP_GOAL_RTF:g} (issue 19)",
+        goal=f"real-time factor >= {CLI_LAP_GOAL_RTF:g}",
         goal_met=rtf >= CLI_LAP_GOAL_RTF,
         note=f"median of {runs} runs, {min(walls):.2f}-{max(walls):.2f} s wall; {plots} plots",
     )
