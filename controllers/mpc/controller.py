@@ -178,7 +178,7 @@ class MPCController(Controller[MPCConfigT]):
         self._sent_commands = np.zeros(capacity)
         self._sent_count = 0
         names = list(SOLVE_DIAGNOSTICS)
-        if self._delay_s > 0.0:  # logged only when compensating, so a run without is today's trace bit for bit
+        if self._delay_s > 0.0:  # logged only when compensating, so a run without has the plain trace
             names.append("delay_compensation_s")
         if self._pose_filter is not None:  # logged only with the filter on, as the delay compensation
             self._pose_filter.reset()

@@ -188,7 +188,7 @@ class Simulation:
         tracker = path.tracker(0.0)
         controller.reset(path, dt)
         # The conditions between plant and controller (`conditions.py`): each model is left out when ideal, so an
-        # ideal run is today's run bit for bit; what the controller saw is logged beside the true state.
+        # ideal run is the plain closed loop, bit for bit; what the controller saw is logged beside the true state.
         conditions = cfg.conditions
         sensors = None if conditions.sensing_is_ideal else SensorModel(conditions, cfg.seed, dt)
         actuator = None if conditions.actuation.is_ideal else ActuatorModel(conditions, dt, cfg.substeps)
