@@ -46,7 +46,7 @@ def test_newest_release_is_the_package_version():
 def test_sections_are_change_types_and_each_release_has_one():
     release_count = 0
     sections_in_release = 0
-    for line in _lines() + ["## [0.0.0] - 1970-01-01"]:  # a sentinel closes the last release
+    for line in [*_lines(), "## [0.0.0] - 1970-01-01"]:  # a sentinel closes the last release
         if line.startswith("## "):
             assert release_count == 0 or sections_in_release > 0, "a release without a change-type section"
             release_count += 1
