@@ -132,7 +132,8 @@ def loop_margins_figure(out: Path) -> None:
     response = np.squeeze(loop(np.exp(1j * omega * settings.sample_time_s)))
     hz = omega / (2 * math.pi)
     phase_deg = np.degrees(np.unwrap(np.angle(response)))
-    phase_deg -= 360.0 * round(float(phase_deg[np.argmin(np.abs(omega - margins.crossover_rad_s))] + 180.0) // 360)
+    at_crossover_deg = float(phase_deg[np.argmin(np.abs(omega - margins.crossover_rad_s))])
+    phase_deg -= 360.0 * math.floor((at_crossover_deg + 180.0) / 360.0)  # the crossover's phase in [-180, 180)
 
     fig = Figure(figsize=(8, 6), layout="constrained")
     ax_mag, ax_phase = fig.subplots(2, 1, sharex=True)
@@ -141,17 +142,20 @@ def loop_margins_figure(out: Path) -> None:
     ax_phase.semilogx(hz, phase_deg, color="tab:blue")
     ax_phase.axhline(-180.0, color="k", lw=0.6)
     crossover_hz = margins.crossover_rad_s / (2 * math.pi)
+    phase_crossover_hz = margins.phase_crossover_rad_s / (2 * math.pi)
     for ax in (ax_mag, ax_phase):
-        ax.axvline(crossover_hz, color="tab:green", ls="--", lw=0.8)
-        if math.isfinite(margins.phase_crossover_rad_s):
-            ax.axvline(margins.phase_crossover_rad_s / (2 * math.pi), color="tab:red", ls=":", lw=0.8)
+        ax.axvline(crossover_hz, color="tab:green", ls="--", lw=0.8, label=f"gain crossover {crossover_hz:.2f} Hz")
+        if math.isfinite(phase_crossover_hz):
+            label = f"phase crossover {phase_crossover_hz:.2f} Hz"
+            ax.axvline(phase_crossover_hz, color="tab:red", ls=":", lw=0.8, label=label)
         ax.grid(True, which="both", alpha=0.3)
+    ax_mag.legend(loc="lower left", fontsize=8)
     ax_mag.set(
         ylabel="|L| (dB)",
         title=(
             f"Clothoid loop L(z), {TRUCK} at {LOOP_SPEED_KMH:g} km/h, lookahead floor {floor_m:.2f} m\n"
-            f"phase margin {margins.phase_margin_deg:.1f} deg at {crossover_hz:.2f} Hz, "
-            f"gain margins +{margins.gain_margin_db:.1f} dB (red) / {margins.gain_reduction_margin_db:.1f} dB"
+            f"phase margin {margins.phase_margin_deg:.1f} deg, gain margin +{margins.gain_margin_db:.1f} dB, "
+            f"gain-reduction margin {margins.gain_reduction_margin_db:.1f} dB"
         ),
     )
     ax_mag.title.set_fontsize(10)

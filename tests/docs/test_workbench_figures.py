@@ -156,3 +156,9 @@ def test_snippets_are_excluded_from_the_pages_once(figures: ModuleType) -> None:
     figures.exclude_snippets(None, config)
     figures.exclude_snippets(None, config)
     assert config.exclude_patterns == ["_build", figures.SNIPPETS_PATTERN]
+
+
+def test_loop_margins_figure_is_drawn(figures: ModuleType, tmp_path: Path) -> None:
+    out = tmp_path / "loop_margins_truck.png"
+    figures.loop_margins_figure(out)
+    assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
