@@ -142,12 +142,18 @@ def loop_margins_figure(out: Path) -> None:
     ax_phase.semilogx(hz, phase_deg, color="tab:blue")
     ax_phase.axhline(-180.0, color="k", lw=0.6)
     crossover_hz = margins.crossover_rad_s / (2 * math.pi)
+    # Where the phase crosses -180 deg with |L| > 1: the gain-reduction margin's frequencies.
+    above_minus_180 = phase_deg > -180.0
+    crossings = np.nonzero(above_minus_180[1:] != above_minus_180[:-1])[0]
+    reduction_crossings = [i for i in crossings if abs(response[i]) > 1.0][-1:]
     phase_crossover_hz = margins.phase_crossover_rad_s / (2 * math.pi)
     for ax in (ax_mag, ax_phase):
         ax.axvline(crossover_hz, color="tab:green", ls="--", lw=0.8, label=f"gain crossover {crossover_hz:.2f} Hz")
         if math.isfinite(phase_crossover_hz):
             label = f"phase crossover {phase_crossover_hz:.2f} Hz"
             ax.axvline(phase_crossover_hz, color="tab:red", ls=":", lw=0.8, label=label)
+        for i in reduction_crossings:
+            ax.axvline(hz[i], color="tab:orange", ls=":", lw=0.8, label=f"phase crossover {hz[i]:.2f} Hz (|L| > 1)")
         ax.grid(True, which="both", alpha=0.3)
     ax_mag.legend(loc="lower left", fontsize=8)
     ax_mag.set(
