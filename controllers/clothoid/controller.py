@@ -47,7 +47,7 @@ from controllers.clothoid import step_kernel as sk
 from controllers.clothoid.curvature_limits import CurvatureLimits
 from controllers.clothoid.delay_predictor import history_length
 from controllers.clothoid.filter_schedule import FilterSchedule
-from controllers.clothoid.lead_filter import DiscreteLeadFilter
+from controllers.clothoid.lead_filter import DiscreteLeadFilter, LeadFilterParams
 from controllers.clothoid.lookahead import MAX_CURVE_POINTS, candidate_count
 from controllers.clothoid.lookahead_filter import RATE_LIMIT
 from controllers.clothoid.path_feedforward import FeedforwardTiming
@@ -547,10 +547,9 @@ class ClothoidController(Controller[ClothoidConfig]):
         """What the controller does at this speed, for `loop_analysis`."""
         from controllers.clothoid.loop_analysis import LoopSettings
 
-        lead = self.filter_schedule.at_speed(speed_kmh) if self.filter_schedule is not None else None
         cfg = self.config
         return LoopSettings(
-            self._dt, cfg.prediction_time_s, lead=lead, known_delay_s=cfg.known_delay_s,
+            self._dt, cfg.prediction_time_s, lead=self._lead_at(speed_kmh), known_delay_s=cfg.known_delay_s,
             delay_compensation=cfg.delay_compensation,
         )  # fmt: skip
 
@@ -565,15 +564,15 @@ class ClothoidController(Controller[ClothoidConfig]):
         cfg = self.config
         floor = self._floors.get(band)
         if floor is None:
-            inputs = self._floor_inputs(band)
-            if inputs is None:
-                floor = cfg.min_lookahead_m
-            else:
-                lags, settings, v, curvatures, delayed = inputs
-                floor = self._recorded_floor_m(band * FLOOR_SPEED_BAND_KMH, settings, curvatures)
-                if floor is None:
+            floor = self._recorded_floor_m(band * FLOOR_SPEED_BAND_KMH)
+            if floor is None:
+                inputs = self._floor_inputs(band)
+                if inputs is None:
+                    floor = cfg.min_lookahead_m
+                else:
                     from controllers.clothoid.loop_analysis import lookahead_floor  # python-control: when used
 
+                    lags, settings, v, curvatures, delayed = inputs
                     floor = lookahead_floor(
                         lags, settings, v, cfg.min_lookahead_m, self._floor_search_top_m, cfg.lookahead_step_m,
                         curvatures, cfg.min_phase_margin_deg, cfg.min_gain_margin_db, delayed,
@@ -581,21 +580,34 @@ class ClothoidController(Controller[ClothoidConfig]):
             self._floors[band] = floor
         return floor
 
-    def _recorded_floor_m(
-        self, speed_kmh: float, settings: LoopSettings, curvatures: tuple[float, float]
-    ) -> float | None:
-        """The floor the tuning's margins design computed at this speed (km/h), when it is the one this analysis
-        computes: the tuning's lags there (`plant_lags`), the same lead filter, loop settings, path curvatures,
-        search grid and margins (`VehicleTuning.recorded_floor_m`); None otherwise (the floor is computed)."""
-        if self.tuning is None:
-            return None
+    def _recorded_floor_m(self, speed_kmh: float) -> float | None:
+        """The floor the tuning's margins design computed at this speed (km/h), when it is the one the analysis
+        of `_floor_inputs` computes: the tuning's lags there (`plant_lags`), the same lead filter, loop settings,
+        path curvatures, search grid and margins (`VehicleTuning.recorded_floor_m`); None otherwise (the floor is
+        computed), and None without a floor (no tuning, the margins set to 0). Built from the config alone, without
+        the loop analysis (python-control), which a reused floor does not need."""
         cfg, g = self.config, self.geometry
+        if self.tuning is None or (cfg.min_phase_margin_deg <= 0.0 and cfg.min_gain_margin_db <= 0.0):
+            return None
+        v = speed_kmh / 3.6
+        kappa_max, _ = self.limits.at_speed(v)
         inputs = FloorInputs(
-            speed_kmh, settings.lead, settings.sample_time_s, settings.prediction_time_s, settings.known_delay_s,
-            curvatures, (cfg.min_lookahead_m, self._floor_search_top_m, cfg.lookahead_step_m),
+            speed_kmh, self._lead_at(speed_kmh), self._dt, cfg.prediction_time_s, cfg.known_delay_s,
+            (0.0, self._floor_arc_1pm(v)), (cfg.min_lookahead_m, self._floor_search_top_m, cfg.lookahead_step_m),
             cfg.min_phase_margin_deg, cfg.min_gain_margin_db,
         )  # fmt: skip
-        return self.tuning.recorded_floor_m(inputs, math.tan(g.max_road_wheel_angle_rad) / g.wheelbase_m)
+        lock_1pm = math.tan(g.max_road_wheel_angle_rad) / g.wheelbase_m
+        return self.tuning.recorded_floor_m(inputs, lock_1pm, kappa_max)
+
+    def _floor_arc_1pm(self, speed_mps: float) -> float:
+        """The arc (1/m) the floor is checked about besides the straight: FLOOR_ARC_LATERAL_ACCEL_G at this speed,
+        capped by the curvature limit there."""
+        kappa_max, _ = self.limits.at_speed(speed_mps)
+        return min(kappa_max, FLOOR_ARC_LATERAL_ACCEL_G * G_MPS2 / speed_mps**2)
+
+    def _lead_at(self, speed_kmh: float) -> LeadFilterParams | None:
+        """The lead filter's parameters at this speed (km/h); None without a lead filter."""
+        return self.filter_schedule.at_speed(speed_kmh) if self.filter_schedule is not None else None
 
     @property
     def _floor_search_top_m(self) -> float:
@@ -618,12 +630,10 @@ class ClothoidController(Controller[ClothoidConfig]):
         from controllers.clothoid.loop_analysis import DelayRobustness  # python-control: imported when used
 
         v = speed_kmh / 3.6
-        kappa_max, _ = self.limits.at_speed(v)
-        arc = min(kappa_max, FLOOR_ARC_LATERAL_ACCEL_G * G_MPS2 / v**2)
         delayed = DelayRobustness(
             cfg.min_delayed_phase_margin_deg, cfg.min_delayed_gain_margin_db, cfg.known_delay_uncertainty_s
         )
-        return lags, self.loop_settings(speed_kmh), v, (0.0, arc), delayed
+        return lags, self.loop_settings(speed_kmh), v, (0.0, self._floor_arc_1pm(v)), delayed
 
     def _band_keeps_margins(self, band: int) -> bool:
         """Whether the lookahead floor of speed band `band` keeps the configured margins (False: no lookahead up to

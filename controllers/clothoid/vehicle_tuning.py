@@ -26,6 +26,9 @@ from workbench.vehicles.steering_lag import SteeringLag
 
 #: The parameters of a lag the tables hold, in their order (`VehicleTuning.lag_tables`).
 LAG_COLUMNS = ("omega_n_rad_s", "zeta", "delay_s", "steady_state_gain")
+#: Relative tolerance (-) within which two inputs of a lookahead floor are one (`FloorInputs.matches`): a rounding
+#: apart, far below any difference that moves a floor by a step of its grid.
+FLOOR_INPUT_REL_TOL = 1e-9
 
 
 @dataclass(frozen=True)
@@ -34,7 +37,7 @@ class FloorInputs:
     that speed: speed_kmh (km/h), lead (the lead filter there; None: none), sample_time_s (controller period, s),
     prediction_time_s (s), known_delay_s (s), path_curvatures_1pm (the straight and the arc it is checked about,
     1/m), lookahead_grid_m (the search's shortest and longest lookahead and its step, m), phase_margin_deg and
-    gain_margin_db (the margins kept). Two floors with equal inputs and lags are equal."""
+    gain_margin_db (the margins kept). Two floors with equal inputs and lags are equal (`matches`)."""
 
     speed_kmh: float
     lead: LeadFilterParams | None
@@ -45,6 +48,26 @@ class FloorInputs:
     lookahead_grid_m: tuple[float, float, float]
     phase_margin_deg: float
     gain_margin_db: float
+
+    def matches(self, other: FloorInputs) -> bool:
+        """Whether other's floor is this one's: the same speed and lead filter, and every number within
+        FLOOR_INPUT_REL_TOL of this one's. Tolerance, not equality, because some are computed (the arc, the period
+        from a rate) and two computations of one value may differ by a rounding (v * v against v**2); such a
+        difference is far below any that moves a floor on its grid. The search grid must be the same: a floor
+        searched from a lower start is not the floor searched from a higher one, as `lookahead_floor`'s bisection
+        visits other lookaheads and, where the margins fail in a gap above a passing lookahead, stops elsewhere."""
+        if self.speed_kmh != other.speed_kmh or self.lead != other.lead:
+            return False
+        ours, theirs = self._numbers(), other._numbers()
+        return len(ours) == len(theirs) and all(
+            math.isclose(a, b, rel_tol=FLOOR_INPUT_REL_TOL) for a, b in zip(ours, theirs, strict=True)
+        )
+
+    def _numbers(self) -> tuple[float, ...]:
+        return (
+            self.sample_time_s, self.prediction_time_s, self.known_delay_s, *self.path_curvatures_1pm,
+            *self.lookahead_grid_m, self.phase_margin_deg, self.gain_margin_db,
+        )  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -61,11 +84,20 @@ class FloorDesign:
     phase_margin_deg: float = REQUIRED_PHASE_MARGIN_DEG
     gain_margin_db: float = REQUIRED_GAIN_MARGIN_DB
 
-    def inputs(self, speed_kmh: float, lead: LeadFilterParams, lock_curvature_1pm: float) -> FloorInputs:
+    def inputs(
+        self,
+        speed_kmh: float,
+        lead: LeadFilterParams,
+        lock_curvature_1pm: float,
+        curvature_limit_1pm: float = math.inf,
+    ) -> FloorInputs:
         """The inputs of its floor at speed_kmh (km/h) with this lead filter, the arc capped at the steered
-        vehicle's lock curvature (1/m), as `tuning.schedule.margins_arc_curvature_1pm` caps it."""
+        vehicle's lock curvature (1/m), as `tuning.schedule.margins_arc_curvature_1pm` caps it, and then at
+        curvature_limit_1pm (1/m; the controller's curvature limit at that speed, which caps the controller's own
+        arc: at and below the lock, it bounds the arcs the controller steers, and its table's rounding must not
+        make the two arcs differ)."""
         v = speed_kmh / 3.6
-        arc = min(lock_curvature_1pm, self.arc_lateral_accel_g * G_MPS2 / (v * v))
+        arc = min(curvature_limit_1pm, lock_curvature_1pm, self.arc_lateral_accel_g * G_MPS2 / (v * v))
         return FloorInputs(
             speed_kmh, lead, self.sample_time_s, self.prediction_time_s, 0.0, (0.0, arc), self.lookahead_grid_m,
             self.phase_margin_deg, self.gain_margin_db,
@@ -116,15 +148,19 @@ class VehicleTuning:
             raise WorkbenchInputError("floors need their floor_design (what they were computed for)")
         object.__setattr__(self, "floors", floors)
 
-    def recorded_floor_m(self, inputs: FloorInputs, lock_curvature_1pm: float) -> float | None:
-        """The lookahead floor (m) this tuning computed at inputs.speed_kmh, when it was computed from exactly
-        these inputs (the steered vehicle's lock curvature, 1/m, caps its arc) and this tuning's lags there (both
-        lags identified); None otherwise: then the floor is to be computed."""
+    def recorded_floor_m(
+        self, inputs: FloorInputs, lock_curvature_1pm: float, curvature_limit_1pm: float = math.inf
+    ) -> float | None:
+        """The lookahead floor (m) this tuning computed at inputs.speed_kmh, when it was computed from these inputs
+        (`FloorInputs.matches`; the steered vehicle's lock curvature and the controller's curvature limit there,
+        1/m, cap its arc as `FloorDesign.inputs` says) and this tuning's lags there (both lags identified); None
+        otherwise: then the floor is to be computed."""
         design, floor = self.floor_design, dict(self.floors).get(inputs.speed_kmh)
         if design is None or floor is None or not self.measured_lags:
             return None
         lead = self.filter_schedule.at_speed(inputs.speed_kmh)
-        return floor if design.inputs(inputs.speed_kmh, lead, lock_curvature_1pm) == inputs else None
+        recorded = design.inputs(inputs.speed_kmh, lead, lock_curvature_1pm, curvature_limit_1pm)
+        return floor if recorded.matches(inputs) else None
 
     @functools.cached_property
     def lag_tables(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
