@@ -325,3 +325,6 @@ class Controller(ABC, Generic[ConfigT]):
         if abs(m.x_m) > MAX_POSITION_M or abs(m.y_m) > MAX_POSITION_M:
             return f"position ({float(m.x_m):g}, {float(m.y_m):g}) m is beyond +-{MAX_POSITION_M:g} m"
         return f"t_s = {float(m.t_s):g} s is beyond +-{MAX_TIME_S:g} s"
+
+
+__all__ = ["Controller"]

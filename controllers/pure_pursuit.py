@@ -56,6 +56,9 @@ class PurePursuitConfig:
 
 
 class PurePursuit(Controller[PurePursuitConfig]):
+    """Pure pursuit, registered as "pure-pursuit": steers onto the arc through the rear axle and the lookahead
+    point (module docstring for the law), with the options of `PurePursuitConfig`."""
+
     name: ClassVar[str] = "pure-pursuit"
     config_type: ClassVar[type] = PurePursuitConfig
     search_space: ClassVar[tuple[Tunable, ...]] = (
@@ -119,3 +122,6 @@ def pure_pursuit_step(
     if distance < 1e-6:  # at the very end of an open path: hold the path's curvature
         return foot_curvature, lookahead, target_s
     return 2.0 * math.sin(math.atan2(dy, dx) - yaw_rad) / distance, lookahead, target_s
+
+
+__all__ = ["PurePursuit", "PurePursuitConfig"]

@@ -92,6 +92,9 @@ class StanleyConfig:
 
 
 class Stanley(Controller[StanleyConfig]):
+    """Stanley, registered as "stanley": heading error plus a front-axle cross-track term, with an optional
+    curvature feed-forward (module docstring for the law), with the options of `StanleyConfig`."""
+
     name: ClassVar[str] = "stanley"
     config_type: ClassVar[type] = StanleyConfig
     search_space: ClassVar[tuple[Tunable, ...]] = (
@@ -151,3 +154,6 @@ class Stanley(Controller[StanleyConfig]):
         self._diag[:] = (foot.cte_m, heading_term, cross_track_term, feedforward)
         limit = self.geometry.max_road_wheel_angle_rad
         return self.saturate(min(max(road_wheel, -limit), limit) * self.geometry.steering_ratio)
+
+
+__all__ = ["Stanley", "StanleyConfig"]

@@ -457,3 +457,17 @@ def _fit_lag(
         source=text,
     )
     return LagFit(lag=lag, logs=tuple(fitted_logs), options=options)
+
+
+__all__ = [
+    "FittedLog",
+    "LagFit",
+    "LagFitOptions",
+    "SteeringGeometry",
+    "fit_lag",
+    "kinematic_curvature",
+    "path_curvature",
+    "realised_curvature",
+    "simulate_unit_dc",
+    "yaw_rate_curvature",
+]

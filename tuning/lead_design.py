@@ -529,3 +529,16 @@ def _design_lead_for_margins(
     without = floor_of(None)
     design = replace(_report(params, lags.path, max_lead_gain, math.inf, None), method="margins")
     return MarginsDesign(design, floor, without, count, chosen_score)
+
+
+__all__ = [
+    "LeadDesign",
+    "MarginsDesign",
+    "ValidationTrace",
+    "check_design_bounds",
+    "design_lead",
+    "design_lead_for_margins",
+    "margin_score",
+    "tracking_bandwidth",
+    "validate",
+]

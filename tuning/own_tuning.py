@@ -247,3 +247,16 @@ def tuned_controller(
     if delays is not None and name in CONTROLLERS:
         config = CONTROLLERS[name].informed_config(config, delays)
     return make_controller(name, vehicle.geometry, config, vehicle=vehicle)
+
+
+__all__ = [
+    "TunableConfig",
+    "cache_key",
+    "generate_vehicle_tuning",
+    "manual_instructions",
+    "shipped_tuning_dir",
+    "tuned_controller",
+    "tuning_dir_for",
+    "tuning_for",
+    "with_vehicle_tuning",
+]

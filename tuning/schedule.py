@@ -12,7 +12,7 @@ prediction, with 45 deg / 6 dB margins about a straight and an arc of 0.4 g).
 
 The filters form a `FilterSchedule`, written in the lead-filter file format with a `schedule` list, which the
 clothoid controller interpolates at the current speed; the file's `design` table keeps, per speed, the identified
-lags (the measured lag's keys prefixed measured_), the filter, and with "margins" the floor with and without it.
+lags (the measured lag's keys prefixed `measured_`), the filter, and with "margins" the floor with and without it.
 With a fitted delay (`tuning schedule --delay`) Eq. 5 matches the plant's frequency response where it matters for
 the loop; the chirp is logged because on dlc and steps alone delay and damping trade off (`tuning/lag_fit.py`).
 `drop_refused=True` (`--drop-refused`) leaves a refused speed out, recorded with the reason in the file's
@@ -405,3 +405,15 @@ def identify_schedule(
 
 def _floor_text(floor_m: float) -> str:
     return f"{floor_m:g} m" if math.isfinite(floor_m) else f"none up to {MARGINS_LOOKAHEAD_M[1]:g} m"
+
+
+__all__ = [
+    "DroppedSpeed",
+    "ScheduleEntry",
+    "ScheduleResult",
+    "identification_logs",
+    "identify_schedule",
+    "lock_curvature_1pm",
+    "margins_arc_curvature_1pm",
+    "steer_amplitude_deg",
+]

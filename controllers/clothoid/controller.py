@@ -734,3 +734,6 @@ class ClothoidController(Controller[ClothoidConfig]):
                 # the kernel asks for a lead filter only when there is a schedule to make it from
                 params = self.filter_schedule.at_speed(float(need))  # type: ignore[union-attr]
                 self._state["filters"][0, need] = DiscreteLeadFilter(params, self._dt).coefficients
+
+
+__all__ = ["ClothoidConfig", "ClothoidController"]

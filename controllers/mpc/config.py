@@ -171,3 +171,6 @@ MPC_SEARCH_SPACE = (
     Tunable("step_s", "linear", 0.04, 0.1, reason="a longer prediction step sees further for the same solve time, "
             "with a coarser model of fast motion"),
 )  # fmt: skip
+
+
+__all__ = ["MPCConfig"]

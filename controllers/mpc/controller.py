@@ -411,3 +411,6 @@ class MPCController(Controller[MPCConfigT]):
         progress = float(z[nx])
         planned_change = float(self._preview.along(s0_m, np.array([progress, progress]), 0.0, -math.inf)[0, 1])
         return z[:nx], s0_m + progress, v0_mps + planned_change
+
+
+__all__ = ["MPCController"]

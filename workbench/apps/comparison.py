@@ -57,6 +57,7 @@ if TYPE_CHECKING:
 #: side of it along the path, and at least ZOOM_MIN_HALF_LENGTH_M (m): the runs' spread then shows at the inset's
 #: scale.
 ZOOM_CTE_FACTOR = 8.0
+#: The shortest half-length (m) of the inset's stretch either side of its centre along the path.
 ZOOM_MIN_HALF_LENGTH_M = 1.0
 #: What shortens a comparison's run refused as too long (`run_size.check_run_size`).
 LONG_RUN_SHORTENED = "a higher speed, fewer laps or a max_time_s (--speed, --laps, --max-time-s) shortens it"

@@ -176,3 +176,6 @@ def compute_metrics(
         min_track_margin_m=margin,
         left_track=None if margin is None else margin < 0.0,
     )
+
+
+__all__ = ["Metrics", "approach_end", "compute_metrics", "offtracking"]

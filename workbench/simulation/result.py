@@ -152,3 +152,6 @@ def _write_parquet(trace: dict[str, np.ndarray], file: Path) -> None:
         return pa.array(values)
 
     pq.write_table(pa.Table.from_arrays([arrow(v) for v in trace.values()], names=list(trace)), file)
+
+
+__all__ = ["SimulationResult", "Status"]

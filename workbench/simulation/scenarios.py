@@ -356,3 +356,19 @@ def describe_scenarios(options: ScenarioOptions | None = None) -> list[tuple[str
 
     rows.append((f"{CIRCUIT_PREFIX}SEED", circuit_family_description()))
     return rows
+
+
+__all__ = [
+    "DoubleLaneChangeLayout",
+    "describe_scenarios",
+    "double_lane_change",
+    "fig17",
+    "figure8",
+    "from_file",
+    "is_named_scenario",
+    "is_zandvoort_file",
+    "make_scenario",
+    "zandvoort",
+    "zandvoort_places",
+    "zandvoort_track_file",
+]

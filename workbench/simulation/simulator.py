@@ -388,3 +388,6 @@ class _TraceLog:
         n = self.n
         columns = self.columns if n else self.columns[: self.seen_offset]
         return {name: self.table[:n, k].copy() for k, name in enumerate(columns)}
+
+
+__all__ = ["Simulation", "plan_path_speed", "plan_path_speed_and_top"]

@@ -226,3 +226,6 @@ def models_with_tyres() -> list[str]:
         if cls.has_tyres and isinstance(getattr(cls, "name", None), str):
             names.add(cls.name)
     return sorted(names)
+
+
+__all__ = ["CompiledVehicleModel", "PlantStepError", "VehicleModel", "VehicleParams", "models_with_tyres"]

@@ -105,6 +105,9 @@ def _commonroad_parameters(vehicle_id: int) -> Any:
 
 
 class CommonRoadMB(VehicleModel[CommonRoadMBParams]):
+    """CommonRoad's 29-state multi-body car as a plant, registered as "commonroad-mb" (module docstring): the
+    published model behind this workbench's steering actuator, reported at the rear-axle centre."""
+
     name: ClassVar[str] = "commonroad-mb"
     state_names: ClassVar[tuple[str, ...]] = _MB_STATES
     extra_output_names: ClassVar[tuple[str, ...]] = ("roll_rad", "path_curvature_1pm")
@@ -217,3 +220,6 @@ class CommonRoadMB(VehicleModel[CommonRoadMBParams]):
                 kappa,
             ]
         )
+
+
+__all__ = ["CommonRoadMB", "CommonRoadMBParams"]

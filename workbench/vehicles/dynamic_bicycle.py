@@ -2,9 +2,11 @@
 
 Stands in for a CarSim C-class car. States (SI): x_m, y_m (rear-axle centre), yaw_rad, vx_mps (longitudinal
 speed), vy_cg_mps (CG lateral velocity, body frame), yaw_rate_rad_s, road_wheel_angle_rad, fy_front_N,
-fy_rear_N (axle lateral forces, lagging their steady-state value by the relaxation length).
+fy_rear_N (axle lateral forces, lagging their steady-state value by the relaxation length)::
+
     m (dvy + vx r) = Fyf cos(delta) + Fyr,   Iz dr = a Fyf cos(delta) - b Fyr,   dvx = a_x (realised command),
     dFy = (vx / sigma) (Fy_ss(alpha) - Fy),  Fy_ss = -mu Fz sin(C atan(B alpha - E (B alpha - atan(B alpha)))),
+
 with B = k / (C mu) so that the cornering stiffness is k Fz, and Fz the axle load including the longitudinal
 load transfer m a_x h / L (as CommonRoad's ST model). Below kinematic_blend_high_mps the lateral accelerations
 blend into the kinematic bicycle's, so the model is well-posed at v = 0 and equals the kinematic bicycle there.
@@ -149,6 +151,9 @@ def _outputs(s, p, delta_cmd, accel, ratio):  # pragma: no cover - compiled
 
 
 class DynamicBicycle(CompiledVehicleModel[DynamicBicycleParams]):
+    """The dynamic single-track car with magic-formula tyres and relaxation length, registered as
+    "dynamic-bicycle" (module docstring for its equations and states)."""
+
     name: ClassVar[str] = "dynamic-bicycle"
     state_names: ClassVar[tuple[str, ...]] = (
         "x_m",
@@ -214,3 +219,6 @@ class DynamicBicycle(CompiledVehicleModel[DynamicBicycleParams]):
             tyre_curvature_factor=p.tyre_curvature_factor,
         )
         return PredictionParams.from_actuator(p, a + b, source or f"the {self.name} model's parameters", track)
+
+
+__all__ = ["DynamicBicycle", "DynamicBicycleParams"]

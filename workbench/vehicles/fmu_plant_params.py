@@ -221,3 +221,6 @@ def _require_pair(parameter_field: str, parameter: str | None, value_field: str,
             f"{parameter_field} and {value_field} are given together or both \"none\"; got {value_text(parameter)} "
             f"and {value_text(value)}"
         )
+
+
+__all__ = ["FmuPlantParams"]

@@ -1,8 +1,10 @@
 """Kinematic bicycle with a first-order, rate-limited steering actuator, referenced at the rear-axle centre.
 
-States: x_m, y_m (rear-axle centre), yaw_rad, speed_mps, road_wheel_angle_rad.
+States: x_m, y_m (rear-axle centre), yaw_rad, speed_mps, road_wheel_angle_rad::
+
     x' = v cos(yaw), y' = v sin(yaw), yaw' = v tan(delta) / L,
     v' = a (v stays >= 0), delta' = clip((delta_cmd - delta) / tau, +-rate_max), delta_cmd = clip(sw_cmd / i_s).
+
 No tyre slip: the path curvature follows the road-wheel angle exactly (tan(delta) = L kappa), so this plant shows
 none of the lag of the paper's section 5. It is the reference the dynamic models must approach at low speed.
 """
@@ -66,6 +68,9 @@ def _advance(state, p, delta_cmd, accel, h, n):  # pragma: no cover - compiled
 
 
 class KinematicBicycle(CompiledVehicleModel[KinematicBicycleParams]):
+    """The kinematic bicycle with a first-order, rate-limited steering actuator, registered as
+    "kinematic-bicycle": no tyre slip (module docstring for its equations and states)."""
+
     name: ClassVar[str] = "kinematic-bicycle"
     state_names: ClassVar[tuple[str, ...]] = ("x_m", "y_m", "yaw_rad", "speed_mps", "road_wheel_angle_rad")
 
@@ -88,3 +93,6 @@ class KinematicBicycle(CompiledVehicleModel[KinematicBicycleParams]):
         """The kinematic single track with this model's actuator (no tyres)."""
         p = self.params
         return PredictionParams.from_actuator(p, p.wheelbase_m, source or f"the {self.name} model's parameters")
+
+
+__all__ = ["KinematicBicycle", "KinematicBicycleParams"]

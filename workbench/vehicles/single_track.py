@@ -190,3 +190,6 @@ def params_from_geometry(geometry: VehicleGeometry) -> PredictionParams:
         max_road_wheel_rate_rad_s=geometry.max_steer_wheel_rate_rad_s / geometry.steering_ratio,
         source="geometry only (kinematic single track, assumed actuator time constant)",
     )
+
+
+__all__ = ["PredictionParams", "SingleTrackParams", "SteeringActuator", "params_from_geometry"]

@@ -396,6 +396,9 @@ def _outputs(s, p, delta_cmd, accel, ratio):  # pragma: no cover - compiled
 
 
 class TractorSemitrailer(CompiledVehicleModel[TractorSemitrailerParams]):
+    """The articulated tractor-semitrailer with saturating tyres, a steering system and quasi-static roll,
+    registered as "tractor-semitrailer", referenced at the tractor's drive-group centre (module docstring)."""
+
     name: ClassVar[str] = "tractor-semitrailer"
     state_names: ClassVar[tuple[str, ...]] = (
         "x_m",
@@ -484,3 +487,6 @@ class TractorSemitrailer(CompiledVehicleModel[TractorSemitrailerParams]):
             f"{super().describe()}, mass {dv.m1 + dv.m2:.0f} kg (payload {self.params.payload_kg:.0f} kg), "
             f"static rollover threshold {dv.rollover_threshold_g:.2f} g"
         )
+
+
+__all__ = ["Derived", "TractorSemitrailer", "TractorSemitrailerParams", "derive"]

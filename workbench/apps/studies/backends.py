@@ -47,6 +47,7 @@ from workbench.apps.studies.worker_setup import prepare_worker_process
 from workbench.base.errors import WorkbenchInputError, value_text
 from workbench.simulation.plot_worker import usable_cpus
 
+#: The names `make_backend` accepts: "local" (worker processes on this machine) or "dask" (a Dask cluster).
 BACKENDS = ("local", "dask")
 
 
