@@ -8,8 +8,10 @@ build starts (`builder-inited`), into docs/_generated/ (git-ignored).
   its shipped tuning, at the lookahead floor: Bode plot with the gain and phase margins
   (controllers/clothoid/loop_analysis.py).
 - _generated/fig17_cte.png: CTE against distance on the fig17 scenario, the clothoid controller and the NMPC on the
-  truck (`workbench.apps.comparison.compare`). Kept between builds while the code it depends on is unchanged (a
-  hash of the sources, in fig17_cte.key).
+  truck (`workbench.apps.comparison.compare`).
+
+Both figures are kept between builds while the code that makes them is unchanged (a hash of its sources, in
+<figure>.key beside each).
 """
 
 from __future__ import annotations
@@ -32,8 +34,9 @@ SNIPPET_NAMES = {"steering": "steering_summary"}
 LOOP_SPEED_KMH = 30.0
 #: Vehicle of both figures: the loaded truck preset.
 TRUCK = "tractor-semitrailer"
-#: Source folders whose code makes the fig17 figure: a change in any of their files re-runs it.
-FIG17_SOURCES = ("controllers", "tuning", "workbench")
+#: Source folders (from the repository's root) of the code that makes the figures, this extension included: a
+#: change in any of their Python or TOML files makes the figures again.
+FIGURE_SOURCES = ("controllers", "tuning", "workbench", "docs/_ext")
 #: Significant digits of the numbers in the benchmark tables.
 SIGNIFICANT_DIGITS = 4
 
@@ -169,7 +172,7 @@ def loop_margins_figure(out: Path) -> None:
     fig.savefig(out, dpi=110)
 
 
-def source_hash(folders: Sequence[str] = FIG17_SOURCES, root: Path = REPO) -> str:
+def source_hash(folders: Sequence[str] = FIGURE_SOURCES, root: Path = REPO) -> str:
     """SHA-256 over the paths and contents of the Python and TOML files under these folders: the code version a
     cached figure was made with."""
     digest = hashlib.sha256()
