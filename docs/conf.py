@@ -30,7 +30,9 @@ sys.path.insert(0, str(ROOT))
 if (DOCS / "_ext" / "workbench_figures.py").exists():
     sys.path.insert(0, str(Path(__file__).parent / "_ext"))
 
-os.environ.setdefault("MPLBACKEND", "Agg")  # the notebooks' kernels inherit it: figures without a display
+# The notebooks' kernels inherit the environment: without MPLBACKEND, IPython's inline backend shows each cell's
+# figures in its output (with MPLBACKEND=Agg, as the tests run them, a figure would be drawn and never shown).
+os.environ.pop("MPLBACKEND", None)
 
 project = "Lateral-control workbench"
 author = "The workbench's authors"
