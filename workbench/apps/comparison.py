@@ -329,7 +329,45 @@ def compare(
     planned speed (`workbench.simulation.feasibility`) is refused before any run starts, naming each such vehicle,
     the places and the limit (`feasibility.refuse_infeasible`, as `workbench run` refuses it), unless
     allow_infeasible (`--allow-infeasible`): then it is announced through `warn` with the other warnings and run,
-    for a study of how the controllers fail there."""
+    for a study of how the controllers fail there.
+
+    Parameters
+    ----------
+    scenario : str or Scenario
+        A scenario name (`workbench scenarios` lists them), a waypoint file, or a built `Scenario`.
+    runs : sequence of RunSpec
+        The (controller, vehicle, options) runs, each at most once; at least one.
+    config : SimulationConfig, optional
+        The simulation settings every run shares (None: the defaults).
+    scenario_options : ScenarioOptions, optional
+        Options of a named scenario or a waypoint file (None: its defaults).
+    reference_controller : str or None
+        The controller whose step time the table's ``step_time_ratio`` column divides by (None: no ratio).
+    warn : callable or None
+        Called with each warning before the first run (None: silent).
+    progress : bool
+        Show a progress bar on stderr.
+    allow_long_run, allow_infeasible : bool
+        Run what would otherwise be refused as too long, or on a path a vehicle cannot follow.
+
+    Returns
+    -------
+    Comparison
+        The results in the order of `runs`: ``summary()`` gives a pandas DataFrame of their metrics,
+        ``plot_trajectories()`` and ``plot_cte()`` draw them.
+
+    Raises
+    ------
+    WorkbenchInputError
+        No run, a run given twice, two runs that would write to one folder, an unknown controller, vehicle or
+        option, a run too long or a path infeasible (unless allowed).
+
+    Examples
+    --------
+    >>> from workbench.apps.comparison import RunSpec, compare
+    >>> result = compare("dlc", [RunSpec("clothoid", "kinematic-bicycle"), RunSpec("stanley", "kinematic-bicycle")])
+    >>> result.summary()[["controller", "max_abs_cte_m"]]  # doctest: +SKIP
+    """
     if not runs:
         raise WorkbenchInputError("a comparison needs at least one (controller, vehicle) run; got none")
     if len(set(runs)) != len(runs):
