@@ -163,7 +163,41 @@ def make_controller(
 ) -> Controller:
     """Build the controller registered under `name` for a vehicle, with its default config unless one is given
     (an instance of that controller's `config_type`, which the name chooses: the controller checks it).
-    `vehicle` (the steered vehicle) gives model-based controllers (the MPCs) their prediction parameters."""
+    `vehicle` (the steered vehicle) gives model-based controllers (the MPCs) their prediction parameters.
+
+    Parameters
+    ----------
+    name : str
+        A registered controller name (`CONTROLLERS`: "clothoid", "pure-pursuit", "stanley", "lmpc", "nmpc" and
+        any registered through the entry points).
+    geometry : VehicleGeometry
+        The steered vehicle's geometry (wheelbase, steering ratio and limits).
+    config : dataclass instance, optional
+        The controller's options, an instance of its ``config_type`` (None: the defaults).
+    vehicle : VehicleModel, optional
+        The steered vehicle, for the controllers that predict with its model.
+
+    Returns
+    -------
+    Controller
+        The controller, ready to step.
+
+    Raises
+    ------
+    WorkbenchInputError
+        An unknown name (the message lists the registered ones), a config the controller refuses, or a vehicle
+        the controller has no tuning for.
+
+    Examples
+    --------
+    >>> from controllers import make_controller
+    >>> from workbench.vehicles import make_vehicle
+    >>> car = make_vehicle("kinematic-bicycle")
+    >>> controller = make_controller("stanley", car.geometry)
+
+    The clothoid controller given a vehicle needs that vehicle's tuning: `tuning.own_tuning.tuned_controller`
+    builds it with the tuning.
+    """
     CONTROLLERS.require(name)
     return CONTROLLERS[name](geometry, config, vehicle=vehicle)
 
