@@ -354,7 +354,30 @@ def fit_lag(
 ) -> LagFit:
     """Fit Eq. 5 (omega_n, zeta; optionally a delay) to all logs jointly; see the module docstring. BLAS runs
     single-threaded meanwhile: the fit's thousands of 4 x 4 matrix exponentials are several times slower with
-    threads (two OpenBLAS pools, numpy's and scipy's, contend on a small machine)."""
+    threads (two OpenBLAS pools, numpy's and scipy's, contend on a small machine).
+
+    Parameters
+    ----------
+    logs : sequence of VehicleLog
+        Open-loop logs at one held speed (steps, a step series, a double lane change or a chirp), at least one.
+    geometry : VehicleGeometry or SteeringGeometry
+        The vehicle's wheelbase and steering ratio, which turn the steering-wheel angle into kinematic curvature.
+    options : LagFitOptions, optional
+        What to fit (gain, delay), the curvature source and the checks of the logs (None: the defaults).
+    source : str
+        The text recorded as the fitted lag's source ("": one naming the logs and the curvature source).
+
+    Returns
+    -------
+    LagFit
+        The identified lag (natural frequency, damping, gain and delay), its fit error and each log's curves.
+
+    Raises
+    ------
+    WorkbenchInputError
+        No log; a log too short, with steering that hardly moves, or slower than the options' least speed; or
+        logs whose speed varies more than the options allow.
+    """
     with threadpool_limits(limits=1, user_api="blas"):
         return _fit_lag(logs, geometry, options or LagFitOptions(), source)
 
