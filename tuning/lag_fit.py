@@ -155,6 +155,7 @@ class LagFit:
 
     @property
     def nrmse(self) -> float:
+        """The fit's normalised RMS error (module docstring): 0 for a perfect fit, at most the options' max_nrmse."""
         return self.lag.nrmse
 
     @property
@@ -163,6 +164,14 @@ class LagFit:
         return self.lag.steady_state_gain
 
     def summary(self) -> str:
+        """The fit in one line, for the CLI and the logs.
+
+        Returns
+        -------
+        str
+            omega_n (rad/s), zeta, the delay (s, when fitted), the gain K, the NRMSE, the number of logs and their
+            speed range (m/s and km/h).
+        """
         lag, (v0, v1) = self.lag, self.lag.speed_range_mps or (math.nan, math.nan)
         delay = f", delay {lag.delay_s:.3f} s" if self.options.fit_delay else ""
         return (
@@ -173,7 +182,28 @@ class LagFit:
 
 
 def kinematic_curvature(steer_wheel_rad: np.ndarray, geometry: VehicleGeometry | SteeringGeometry) -> np.ndarray:
-    """Ackermann curvature (1/m) of a steering-wheel angle (rad): tan(steer_wheel / steering_ratio) / wheelbase."""
+    """Ackermann curvature (1/m) of a steering-wheel angle (rad): tan(steer_wheel / steering_ratio) / wheelbase.
+
+    Parameters
+    ----------
+    steer_wheel_rad : array_like of float, rad
+        Steering-wheel angles, any shape; positive turns left. Finite, and under steering_ratio x pi / 2 in
+        magnitude (the road-wheel angle stays inside +-90 deg).
+    geometry : VehicleGeometry or SteeringGeometry
+        The vehicle's wheelbase (m) and steering ratio (steering-wheel / road-wheel angle).
+
+    Returns
+    -------
+    numpy.ndarray of float, 1/m
+        The kinematic curvature of each angle, in the shape of ``steer_wheel_rad``.
+
+    Examples
+    --------
+    >>> from tuning.lag_fit import SteeringGeometry, kinematic_curvature
+    >>> geometry = SteeringGeometry(wheelbase_m=2.5, steering_ratio=15.0)
+    >>> kinematic_curvature([0.0, 0.15], geometry).round(5).tolist()
+    [0.0, 0.004]
+    """
     return np.tan(np.asarray(steer_wheel_rad, dtype=float) / geometry.steering_ratio) / geometry.wheelbase_m
 
 
@@ -206,7 +236,29 @@ class _PathDerivatives:
 
 
 def path_curvature(log: VehicleLog, smooth_s: float = 0.3) -> np.ndarray:
-    """Curvature (1/m) of the logged rear-axle path, from Savitzky-Golay (cubic) time derivatives of x and y."""
+    """Curvature (1/m) of the logged rear-axle path, from Savitzky-Golay (cubic) time derivatives of x and y.
+
+    The derivatives are zero phase, so the curvature carries no lag of its own: the lag fitted against it is the
+    vehicle's.
+
+    Parameters
+    ----------
+    log : VehicleLog
+        A log with rear-axle positions (x_m, y_m columns), moving throughout.
+    smooth_s : float, s
+        The Savitzky-Golay window (rounded to an odd number of samples, at least 5); at most the log's duration.
+
+    Returns
+    -------
+    numpy.ndarray of float, 1/m
+        The path curvature at each sample of the log, positive turning left.
+
+    Raises
+    ------
+    WorkbenchInputError
+        The log has no x_m, y_m columns, the window is longer than the log, or the rear axle stands still at some
+        sample (the curvature is undefined there).
+    """
     x_m, y_m = log.x_m, log.y_m
     if x_m is None or y_m is None:
         raise WorkbenchInputError(f"{log.name}: no x_m, y_m columns to compute the path curvature from")
@@ -227,14 +279,52 @@ def _path_of(kappa: np.ndarray, speed: np.ndarray, dt_s: float, heading0: float)
 
 
 def yaw_rate_curvature(log: VehicleLog) -> np.ndarray:
-    """Curvature (1/m) as yaw rate / speed."""
+    """Curvature (1/m) as yaw rate / speed.
+
+    Parameters
+    ----------
+    log : VehicleLog
+        A log with a yaw_rate_rad_s column (rad/s) and a speed that stays above zero.
+
+    Returns
+    -------
+    numpy.ndarray of float, 1/m
+        yaw rate / speed at each sample of the log, positive turning left.
+
+    Raises
+    ------
+    WorkbenchInputError
+        The log has no yaw_rate_rad_s column.
+    """
     if not log.has_yaw_rate:
         raise WorkbenchInputError(f"{log.name}: no yaw_rate_rad_s column to compute the curvature from")
     return log.yaw_rate_rad_s / log.speed_mps
 
 
 def realised_curvature(log: VehicleLog, options: LagFitOptions) -> tuple[np.ndarray, str]:
-    """The measured curvature (1/m) of the log and the source used ("path" or "yaw-rate")."""
+    """The measured curvature (1/m) of the log and the source used ("path" or "yaw-rate").
+
+    Parameters
+    ----------
+    log : VehicleLog
+        The vehicle log to measure.
+    options : LagFitOptions
+        Its curvature_from ("auto": the path when the log has x_m, y_m, else the yaw rate; "path"; "yaw-rate")
+        and smooth_s (s, the path's Savitzky-Golay window) are used.
+
+    Returns
+    -------
+    curvature : numpy.ndarray of float, 1/m
+        The realised curvature at each sample of the log.
+    source : str
+        The source used: "path" or "yaw-rate".
+
+    Raises
+    ------
+    WorkbenchInputError
+        The source asked for needs columns the log does not have, or the path curvature is undefined (see
+        `path_curvature`).
+    """
     source = options.curvature_from
     if source == "auto":
         source = "path" if log.has_positions else "yaw-rate"
@@ -246,7 +336,38 @@ def realised_curvature(log: VehicleLog, options: LagFitOptions) -> tuple[np.ndar
 def simulate_unit_dc(num: np.ndarray, den: np.ndarray, u: np.ndarray, dt_s: float) -> np.ndarray:
     """A proper transfer function num/den (coefficients in s, highest power first) driven by u sampled every dt_s,
     from the steady state of u[0]: the exact first-order-hold discretisation (u linear between samples, as in
-    scipy.signal.lsim and python-control's forced_response), run by scipy.signal.lfilter."""
+    scipy.signal.lsim and python-control's forced_response), run by scipy.signal.lfilter.
+
+    Starting from the steady state of u[0] assumes unit DC gain (hence the name): the output starts at u[0]. A log
+    that starts in a held turn then needs no run-in.
+
+    Parameters
+    ----------
+    num : array_like of float
+        Numerator coefficients in s, highest power first.
+    den : array_like of float
+        Denominator coefficients in s, highest power first; at least the degree of ``num`` (proper), stable.
+    u : array_like of float
+        The input, one value per sample, at least one sample.
+    dt_s : float, s
+        The sample time, > 0.
+
+    Returns
+    -------
+    numpy.ndarray of float
+        The output at each sample of ``u``, in the unit of ``u``.
+
+    Examples
+    --------
+    A first-order lag 1 / (s + 1) from rest, driven by a unit step from the second sample on (the first-order
+    hold ramps the input over the first 0.01 s): close to 1 - e^-1 at t = 1 s.
+
+    >>> import numpy as np
+    >>> from tuning.lag_fit import simulate_unit_dc
+    >>> y = simulate_unit_dc([1.0], [1.0, 1.0], np.r_[0.0, np.ones(100)], 0.01)
+    >>> round(float(y[-1]), 2)
+    0.63
+    """
     u = np.asarray(u, dtype=float)
     b, a, _ = signal.cont2discrete((np.asarray(num, dtype=float), np.asarray(den, dtype=float)), dt_s, method="foh")
     b = np.ravel(b)
