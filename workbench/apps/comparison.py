@@ -93,11 +93,24 @@ class RunSpec:
             )
 
     def make_vehicle(self) -> VehicleModel:
-        """A fresh vehicle of this run (a preset or the file, with the payload if given)."""
+        """A fresh vehicle of this run (a preset or the file, with the payload if given).
+
+        Returns
+        -------
+        VehicleModel
+            A new model, its state not shared with any other run.
+
+        Raises
+        ------
+        WorkbenchInputError
+            The vehicle file is missing or malformed, or a payload is given for a vehicle without one or is out of
+            its range.
+        """
         return load_vehicle(self.vehicle, self.payload_kg)
 
     @property
     def label(self) -> str:
+        """The run in words for legends and messages: controller, its options, vehicle and payload."""
         options = f" ({', '.join(self.overrides)})" if self.overrides else ""
         payload = f" with {self.payload_kg:g} kg" if self.payload_kg is not None else ""
         return f"{self.controller}{options} on {self.vehicle}{payload}"
@@ -114,7 +127,30 @@ class RunSpec:
 
 def converge_distance_m(progress_m: np.ndarray, cte_m: np.ndarray, tolerance_m: float = CONVERGED_CTE_M) -> float:
     """Distance along the path (m) after which |CTE| stays within tolerance_m to the end of the run; 0 if it never
-    left it; NaN if it is outside at the end (never converged)."""
+    left it; NaN if it is outside at the end (never converged).
+
+    Parameters
+    ----------
+    progress_m : numpy.ndarray
+        Distance along the path (m) of each sample, shape (n,).
+    cte_m : numpy.ndarray
+        Cross-track error (m) of each sample, shape (n,), aligned with `progress_m`.
+    tolerance_m : float
+        The band (m) |CTE| must stay within; positive (default `CONVERGED_CTE_M`).
+
+    Returns
+    -------
+    float
+        Distance (m) from the first sample to the first one after which |CTE| stays within the band; 0.0 when it
+        never left it, NaN when the last sample is outside it.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from workbench.apps.comparison import converge_distance_m
+    >>> converge_distance_m(np.array([0.0, 1.0, 2.0, 3.0]), np.array([0.5, 0.2, 0.01, 0.0]), tolerance_m=0.05)
+    2.0
+    """
     outside = np.flatnonzero(np.abs(cte_m) > tolerance_m)
     if outside.size == 0:
         return 0.0
@@ -154,7 +190,18 @@ class Comparison:
     _summary: list[pd.DataFrame] = field(default_factory=list, repr=False)
 
     def select(self, specs: Sequence[RunSpec]) -> Comparison:
-        """The sub-comparison of these runs (e.g. the paper's published pairs out of the full cross product)."""
+        """The sub-comparison of these runs (e.g. the paper's published pairs out of the full cross product).
+
+        Parameters
+        ----------
+        specs : sequence of RunSpec
+            Runs of this comparison, in the order the sub-comparison keeps them.
+
+        Returns
+        -------
+        Comparison
+            The same scenario, config and reference controller with only these runs' results.
+        """
         index = [self.specs.index(s) for s in specs]
         return Comparison(
             self.scenario,
@@ -166,7 +213,13 @@ class Comparison:
 
     def summary(self) -> pd.DataFrame:
         """One row per run: the metrics.json fields, status and message, the distance to converge within
-        CONVERGED_CTE_M, and step_time_ratio (`step_time_ratios`)."""
+        CONVERGED_CTE_M, and step_time_ratio (`step_time_ratios`).
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row per run in the runs' order (a copy: changing it leaves the comparison as it is).
+        """
         if not self._summary:
             rows = []
             for spec, result in zip(self.specs, self.results, strict=True):
@@ -182,7 +235,13 @@ class Comparison:
 
     def conditions_text(self) -> str:
         """The runs' conditions in a sentence for a report, and whether the controllers were told their nominal
-        delays (`SimulationConfig.inform_delays`, `KnownDelays`); "" under ideal conditions."""
+        delays (`SimulationConfig.inform_delays`, `KnownDelays`); "" under ideal conditions.
+
+        Returns
+        -------
+        str
+            One or two sentences, or "" under ideal conditions.
+        """
         config = self.config
         if config.conditions.is_ideal:
             return ""
@@ -197,11 +256,23 @@ class Comparison:
 
     def limit_cycles(self) -> list[LimitCycle]:
         """Each run's steering limit cycle (`simulation/limit_cycle.py`; the summary's limit_cycle fields, plus when it
-        starts and how long it lasts), in the runs' order."""
+        starts and how long it lasts), in the runs' order.
+
+        Returns
+        -------
+        list of LimitCycle
+            One per run, in the runs' order.
+        """
         return [detect_limit_cycle(r.trace["t_s"], r.trace["steer_wheel_rad"]) for r in self.results]
 
     def to_pandas(self) -> pd.DataFrame:
-        """Every run's trace stacked, with `controller`, `vehicle` and `run` columns."""
+        """Every run's trace stacked, with `controller`, `vehicle` and `run` columns.
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row per sample of each run, the runs in order; ``run`` is the run's label.
+        """
         frames = []
         for spec, result in zip(self.specs, self.results, strict=True):
             frame = result.to_pandas()
@@ -213,30 +284,79 @@ class Comparison:
 
     # Figures 17 and 18: every run on one axis, in its style (`styles`); each returns the axes.
     def plot_trajectories(self, ax: Axes | None = None) -> Axes:
-        """Figure 17a, with an inset on the hardest stretch (`hardest_stretch`)."""
+        """Figure 17a, with an inset on the hardest stretch (`hardest_stretch`).
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+            The axes to draw on (None: a new figure's).
+
+        Returns
+        -------
+        matplotlib.axes.Axes
+            The axes drawn on.
+        """
         from workbench.simulation import plots
 
         return plots.trajectories(self.results, self.labels, ax, self.styles, self.hardest_stretch())
 
     def plot_cte(self, ax: Axes | None = None, zoom: bool = True) -> Axes:
-        """Figure 17b; zoom: the stretch the trajectories' inset shows shaded."""
+        """Figure 17b; zoom: the stretch the trajectories' inset shows shaded.
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+            The axes to draw on (None: a new figure's).
+        zoom : bool
+            Shade the stretch the trajectories' inset magnifies (`hardest_stretch`).
+
+        Returns
+        -------
+        matplotlib.axes.Axes
+            The axes drawn on.
+        """
         from workbench.simulation import plots
 
         stretch = self.hardest_stretch() if zoom else None
         return plots.cte_comparison(self.results, self.labels, ax, self.styles, stretch)
 
     def plot_speed(self, ax: Axes | None = None) -> Axes:
+        """Figure 18a: each run's speed against distance along the path, and the first run's planned profile.
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+            The axes to draw on (None: a new figure's).
+
+        Returns
+        -------
+        matplotlib.axes.Axes
+            The axes drawn on.
+        """
         from workbench.simulation import plots
 
         return plots.speed_comparison(self.results, self.labels, ax, self.styles)
 
     def plot_steering(self, ax: Axes | None = None) -> Axes:
+        """Figure 18b: each run's measured steering-wheel angle against time.
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+            The axes to draw on (None: a new figure's).
+
+        Returns
+        -------
+        matplotlib.axes.Axes
+            The axes drawn on.
+        """
         from workbench.simulation import plots
 
         return plots.steering_comparison(self.results, self.labels, ax, self.styles)
 
     @property
     def labels(self) -> list[str]:
+        """Each run's `RunSpec.label`, in the runs' order (the figures' legend)."""
         return [s.label for s in self.specs]
 
     @property
@@ -251,7 +371,14 @@ class Comparison:
     def hardest_stretch(self) -> Stretch | None:
         """The stretch of the course around the largest |CTE| of any run once it has converged (`approach_end`),
         ZOOM_CTE_FACTOR times that |CTE| either side along the path (at least ZOOM_MIN_HALF_LENGTH_M); None when no
-        run has a sample after its approach."""
+        run has a sample after its approach.
+
+        Returns
+        -------
+        Stretch or None
+            The stretch along the path (m) and a caption naming the largest |CTE|; None when no run has a sample
+            after its approach.
+        """
         peak, where = -1.0, math.nan
         for result in self.results:
             cte = np.abs(result.trace["cte_m"])
@@ -265,7 +392,21 @@ class Comparison:
         return Stretch(where - half, where + half, f"largest |CTE| {peak:.3g} m")
 
     def save_figures(self, out_dir: str | Path, prefix: str = "") -> list[Path]:
-        """Write the four comparison figures as PNG; return their paths."""
+        """Write the four comparison figures as PNG; return their paths.
+
+        Parameters
+        ----------
+        out_dir : str or pathlib.Path
+            The folder to write to (made if missing).
+        prefix : str
+            Put before each file name (`FIGURES`: trajectories.png, cte_vs_distance.png, speed_vs_distance.png,
+            steering_vs_time.png).
+
+        Returns
+        -------
+        list of pathlib.Path
+            The files written, in the order of `FIGURES`.
+        """
         from workbench.simulation.plots import file_figure
 
         out = Path(out_dir)
@@ -281,7 +422,26 @@ class Comparison:
 
     def save(self, out_dir: str | Path, with_plots: bool = True) -> list[Path]:
         """Write each run's trace and metrics under DIR/runs/<slug>/ (`RunSpec.slug`: controller-vehicle, and the
-        options when given), DIR/summary.csv and, with_plots, the figures; return the paths."""
+        options when given), DIR/summary.csv and, with_plots, the figures; return the paths.
+
+        Parameters
+        ----------
+        out_dir : str or pathlib.Path
+            The folder DIR to write to (made if missing); files already there of the same names are replaced.
+        with_plots : bool
+            Also write the four figures (`save_figures`).
+
+        Returns
+        -------
+        list of pathlib.Path
+            Every file written: the runs' files, summary.csv, then the figures.
+
+        Examples
+        --------
+        >>> from workbench.apps.comparison import RunSpec, compare
+        >>> result = compare("dlc", [RunSpec("clothoid", "kinematic-bicycle")])  # doctest: +SKIP
+        >>> paths = result.save("out/compare", with_plots=False)  # doctest: +SKIP
+        """
         out = Path(out_dir)
         written = []
         for spec, result in zip(self.specs, self.results, strict=True):
