@@ -119,7 +119,26 @@ WHOLE_FROM = 999.5
 
 def number_text(value: float | None, missing: str = MISSING) -> str:
     """A number as a table shows it: three significant digits (0.0466, 23.8, 269), whole with its thousands grouped
-    from WHOLE_FROM on (1,234), `missing` for None or NaN."""
+    from WHOLE_FROM on (1,234), `missing` for None or NaN.
+
+    Parameters
+    ----------
+    value : float or None
+        The number, in whatever unit its column states.
+    missing : str
+        What None or NaN shows as.
+
+    Returns
+    -------
+    str
+        The number as text.
+
+    Examples
+    --------
+    >>> from workbench.apps.report import number_text
+    >>> number_text(0.046637), number_text(23.84), number_text(12345.6), number_text(float("nan"))
+    ('0.0466', '23.8', '12,346', '–')
+    """
     if value is None or math.isnan(value):
         return missing
     if abs(value) >= WHOLE_FROM:
@@ -164,7 +183,20 @@ def _table(summary: pd.DataFrame, cycles: Sequence[LimitCycle], columns: Sequenc
 
 def text_table(frame: pd.DataFrame, missing: str = MISSING) -> str:
     """A table of text cells (escaped) and numbers (`number_text`, right-aligned), its columns as headings; a missing
-    number shows as `missing`."""
+    number shows as `missing`.
+
+    Parameters
+    ----------
+    frame : pandas.DataFrame
+        The rows to show; its index is not shown.
+    missing : str
+        What a missing number (None, NaN or pandas.NA) shows as.
+
+    Returns
+    -------
+    str
+        An HTML ``<table class='text'>`` element.
+    """
     head = "".join(f"<th>{html.escape(str(c))}</th>" for c in frame.columns)
 
     def cell(value: object) -> str:
@@ -176,14 +208,38 @@ def text_table(frame: pd.DataFrame, missing: str = MISSING) -> str:
 
 
 def png_figure(png: bytes, caption: str) -> str:
-    """A figure element with the PNG embedded (base64) and its caption (plain) as alt text and caption."""
+    """A figure element with the PNG embedded (base64) and its caption (plain) as alt text and caption.
+
+    Parameters
+    ----------
+    png : bytes
+        The image, PNG-encoded (`figure_png`).
+    caption : str
+        Plain text (escaped here).
+
+    Returns
+    -------
+    str
+        An HTML ``<figure>`` element.
+    """
     alt = html.escape(caption)
     data = base64.b64encode(png).decode("ascii")
     return f'<figure><img alt="{alt}" src="data:image/png;base64,{data}"><figcaption>{alt}</figcaption></figure>'
 
 
 def figure_png(fig: Figure | SubFigure) -> bytes:
-    """The figure (an axes' `.figure`: the root figure of a subfigure) as PNG at FIGURE_DPI; the figure is closed."""
+    """The figure (an axes' `.figure`: the root figure of a subfigure) as PNG at FIGURE_DPI; the figure is closed.
+
+    Parameters
+    ----------
+    fig : matplotlib.figure.Figure or matplotlib.figure.SubFigure
+        The figure to encode; a subfigure's root figure is encoded and closed.
+
+    Returns
+    -------
+    bytes
+        The PNG file's content.
+    """
     import matplotlib.pyplot as plt
 
     root = fig.get_figure(root=True)
@@ -198,14 +254,40 @@ _TABLE = re.compile(r"<table\b.*?</table>", re.DOTALL | re.IGNORECASE)
 
 def scrolling_tables(body: str) -> str:
     """body with each table put in a TABLE_SCROLL_CLASS element, which scrolls sideways when the table is wider than
-    the page (tables are not nested in these reports: each runs to its first closing tag)."""
+    the page (tables are not nested in these reports: each runs to its first closing tag).
+
+    Parameters
+    ----------
+    body : str
+        HTML whose ``<table>`` elements are not nested.
+
+    Returns
+    -------
+    str
+        The same HTML, each table wrapped in a ``<div class="table-scroll">``.
+    """
     return _TABLE.sub(lambda table: f'<div class="{TABLE_SCROLL_CLASS}">{table.group(0)}</div>', body)
 
 
 def html_page(title: str, body: Sequence[str], intro: str = "") -> str:
     """A whole HTML document: the title, the intro (plain), when it was generated, then the body's parts (HTML), each
     of its tables in a sideways-scrolling element (`scrolling_tables`). Every report of the workbench is written as
-    such a page, so that no table runs off the page."""
+    such a page, so that no table runs off the page.
+
+    Parameters
+    ----------
+    title : str
+        The page's title and first heading (plain text).
+    body : sequence of str
+        The page's parts in order, each HTML.
+    intro : str
+        A paragraph under the title (plain text; "" for none).
+
+    Returns
+    -------
+    str
+        The whole document, self-contained (its style inline, no external links).
+    """
     parts = [
         "<!DOCTYPE html>",
         '<html lang="en"><head><meta charset="utf-8">',
@@ -281,7 +363,24 @@ def _section(section: ReportSection) -> list[str]:
 def render_report(
     title: str, sections: Sequence[ReportSection], intro: str = "", tables: Sequence[ReportTable] = ()
 ) -> str:
-    """The report as one HTML document: the tables of text, then the sections."""
+    """The report as one HTML document: the tables of text, then the sections.
+
+    Parameters
+    ----------
+    title : str
+        The page's title and first heading (plain text).
+    sections : sequence of ReportSection
+        One per comparison, each with its table, course and figures, in order.
+    intro : str
+        A paragraph under the title (plain text; "" for none).
+    tables : sequence of ReportTable
+        Tables of text shown before the sections.
+
+    Returns
+    -------
+    str
+        The whole HTML document, its figures embedded.
+    """
     body: list[str] = []
     for table in tables:
         body.append(f"<h2>{html.escape(table.heading)}</h2>")
@@ -300,7 +399,35 @@ def write_report(
     intro: str = "",
     tables: Sequence[ReportTable] = (),
 ) -> Path:
-    """Write the report to `path` (its directory is created); return the path."""
+    """Write the report to `path` (its directory is created); return the path.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The HTML file to write (replaced if it exists).
+    title : str
+        The page's title and first heading (plain text).
+    sections : sequence of ReportSection
+        One per comparison, each with its table, course and figures, in order.
+    intro : str
+        A paragraph under the title (plain text; "" for none).
+    tables : sequence of ReportTable
+        Tables of text shown before the sections.
+
+    Returns
+    -------
+    pathlib.Path
+        The file written.
+
+    Examples
+    --------
+    >>> from workbench.apps.comparison import RunSpec, compare
+    >>> from workbench.apps.report import ReportSection, write_report
+    >>> result = compare("dlc", [RunSpec("clothoid", "kinematic-bicycle"), RunSpec("stanley", "kinematic-bicycle")])
+    >>> section = ReportSection("Double lane change", "Two controllers on the kinematic bicycle.", result)
+    >>> write_report("out/report.html", "Clothoid against Stanley", [section])  # doctest: +SKIP
+    PosixPath('out/report.html')
+    """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     path.write_text(render_report(title, sections, intro, tables), encoding="utf-8")
