@@ -48,6 +48,26 @@ def figure8(options: ScenarioOptions, radius_m: float = 22.0, transition_m: floa
     The crossing straights lie at +-45 degrees; each lobe turns 270 degrees (clothoid to 1/R, arc, clothoid back
     to zero). The straight's length is solved so that each lobe is symmetric about the x axis, which closes the
     loop exactly. Minimum radius `radius_m` (default 22 m).
+
+    Parameters
+    ----------
+    options : ScenarioOptions
+        What a scenario may depend on; this one depends on none of it (a factory of `SCENARIOS` takes it).
+    radius_m : float
+        Radius of each lobe's arc (m, > 0), the path's tightest.
+    transition_m : float
+        Length of each clothoid between a straight and an arc (m, >= 0), shorter than a lobe's 270 degrees of
+        turn at `radius_m` asks (3 pi / 2 * radius_m).
+
+    Returns
+    -------
+    Scenario
+        The closed figure-8 path, starting at the crossing on the path.
+
+    Raises
+    ------
+    WorkbenchInputError
+        When `transition_m` leaves no arc at `radius_m`.
     """
     from workbench.base.clothoid_chain import ClothoidChain
 
@@ -92,6 +112,15 @@ class DoubleLaneChangeLayout:
     Lane widths 1.1 b + 0.25, 1.2 b + 0.25 and 1.3 b + 0.25 m; sections 15, 30, 25, 25 and 15 m. The 3.5 m lateral
     offset is taken between the right-hand cone lines of sections 1 and 3 (the datum varies between sources);
     the exit lane is centred on the entry lane's centre line.
+
+    Parameters
+    ----------
+    vehicle_width_m : float
+        Overall width b of the vehicle the lanes are sized for (m).
+    run_in_m, run_out_m : float
+        Straights before section 1 and after section 5 (m).
+    lateral_offset_m : float
+        Offset between the right-hand cone lines of sections 1 and 3 (m).
     """
 
     vehicle_width_m: float
@@ -115,7 +144,18 @@ class DoubleLaneChangeLayout:
         return -w1 / 2 + self.lateral_offset_m + w3 / 2
 
     def centre_line(self, x_m: np.ndarray) -> np.ndarray:
-        """y of the smooth centre line: straight in each lane, quintic smoothsteps (curvature-continuous) between."""
+        """y of the smooth centre line: straight in each lane, quintic smoothsteps (curvature-continuous) between.
+
+        Parameters
+        ----------
+        x_m : numpy.ndarray
+            Distances along the course from the start of the run-in (m), any shape.
+
+        Returns
+        -------
+        numpy.ndarray
+            The centre line's lateral position y (m, left positive) at each x, of the shape of `x_m`.
+        """
         _, x1, x2, x3, x4, _ = self.section_starts_m
         h = self.offset_lane_centre_m
 
@@ -126,7 +166,13 @@ class DoubleLaneChangeLayout:
         return h * (smoothstep((x_m - x1) / (x2 - x1)) - smoothstep((x_m - x3) / (x4 - x3)))
 
     def cones(self) -> np.ndarray:
-        """(n, 2) cone positions: both edges of lanes 1, 3 and 5 at their start, middle and end."""
+        """(n, 2) cone positions: both edges of lanes 1, 3 and 5 at their start, middle and end.
+
+        Returns
+        -------
+        numpy.ndarray
+            Array of shape (18, 2): x and y (m) of each cone.
+        """
         x0, x1, x2, x3, x4, x5 = self.section_starts_m
         w1, w3, w5 = self.lane_widths_m
         h = self.offset_lane_centre_m
@@ -138,7 +184,23 @@ class DoubleLaneChangeLayout:
 
 
 def double_lane_change(options: ScenarioOptions) -> Scenario:
-    """ISO 3888-1 double lane change laid out for the vehicle's width, with run-in and run-out straights."""
+    """ISO 3888-1 double lane change laid out for the vehicle's width, with run-in and run-out straights.
+
+    Parameters
+    ----------
+    options : ScenarioOptions
+        `vehicle_width_m`, the overall width (m) of the vehicle to be driven, sizes the lanes; required.
+
+    Returns
+    -------
+    Scenario
+        The open centre-line path (sampled every 0.5 m) and the cones to draw.
+
+    Raises
+    ------
+    WorkbenchInputError
+        When `options.vehicle_width_m` is None (the message says how to give it).
+    """
     from workbench.base.path import ReferencePath
     from workbench.base.waypoints import Waypoints
 
@@ -171,6 +233,16 @@ def fig17(options: ScenarioOptions) -> Scenario:
 
     40 m straight; 20 m clothoid to 1/30 1/m (left); 30 m arc; 40 m clothoid to -1/30 1/m; 30 m arc; 20 m clothoid
     to 0; 60 m straight. The vehicle starts 1.0 m left of the path, heading along it.
+
+    Parameters
+    ----------
+    options : ScenarioOptions
+        What a scenario may depend on; this one depends on none of it (a factory of `SCENARIOS` takes it).
+
+    Returns
+    -------
+    Scenario
+        The open 240 m path, with its initial offset of 1.0 m.
     """
     from workbench.base.clothoid_chain import ClothoidChain
 
@@ -202,6 +274,21 @@ def zandvoort(options: ScenarioOptions) -> Scenario:
     directory, ../shared/tracks/ beside the checkout). Only that file (recognised by `is_zandvoort_file`, its
     content's digest) makes the scenario named "zandvoort"; any other waypoint file given for it is read as it is
     and named by the file (its stem), so that no result on another track is labelled, or judged, as Zandvoort.
+
+    Parameters
+    ----------
+    options : ScenarioOptions
+        `track_file`, the track CSV to read (None: looked for as `zandvoort_track_file` says).
+
+    Returns
+    -------
+    Scenario
+        The closed centre line with its track widths, named "zandvoort" when the file is the TUMFTM one.
+
+    Raises
+    ------
+    WorkbenchInputError
+        When no track file is found or named, or the file cannot be read as waypoints.
     """
     track = _zandvoort_track(options)
     scenario = from_file(track, options)
@@ -211,7 +298,23 @@ def zandvoort(options: ScenarioOptions) -> Scenario:
 
 
 def is_zandvoort_file(track_file: Path) -> bool:
-    """Whether this file holds exactly the bytes of the TUMFTM Zandvoort track file (SHA-256 `ZANDVOORT_SHA256`)."""
+    """Whether this file holds exactly the bytes of the TUMFTM Zandvoort track file (SHA-256 `ZANDVOORT_SHA256`).
+
+    Parameters
+    ----------
+    track_file : pathlib.Path
+        The file to check.
+
+    Returns
+    -------
+    bool
+        True when its SHA-256 is `ZANDVOORT_SHA256`.
+
+    Raises
+    ------
+    WorkbenchInputError
+        When the file cannot be read (the message names it and why).
+    """
     import hashlib
 
     try:
@@ -223,7 +326,13 @@ def is_zandvoort_file(track_file: Path) -> bool:
 def zandvoort_places() -> list[Path]:
     """Where the Zandvoort file is looked for when neither --track nor $WORKBENCH_ZANDVOORT_CSV names it, in order:
     each of ZANDVOORT_FILE_NAMES in tracks/ of the current directory, then in ../shared/tracks/ beside the checkout
-    (when running from one)."""
+    (when running from one).
+
+    Returns
+    -------
+    list of pathlib.Path
+        The candidate files, in the order they are tried; they need not exist.
+    """
     folders = [Path.cwd() / TRACKS_FOLDER]
     if CHECKOUT_ROOT is not None:
         folders.append(CHECKOUT_ROOT.parent / "shared" / "tracks")
@@ -233,7 +342,23 @@ def zandvoort_places() -> list[Path]:
 def zandvoort_track_file(track_file: Path | None = None) -> Path:
     """The Zandvoort file: `track_file` (--track), else $WORKBENCH_ZANDVOORT_CSV, else the first of
     `zandvoort_places` that exists. WorkbenchInputError when a file named by the first two does not exist, or when
-    neither names one and no place holds it (the message lists every place looked in)."""
+    neither names one and no place holds it (the message lists every place looked in).
+
+    Parameters
+    ----------
+    track_file : pathlib.Path or None
+        The file given with --track (None: the environment variable, then the places).
+
+    Returns
+    -------
+    pathlib.Path
+        An existing file; whether it is the TUMFTM track is for `is_zandvoort_file` to say.
+
+    Raises
+    ------
+    WorkbenchInputError
+        When the named file does not exist, or none is named and none of `zandvoort_places` exists.
+    """
     named, by = (track_file, "--track") if track_file is not None else (None, "")
     if named is None and os.environ.get(ZANDVOORT_ENV):
         named, by = Path(os.environ[ZANDVOORT_ENV]), f"${ZANDVOORT_ENV}"
@@ -271,7 +396,28 @@ def _zandvoort_description(options: ScenarioOptions) -> str:
 
 # ---------------------------------------------------------------------------------------------- files
 def from_file(path: Path, options: ScenarioOptions) -> Scenario:
-    """A scenario from any waypoint file (CSV x,y[,v]; TUMFTM racetrack CSV; GPS CSV with lat/lon columns)."""
+    """A scenario from any waypoint file (CSV x,y[,v]; TUMFTM racetrack CSV; GPS CSV with lat/lon columns).
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        The waypoint file: x, y (m) and optionally v (m/s) columns, a TUMFTM racetrack CSV (x, y and the track
+        widths, m), or latitude and longitude (degrees) projected onto a local plane.
+    options : ScenarioOptions
+        What a scenario may depend on; a file's path depends on none of it.
+
+    Returns
+    -------
+    Scenario
+        The path named after the file's stem; a closed loop when the file's last point repeats its first, and
+        for a TUMFTM racetrack file.
+
+    Raises
+    ------
+    WorkbenchInputError
+        When the file cannot be read, or its columns or waypoints are malformed (the message names the file and
+        the fault).
+    """
     from workbench.base.path import ReferencePath
     from workbench.base.waypoint_files import read_waypoints  # pyproj for a GPS file only (start-up time)
 
@@ -299,6 +445,38 @@ def make_scenario(name_or_file: str, options: ScenarioOptions | None = None) -> 
     `dlc` and `circuit:SEED` need `options.vehicle_width_m` (the width of the vehicle to be driven: the lanes and
     the track are sized for it); the other scenarios do not depend on the vehicle. `circuit:SEED` is drawn within
     `options.circuit_ranges` (None: the defaults), which any other scenario refuses.
+
+    Parameters
+    ----------
+    name_or_file : str
+        A named scenario ("figure8", "dlc", "fig17", "zandvoort"), a generated circuit "circuit:SEED" (SEED a
+        whole number from 0 to 2**63 - 1), or the path of a waypoint file (.csv or .txt, or any existing file).
+    options : ScenarioOptions, optional
+        The vehicle's width, the track file and the circuit ranges the scenario may depend on (None: none given).
+
+    Returns
+    -------
+    Scenario
+        The reference path, where the vehicle starts on it and what to draw around it.
+
+    Raises
+    ------
+    WorkbenchInputError
+        An unknown name (the message lists the scenarios), a waypoint file that does not exist or is malformed,
+        `dlc` or a circuit without `options.vehicle_width_m`, circuit ranges given for a scenario that is not a
+        circuit, or a Zandvoort track file that cannot be found.
+
+    Examples
+    --------
+    >>> from workbench.simulation.scenario import ScenarioOptions
+    >>> from workbench.simulation.scenarios import make_scenario
+    >>> make_scenario("fig17").initial_offset_m
+    1.0
+    >>> dlc = make_scenario("dlc", ScenarioOptions(vehicle_width_m=1.8))
+    >>> dlc.path.closed, dlc.cones_xy.shape
+    (False, (18, 2))
+    >>> make_scenario("circuit:7", ScenarioOptions(vehicle_width_m=1.8)).path.closed
+    True
     """
     options = options or ScenarioOptions()
     from workbench.simulation.circuits import DEFAULT_RANGES, circuit_seed, generate_circuit
@@ -327,7 +505,23 @@ def make_scenario(name_or_file: str, options: ScenarioOptions | None = None) -> 
 
 def is_named_scenario(name: str) -> bool:
     """Whether `name` names a scenario rather than a file: one of SCENARIOS, or a generated circuit's name
-    (circuit:SEED). A name that starts with circuit: but has no valid seed is refused (`circuits.circuit_seed`)."""
+    (circuit:SEED). A name that starts with circuit: but has no valid seed is refused (`circuits.circuit_seed`).
+
+    Parameters
+    ----------
+    name : str
+        A scenario name or a waypoint file's path, as given to `make_scenario`.
+
+    Returns
+    -------
+    bool
+        True for a named scenario or a generated circuit, False for anything else (a file).
+
+    Raises
+    ------
+    WorkbenchInputError
+        When `name` starts with "circuit:" but does not end in a valid seed.
+    """
     if name in SCENARIOS:
         return True
     from workbench.simulation.circuits import circuit_seed
@@ -345,7 +539,20 @@ DESCRIPTIONS: dict[str, Callable[[ScenarioOptions], str]] = {
 
 
 def describe_scenarios(options: ScenarioOptions | None = None) -> list[tuple[str, str]]:
-    """(name, one-line description) of every named scenario; a scenario that needs a missing file says so."""
+    """(name, one-line description) of every named scenario; a scenario that needs a missing file says so.
+
+    Parameters
+    ----------
+    options : ScenarioOptions, optional
+        The vehicle's width and track file the descriptions may depend on (None: none given: `dlc` then describes
+        its lanes by formula).
+
+    Returns
+    -------
+    list of tuple of (str, str)
+        (name, description) of each named scenario in the order `workbench scenarios` lists them, then the
+        generated circuits' family ("circuit:SEED").
+    """
     rows = []
     for name, factory in SCENARIOS.items():
         try:

@@ -63,13 +63,52 @@ _MEASURED = operator.itemgetter(0, 1, 2, 3, 4, 5, 6)
 
 def plan_path_speed(path: ReferencePath, config: SimulationConfig) -> ReferencePath:
     """The path carrying the planned speed: the paper's smart velocity waypoints (section 6), capped by any speed
-    the path's waypoints already carry (`plan_path_speed_and_top`)."""
+    the path's waypoints already carry (`plan_path_speed_and_top`).
+
+    Parameters
+    ----------
+    path : ReferencePath
+        The path to plan along; a speed its waypoints carry (m/s, > 0 everywhere) caps the planned one.
+    config : SimulationConfig
+        The speed asked for (`speed_kmh`), the lateral-acceleration bound (`max_lateral_accel_g`) and the
+        acceleration and braking bounds (`max_accel_mps2`, `max_decel_mps2`) the profile is planned within.
+
+    Returns
+    -------
+    ReferencePath
+        `path` with its planned speed (m/s) at each of its samples.
+
+    Raises
+    ------
+    WorkbenchInputError
+        When the path's own speed is not > 0 m/s somewhere (the message names the first such place).
+    """
     return plan_path_speed_and_top(path, config)[0]
 
 
 def plan_path_speed_and_top(path: ReferencePath, config: SimulationConfig) -> tuple[ReferencePath, TopSpeed]:
     """The path carrying the planned speed (`plan_path_speed`) and its top speed with what limited it: the speed
-    profile's (`SpeedProfile.top_speed`), or the path's own speeds where they lower the top."""
+    profile's (`SpeedProfile.top_speed`), or the path's own speeds where they lower the top.
+
+    Parameters
+    ----------
+    path : ReferencePath
+        The path to plan along; a speed its waypoints carry (m/s, > 0 everywhere) caps the planned one.
+    config : SimulationConfig
+        The speed asked for and the lateral, acceleration and braking bounds the profile is planned within.
+
+    Returns
+    -------
+    tuple of (ReferencePath, TopSpeed)
+        `path` with its planned speed (m/s), and the planned top speed (m/s), where along the path it is (m) and
+        what limited it (the speed asked for, the lateral-acceleration, acceleration or braking bound, or the
+        path's own speeds).
+
+    Raises
+    ------
+    WorkbenchInputError
+        When the path's own speed is not > 0 m/s somewhere (the message names the first such place).
+    """
     n = max(3, math.ceil(path.length_m / SPEED_PLAN_SPACING_M))
     s_plan = np.linspace(0.0, path.length_m, n + 1)
     if path.closed:
@@ -105,7 +144,41 @@ def plan_path_speed_and_top(path: ReferencePath, config: SimulationConfig) -> tu
 
 
 class Simulation:
-    """A scenario, a vehicle and a controller, wired once; `run()` simulates and returns a SimulationResult."""
+    """A scenario, a vehicle and a controller, wired once; `run()` simulates and returns a SimulationResult.
+
+    The path's speed is planned when the simulation is built (`plan_path_speed_and_top`), and where the vehicle
+    cannot follow it at that speed is found then (`path_warnings`), so that both can be told before the run.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        The reference path, where the vehicle starts on it and what to draw around it (`make_scenario`).
+    vehicle : VehicleModel
+        The plant (`make_vehicle`); its road friction is set for the run from the conditions.
+    controller : Controller
+        The steering controller (`controllers.make_controller`); it is reset at the start of `run`.
+    config : SimulationConfig, optional
+        Speed, rates, laps, limits and conditions of the run (None: the defaults, 30 km/h and ideal conditions).
+
+    Raises
+    ------
+    WorkbenchInputError
+        When more than one lap is asked of an open path, or the path's own speed is not > 0 m/s somewhere.
+
+    Examples
+    --------
+    >>> from controllers import make_controller
+    >>> from workbench.simulation.run_config import SimulationConfig
+    >>> from workbench.simulation.scenarios import make_scenario
+    >>> from workbench.simulation.simulator import Simulation
+    >>> from workbench.vehicles import make_vehicle
+    >>> vehicle = make_vehicle("kinematic-bicycle")
+    >>> controller = make_controller("stanley", vehicle.geometry)
+    >>> simulation = Simulation(make_scenario("fig17"), vehicle, controller, SimulationConfig(speed_kmh=30.0))
+    >>> result = simulation.run()
+    >>> result.status.value
+    'completed'
+    """
 
     def __init__(
         self,
@@ -132,14 +205,36 @@ class Simulation:
 
     def warnings(self, label: str = "the run") -> list[str]:
         """What to tell a person before this run: `path_warnings`, the planned top speed when it falls short of
-        the speed asked for (`top_speed_warning`), and the controller's own (`controller_warnings`)."""
+        the speed asked for (`top_speed_warning`), and the controller's own (`controller_warnings`).
+
+        Parameters
+        ----------
+        label : str
+            What each of the top-speed and controller warnings starts with, naming the run (e.g. its folder).
+
+        Returns
+        -------
+        list of str
+            One line per warning, in that order; empty when there is nothing to tell.
+        """
         top = self.top_speed_warning(label)
         return self.path_warnings() + ([top] if top is not None else []) + self.controller_warnings(label)
 
     def controller_warnings(self, label: str = "the run") -> list[str]:
         """What the controller says about this run before it starts (`SteeringController.run_warnings` on the
         planned path at the controller rate: e.g. the clothoid controller's lookahead floor above its range), each
-        after `label`; none from a controller without that method."""
+        after `label`; none from a controller without that method.
+
+        Parameters
+        ----------
+        label : str
+            What each warning starts with, naming the run.
+
+        Returns
+        -------
+        list of str
+            One line per warning, each ``"<label>: <warning>"``; empty when the controller has none.
+        """
         run_warnings = getattr(self.controller, "run_warnings", None)
         if run_warnings is None:
             return []
@@ -147,7 +242,18 @@ class Simulation:
 
     def top_speed_warning(self, label: str = "the run") -> str | None:
         """The planned top speed and what limited it, when it falls short of the speed asked for (`TopSpeed`);
-        None when the profile reaches it."""
+        None when the profile reaches it.
+
+        Parameters
+        ----------
+        label : str
+            What the warning starts with, naming the run.
+
+        Returns
+        -------
+        str or None
+            ``"<label>: <planned top and its limit>"``, or None when the planned top reaches the speed asked for.
+        """
         if self.top_speed.reached:
             return None
         return f"{label}: {self.top_speed.describe()}"
@@ -155,7 +261,14 @@ class Simulation:
     def path_warnings(self) -> list[str]:
         """What about the path this vehicle cannot do, to say before the run: stretches curving tighter than its
         steering lock turns it (understeer included), or asking more lateral acceleration than its rollover threshold
-        or tyres allow at the planned speed (`feasibility.py`)."""
+        or tyres allow at the planned speed (`feasibility.py`).
+
+        Returns
+        -------
+        list of str
+            One line per kind of infeasible stretch, naming the path, the places and the limit; empty when the
+            vehicle can follow the whole path at its planned speed.
+        """
         return feasibility_warnings(self.path.name, VehicleLimits.of(self.vehicle), self.infeasible_curvature)
 
     @property
@@ -177,7 +290,27 @@ class Simulation:
     def run(self, progress: bool = False) -> SimulationResult:
         """Simulate until the run ends (the module docstring says how); `progress` shows the metres covered on a bar.
         The simulator's own work at each step is compiled (`step_kernel`): Python calls the plant, the conditions'
-        models and the controller, and builds the measurement."""
+        models and the controller, and builds the measurement.
+
+        A run that ends early (time-out, left the path, diverged, plant or controller failed) is not an error: the
+        result keeps the partial trace, and its `status` and `message` say why.
+
+        Parameters
+        ----------
+        progress : bool
+            Show the metres covered on a progress bar on stderr (shown only for a run longer than 2 s).
+
+        Returns
+        -------
+        SimulationResult
+            The trace (one row per controller step), how the run ended, and what it was run with.
+
+        Raises
+        ------
+        WorkbenchInputError
+            When the vehicle's position or the speed reference stops being finite (a plant or path that cannot be
+            simulated), rather than a trace of NaN.
+        """
         cfg, path, vehicle, controller = self.config, self.path, self.vehicle, self.controller
         dt = 1.0 / cfg.controller_rate_hz
         total_length = self.total_length_m
