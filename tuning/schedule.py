@@ -91,6 +91,17 @@ class ScheduleEntry:
     margins: MarginsDesign | None = None
 
     def row(self) -> dict[str, float]:
+        """The entry as one row of the lead-filter file's ``design.per_speed`` table and of `ScheduleResult.table`.
+
+        Returns
+        -------
+        dict of str to float
+            speed_kmh; the path lag (omega_n_rad_s, zeta, steady_state_gain, delay_s, nrmse); the measured lag
+            under the same keys prefixed ``measured_`` when it was identified; the filter (omega_z_rad_s, psi,
+            omega_p_rad_s), its lead_peak_gain and the plant's and cascade's bandwidths (rad/s); with the margins
+            design, lookahead_floor_m (or margin_score when no lookahead keeps the margins) and
+            floor_without_lead_m when finite.
+        """
         lag, d = self.fit.lag, self.design
         out = {
             "speed_kmh": self.speed_kmh,
@@ -139,6 +150,14 @@ class DroppedSpeed:
     measured_lag: SteeringLag | None = None
 
     def row(self) -> dict[str, float | str]:
+        """The dropped speed as one row of the lead-filter file's ``design.dropped_speeds`` table.
+
+        Returns
+        -------
+        dict of str to float or str
+            speed_kmh and reason; the path lag's omega_n_rad_s, zeta, steady_state_gain, delay_s and nrmse when it
+            was fitted; the measured lag's under the same keys prefixed ``measured_`` (but nrmse) when it was.
+        """
         out: dict[str, float | str] = {"speed_kmh": self.speed_kmh, "reason": self.reason}
         if self.lag is not None:
             lag = self.lag
@@ -169,11 +188,30 @@ class ScheduleResult:
 
     @property
     def speeds_kmh(self) -> tuple[float, ...]:
+        """The speeds kept (km/h), strictly increasing, one per entry."""
         return tuple(e.speed_kmh for e in self.entries)
 
     def entry_at(self, speed_kmh: float, what: str) -> ScheduleEntry:
         """The entry identified at speed_kmh (km/h); WorkbenchInputError naming `what`, the speeds kept and, when
-        it was left out (`drop_refused`), why."""
+        it was left out (`drop_refused`), why.
+
+        Parameters
+        ----------
+        speed_kmh : float, km/h
+            One of the schedule's speeds (`speeds_kmh`), matched within SPEED_MATCH_KMH.
+        what : str
+            What the speed is, for the error message (e.g. "the nominal speed").
+
+        Returns
+        -------
+        ScheduleEntry
+            The lags, the filter and (margins design) the floors identified at that speed.
+
+        Raises
+        ------
+        WorkbenchInputError
+            speed_kmh is not one of the speeds kept; the message lists them and, for a dropped speed, the reason.
+        """
         for entry in self.entries:
             if abs(entry.speed_kmh - speed_kmh) <= SPEED_MATCH_KMH:
                 return entry
@@ -186,6 +224,14 @@ class ScheduleResult:
         )
 
     def filter_schedule(self) -> FilterSchedule:
+        """The filters as the schedule the clothoid controller interpolates on speed.
+
+        Returns
+        -------
+        FilterSchedule
+            The speeds kept (km/h) and each speed's lead-filter parameters, with a source text naming the vehicle,
+            the maneuvers and the design.
+        """
         return FilterSchedule(self.speeds_kmh, tuple(e.design.params for e in self.entries), source=self._source())
 
     def _source(self) -> str:
@@ -203,7 +249,26 @@ class ScheduleResult:
     def write(self, path: str | Path, nominal_speed_kmh: float | None = None) -> Path:
         """Write the lead-filter file (JSON, or TOML by suffix). The top-level filter and `plant` are those of the
         speed nominal_speed_kmh, which must be one of the schedule's speeds (default: the first speed): a filter is
-        designed only at the speeds identified, so another speed's would be a different filter under its name."""
+        designed only at the speeds identified, so another speed's would be a different filter under its name.
+
+        Parameters
+        ----------
+        path : str or pathlib.Path
+            The file to write: ``.json`` or ``.toml`` (the suffix chooses the format).
+        nominal_speed_kmh : float or None, km/h
+            The speed whose filter and lag are the file's top-level filter and ``plant``; one of `speeds_kmh`
+            (None: the first).
+
+        Returns
+        -------
+        pathlib.Path
+            The path written.
+
+        Raises
+        ------
+        WorkbenchInputError
+            nominal_speed_kmh is not one of the schedule's speeds, or the path's suffix is neither .json nor .toml.
+        """
         nominal = self.entries[0]
         if nominal_speed_kmh is not None:
             nominal = self.entry_at(nominal_speed_kmh, "the nominal speed")
@@ -239,6 +304,16 @@ class ScheduleResult:
         )
 
     def table(self) -> str:
+        """The schedule as a fixed-width text table, one line per speed kept and one per speed dropped.
+
+        Returns
+        -------
+        str
+            Columns: speed (km/h), the path lag (omega_n rad/s, zeta, K, delay s, NRMSE), the measured lag (``m_``
+            columns, when identified), the filter (omega_z rad/s, psi, omega_p rad/s, peak gain), the plant's and
+            cascade's bandwidths (rad/s) and, with the margins design, the lookahead floors with and without the
+            lead (m; nan when none keeps the margins).
+        """
         measured = any(e.measured_fit is not None for e in self.entries)
         floors = any(e.margins is not None for e in self.entries)
         head = "speed_kmh  omega_n  zeta    K      delay_s  nrmse  "
@@ -278,7 +353,34 @@ def identification_logs(
     sample_rate_hz: float = 100.0,
 ) -> list[VehicleLog]:
     """Open-loop logs at speed_kmh, each profile's amplitude giving lat_accel_g of kinematic lateral acceleration,
-    its steering-wheel rate at most IDENTIFICATION_RATE_FRACTION of the vehicle's rate limit."""
+    its steering-wheel rate at most IDENTIFICATION_RATE_FRACTION of the vehicle's rate limit.
+
+    Parameters
+    ----------
+    vehicle : VehicleModel
+        The plant driven open loop.
+    speed_kmh : float, km/h
+        The held speed, within SPEED_RANGE_KMH (5-200 km/h).
+    lat_accel_g : float, g
+        The kinematic lateral acceleration each profile's amplitude gives, within LAT_ACCEL_RANGE_G
+        (0.001-1 g); the amplitude is capped at the steering lock.
+    maneuvers : sequence of str
+        The steering profiles, one log each: "step", "step-series", "dlc" or "chirp".
+    duration_s : float, s
+        Each log's duration, > 0 (a chirp needs more than its start time).
+    sample_rate_hz : float, Hz
+        The logs' sample rate, 1-10000 Hz.
+
+    Returns
+    -------
+    list of VehicleLog
+        One log per maneuver, named "<maneuver> at <speed> km/h".
+
+    Raises
+    ------
+    WorkbenchInputError
+        A speed, lateral acceleration, duration or sample rate out of its range, or an unknown maneuver.
+    """
     require_in_range("speed_kmh", speed_kmh, *SPEED_RANGE_KMH, "km/h")
     require_in_range("lat_accel_g", lat_accel_g, *LAT_ACCEL_RANGE_G, "g")
     amplitude = steer_amplitude_deg(vehicle, speed_kmh, lat_accel_g)
@@ -296,7 +398,22 @@ def identification_logs(
 
 
 def steer_amplitude_deg(vehicle: VehicleModel, speed_kmh: float, lat_accel_g: float) -> float:
-    """Steering-wheel angle (deg) whose kinematic curvature gives lat_accel_g at speed_kmh, capped at the lock."""
+    """Steering-wheel angle (deg) whose kinematic curvature gives lat_accel_g at speed_kmh, capped at the lock.
+
+    Parameters
+    ----------
+    vehicle : VehicleModel
+        The vehicle whose geometry (wheelbase, steering ratio, lock) turns curvature into a steering-wheel angle.
+    speed_kmh : float, km/h
+        The speed, > 0.
+    lat_accel_g : float, g
+        The kinematic lateral acceleration v^2 x curvature, >= 0.
+
+    Returns
+    -------
+    float, deg
+        The steering-wheel angle, at most the one at the steering lock.
+    """
     v = speed_kmh / 3.6
     geometry = vehicle.geometry
     curvature = min(lat_accel_g * G_MPS2 / (v * v), lock_curvature_1pm(vehicle))
@@ -304,14 +421,38 @@ def steer_amplitude_deg(vehicle: VehicleModel, speed_kmh: float, lat_accel_g: fl
 
 
 def lock_curvature_1pm(vehicle: VehicleModel) -> float:
-    """The kinematic curvature (1/m) at the steering lock: tan(max road-wheel angle) / wheelbase."""
+    """The kinematic curvature (1/m) at the steering lock: tan(max road-wheel angle) / wheelbase.
+
+    Parameters
+    ----------
+    vehicle : VehicleModel
+        The vehicle whose geometry gives the largest road-wheel angle and the wheelbase.
+
+    Returns
+    -------
+    float, 1/m
+        The curvature at full lock, > 0.
+    """
     geometry = vehicle.geometry
     return math.tan(geometry.max_road_wheel_angle_rad) / geometry.wheelbase_m
 
 
 def margins_arc_curvature_1pm(vehicle: VehicleModel, speed_kmh: float) -> float:
     """The arc the margins design checks the floor about at speed_kmh: MARGINS_ARC_LATERAL_ACCEL_G / v^2, capped at
-    the steering lock (the controller's floor uses its curvature limit; the lock bounds it)."""
+    the steering lock (the controller's floor uses its curvature limit; the lock bounds it).
+
+    Parameters
+    ----------
+    vehicle : VehicleModel
+        The vehicle whose steering lock caps the curvature.
+    speed_kmh : float, km/h
+        The speed, > 0.
+
+    Returns
+    -------
+    float, 1/m
+        The arc's curvature.
+    """
     v = speed_kmh / 3.6
     return min(lock_curvature_1pm(vehicle), MARGINS_ARC_LATERAL_ACCEL_G * G_MPS2 / (v * v))
 
@@ -336,7 +477,59 @@ def identify_schedule(
     both lags, the loop at controller_rate_hz with prediction_time_s, about a straight and the arc of
     margins_arc_curvature_1pm; bounded by max_lead_gain). A speed whose fit or design is refused makes the whole
     schedule refused, naming the speed; with drop_refused=True it is left out and recorded in `dropped` instead
-    (refused only when no speed is left). progress, if given, is called with one line per speed."""
+    (refused only when no speed is left). progress, if given, is called with one line per speed.
+
+    Parameters
+    ----------
+    vehicle : VehicleModel
+        The plant the open-loop logs are simulated with.
+    speeds_kmh : sequence of float, km/h
+        The speeds to identify, 1 to 200 of them, each within SPEED_RANGE_KMH (5-200 km/h), strictly increasing.
+    lat_accel_g : float, g
+        The identification maneuvers' kinematic lateral acceleration, within LAT_ACCEL_RANGE_G (0.001-1 g).
+    fit_options : LagFitOptions or None
+        How the lags are fitted (None: the defaults; ``fit_delay=True`` adds a pure delay).
+    max_lead_gain : float
+        Bound on the lead filter's peak gain, 1-1000.
+    max_cascade_peak_db : float, dB
+        Bound on the resonance peak of lead x lag ("cancel" design), 0-20 dB.
+    drop_refused : bool
+        Leave a refused speed out (recorded in the result's ``dropped``) instead of refusing the schedule.
+    progress : callable or None
+        Called with one line of text per speed identified or dropped (None: silent).
+    design : str
+        "cancel" (`design_lead` on the path lag) or "margins" (`design_lead_for_margins` on both lags).
+    controller_rate_hz : float, Hz
+        The clothoid controller's rate the margins design analyses the loop at, 1-1000 Hz.
+    prediction_time_s : float, s
+        The controller's pose prediction the margins design analyses the loop with, 0-2 s.
+
+    Returns
+    -------
+    ScheduleResult
+        One entry per speed kept, the speeds dropped, and the settings; `ScheduleResult.write` writes the
+        lead-filter file.
+
+    Raises
+    ------
+    WorkbenchInputError
+        An argument out of its range or an unknown design (before anything is identified); a speed whose fit or
+        design is refused, naming the speed (without drop_refused); no speed left (with drop_refused).
+
+    Examples
+    --------
+    Two speeds on the dynamic bicycle (a few seconds):
+
+    >>> from tuning.schedule import identify_schedule
+    >>> from workbench.vehicles import make_vehicle
+    >>> result = identify_schedule(make_vehicle("dynamic-bicycle"), [30.0, 60.0])
+    >>> result.speeds_kmh
+    (30.0, 60.0)
+    >>> entry = result.entry_at(60.0, "the speed")
+    >>> round(entry.fit.lag.omega_n_rad_s, 1)
+    7.7
+    >>> path = result.write("lead_schedule.toml")  # doctest: +SKIP
+    """
     speeds = check_speeds(speeds_kmh, *SPEED_RANGE_KMH)
     if design not in DESIGNS:
         raise WorkbenchInputError(f"design must be one of {', '.join(DESIGNS)}; got {design!r}")
