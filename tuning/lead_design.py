@@ -92,6 +92,7 @@ class LeadDesign:
 
     @property
     def bandwidth_ratio(self) -> float:
+        """The cascade's -3 dB bandwidth over the plant's: how much faster the compensated steering responds."""
         return self.cascade_bandwidth_rad_s / self.plant_bandwidth_rad_s
 
     @property
@@ -103,13 +104,35 @@ class LeadDesign:
 
     def transfer_functions(self) -> tuple[control.TransferFunction, control.TransferFunction, control.TransferFunction]:
         """(plant G_lag, compensator G_lead, cascade G_lead G_lag) as python-control transfer functions (without
-        the lag's delay, if any: `frequency_response` includes it)."""
+        the lag's delay, if any: `frequency_response` includes it).
+
+        Returns
+        -------
+        plant : control.TransferFunction
+            The lag of Eq. 5 with unit gain, without its delay.
+        compensator : control.TransferFunction
+            The lead filter of Eq. 6.
+        cascade : control.TransferFunction
+            Their product, G_lead G_lag.
+        """
         plant = self.lag.transfer_function(with_gain=False)
         lead = self.params.transfer_function()
         return plant, lead, lead * plant
 
     def frequency_response(self, omega_rad_s: np.ndarray) -> dict[str, tuple[np.ndarray, np.ndarray]]:
-        """{"plant", "compensator", "cascade"}: (magnitude, phase in degrees) at omega (rad/s), delay included."""
+        """{"plant", "compensator", "cascade"}: (magnitude, phase in degrees) at omega (rad/s), delay included.
+
+        Parameters
+        ----------
+        omega_rad_s : numpy.ndarray of float, rad/s
+            The frequencies, > 0, increasing (the phase is unwrapped along them).
+
+        Returns
+        -------
+        dict of str to (numpy.ndarray, numpy.ndarray)
+            For "plant", "compensator" and "cascade": the magnitude (linear) and the phase (deg, negative: lag) at
+            each frequency; the plant's and the cascade's phases include the lag's delay.
+        """
         out = {}
         for name, tf in zip(("plant", "compensator", "cascade"), self.transfer_functions(), strict=True):
             response = np.asarray(control.frequency_response(tf, omega_rad_s).complex).ravel()
@@ -120,7 +143,15 @@ class LeadDesign:
         return out
 
     def metadata(self) -> dict[str, object]:
-        """The `design` table of the filter file."""
+        """The `design` table of the filter file.
+
+        Returns
+        -------
+        dict of str to object
+            The method and its criterion in words, the bounds, the peaks, the bandwidths (rad/s) and their ratio,
+            the phases (deg) at phase_frequency_rad_s, and when known the lag's delay (plant_delay_s), NRMSE and
+            speed range (m/s).
+        """
         criterion = (
             "zeros on the lag's poles (omega_z = omega_n, psi = zeta); the largest omega_p with peak |G_lead| <= "
             "max_lead_gain and peak |G_lead G_lag| <= max_cascade_peak_db"
@@ -153,6 +184,14 @@ class LeadDesign:
         return out
 
     def summary(self) -> str:
+        """The design in one line, for the CLI.
+
+        Returns
+        -------
+        str
+            The filter's parameters (rad/s), its DC gain and peak gain (linear and dB, with the bound), the plant's
+            and the cascade's -3 dB and tracking bandwidths (rad/s) and phases (deg).
+        """
         p = self.params
         return (
             f"lead filter ({self.method}): omega_z {p.omega_z_rad_s:.3f} rad/s, psi {p.psi:.3f}, omega_p "
@@ -179,7 +218,31 @@ def _first_crossing(w: np.ndarray, excess: np.ndarray) -> np.ndarray:
 
 def tracking_bandwidth(omega_rad_s: np.ndarray, response: np.ndarray) -> np.ndarray:
     """First frequency of the grid omega (increasing, starting well inside the pass band) where |G(jw) - 1| of the
-    complex response (..., n) reaches TRACKING_ERROR (log-interpolated)."""
+    complex response (..., n) reaches TRACKING_ERROR (log-interpolated).
+
+    Parameters
+    ----------
+    omega_rad_s : numpy.ndarray of float, rad/s
+        The frequency grid, shape (n,), > 0 and increasing, its first frequency inside the pass band.
+    response : numpy.ndarray of complex
+        G(jw) at the grid, shape (..., n): one response or a stack of them.
+
+    Returns
+    -------
+    numpy.ndarray of float, rad/s
+        The tracking bandwidth of each response, shape (...); the grid's last frequency where the error never
+        reaches TRACKING_ERROR.
+
+    Examples
+    --------
+    A first-order lag 1 / (s + 1): |G - 1| = w / sqrt(1 + w^2) reaches 1 - 10^(-3/20) at 0.305 rad/s.
+
+    >>> import numpy as np
+    >>> from tuning.lead_design import tracking_bandwidth
+    >>> w = np.geomspace(0.01, 100.0, 2001)
+    >>> round(float(tracking_bandwidth(w, 1.0 / (1j * w + 1.0))), 3)
+    0.305
+    """
     return _first_crossing(omega_rad_s, np.abs(response - 1.0) - TRACKING_ERROR)
 
 
@@ -250,7 +313,21 @@ MAX_CASCADE_PEAK_DB_RANGE = (0.0, 20.0)
 
 def check_design_bounds(max_lead_gain: float, max_cascade_peak_db: float | None = None) -> None:
     """Refuse a design bound outside its range (MAX_LEAD_GAIN_RANGE, MAX_CASCADE_PEAK_DB_RANGE), naming it: every
-    design checks its bounds here, and a schedule before it identifies anything."""
+    design checks its bounds here, and a schedule before it identifies anything.
+
+    Parameters
+    ----------
+    max_lead_gain : float
+        Bound on the peak of |G_lead| (linear), within MAX_LEAD_GAIN_RANGE (1-1000).
+    max_cascade_peak_db : float or None, dB
+        Bound on the peak of |G_lead G_lag|, within MAX_CASCADE_PEAK_DB_RANGE (0-20 dB); None: not checked (the
+        margins design has no such bound).
+
+    Raises
+    ------
+    WorkbenchInputError
+        A bound outside its range, or not a finite number.
+    """
     require_in_range("max_lead_gain", max_lead_gain, *MAX_LEAD_GAIN_RANGE)
     if max_cascade_peak_db is not None:
         require_in_range("max_cascade_peak_db", max_cascade_peak_db, *MAX_CASCADE_PEAK_DB_RANGE, "dB")
@@ -264,7 +341,42 @@ def design_lead(
 ) -> LeadDesign:
     """Design Eq. 6 for `lag` by the criterion of the module docstring. max_lead_gain: bound on the peak of
     |G_lead| (linear, >= 1); max_cascade_peak_db: bound on the cascade's peak (dB, >= 0); phase_frequency_rad_s:
-    where the phases are reported (rad/s; default: the plant's -3 dB bandwidth)."""
+    where the phases are reported (rad/s; default: the plant's -3 dB bandwidth).
+
+    Parameters
+    ----------
+    lag : SteeringLag
+        The identified lag of Eq. 5 (its zeta at most PSI_MAX = 5, the largest damping of Eq. 6's zeros).
+    max_lead_gain : float
+        Bound on the peak of |G_lead| (linear), 1-1000.
+    max_cascade_peak_db : float, dB
+        Bound on the peak of the cascade G_lead G_lag, 0-20 dB.
+    phase_frequency_rad_s : float or None, rad/s
+        The frequency the phases are reported at, 1e-3 to 1e4 rad/s (None: the plant's -3 dB bandwidth).
+
+    Returns
+    -------
+    LeadDesign
+        The filter (zeros on the lag's poles, the largest pole frequency within the bounds) and what it achieves.
+
+    Raises
+    ------
+    WorkbenchInputError
+        A bound or the phase frequency out of its range; a lag whose zeta is over PSI_MAX; or no filter within the
+        bounds (a strongly damped lag under a tight bound).
+
+    Examples
+    --------
+    >>> from tuning.lead_design import design_lead
+    >>> from workbench.vehicles.steering_lag import SteeringLag
+    >>> design = design_lead(SteeringLag(omega_n_rad_s=8.0, zeta=0.7))
+    >>> design.params.omega_z_rad_s, design.params.psi
+    (8.0, 0.7)
+    >>> round(design.params.omega_p_rad_s, 1), round(design.lead_peak_gain, 2)
+    (31.6, 6.0)
+    >>> round(design.bandwidth_ratio, 2)
+    1.99
+    """
     check_design_bounds(max_lead_gain, max_cascade_peak_db)
     if phase_frequency_rad_s is not None:
         require_in_range("phase_frequency_rad_s", phase_frequency_rad_s, 1e-3, 1e4, "rad/s")
@@ -325,7 +437,27 @@ class ValidationTrace:
 
 def validate(design: LeadDesign, log: VehicleLog, geometry: VehicleGeometry | SteeringGeometry) -> ValidationTrace:
     """Time-domain check of the design on a log (Figure 9): the compensated curvature should follow the kinematic
-    curvature more closely than the lagged one does."""
+    curvature more closely than the lagged one does.
+
+    Parameters
+    ----------
+    design : LeadDesign
+        The filter and the lag it was designed for.
+    log : VehicleLog
+        A log of the steering-wheel angle; its measured curvature (path or yaw rate) is added when it has one.
+    geometry : VehicleGeometry or SteeringGeometry
+        The vehicle's wheelbase and steering ratio, which turn the steering-wheel angle into kinematic curvature.
+
+    Returns
+    -------
+    ValidationTrace
+        The curvatures over time and the NRMSEs of the lagged and compensated curvatures against the kinematic one.
+
+    Raises
+    ------
+    WorkbenchInputError
+        The log's measured curvature cannot be computed (see `realised_curvature`).
+    """
     lag = design.lag
     kin = kinematic_curvature(log.steer_wheel_rad, geometry)
     lagged = lag.simulate(kin, log.dt_s, with_gain=False)
@@ -375,7 +507,23 @@ class MarginsDesign:
 def margin_score(margins: Margins, phase_margin_deg: float, gain_margin_db: float) -> float:
     """How well a loop meets the required margins: the least of phase margin / required, gain margin / required
     and -(gain-reduction margin) / required (1: just met; -inf: unstable). The margins design ranks candidates by it
-    where none keeps the margins at any lookahead."""
+    where none keeps the margins at any lookahead.
+
+    Parameters
+    ----------
+    margins : Margins
+        The loop's margins (`controllers.clothoid.loop_analysis.loop_margins`).
+    phase_margin_deg : float, deg
+        The required phase margin, >= 0 (0: not required).
+    gain_margin_db : float, dB
+        The required gain margin both ways, >= 0 (0: not required).
+
+    Returns
+    -------
+    float
+        The least ratio: >= 1 when the margins are met, under 1 when not, -inf for an unstable loop, inf when
+        nothing is required.
+    """
     if not margins.stable:
         return -math.inf
     ratios = [margins.phase_margin_deg / phase_margin_deg if phase_margin_deg > 0 else math.inf]
@@ -414,7 +562,57 @@ def design_lead_for_margins(
     does, at 40 m), the floor is nan and the candidate with the best `margin_score` at max_lookahead_m (the least
     bad loop there) is chosen, its score reported. Refused (WorkbenchInputError) when no candidate meets
     max_lead_gain. BLAS runs single-threaded meanwhile (the loop analyses are many small matrix problems, several
-    times slower threaded on a small machine)."""
+    times slower threaded on a small machine).
+
+    Parameters
+    ----------
+    lags : PlantLags
+        The path lag (which the filter is designed for and reported against) and the measured (yaw-rate) lag.
+    speed_mps : float, m/s
+        The speed the loop is analysed at, 0.1-100 m/s.
+    settings : LoopSettings
+        The controller's sample time, pose prediction and the other loop settings; its lead filter is replaced by
+        each candidate.
+    min_lookahead_m : float, m
+        The shortest lookahead searched, > 0.
+    max_lookahead_m : float, m
+        The longest lookahead searched, at least min_lookahead_m.
+    lookahead_step_m : float, m
+        The step of the lookahead search, > 0.
+    path_curvatures_1pm : tuple of float, 1/m
+        The path curvatures the margins must hold about (0: a straight); an arc is skipped at lookaheads where
+        |curvature| x lookahead reaches 1.8.
+    max_lead_gain : float
+        Bound on the peak of |G_lead| (linear), 1-1000.
+    phase_margin_deg : float, deg
+        The required phase margin (default 45 deg).
+    gain_margin_db : float, dB
+        The required gain margin both ways (default 6 dB).
+
+    Returns
+    -------
+    MarginsDesign
+        The chosen filter's design, its floor and the floor without a filter (m), how many candidates met the gain
+        bound, and the margin score where no floor was found.
+
+    Raises
+    ------
+    WorkbenchInputError
+        max_lead_gain or speed_mps out of its range, or no candidate of the grid within max_lead_gain.
+
+    Examples
+    --------
+    A lag of 8 rad/s, damping 0.7 at 60 km/h, the controller at 50 Hz with 0.2 s of pose prediction (seconds):
+
+    >>> from controllers.clothoid.loop_analysis import LoopSettings, PlantLags
+    >>> from tuning.lead_design import design_lead_for_margins
+    >>> from workbench.vehicles.steering_lag import SteeringLag
+    >>> lag = SteeringLag(omega_n_rad_s=8.0, zeta=0.7)
+    >>> settings = LoopSettings(sample_time_s=0.02, prediction_time_s=0.2)
+    >>> result = design_lead_for_margins(PlantLags(lag, lag), 60 / 3.6, settings)
+    >>> result.floor_m
+    12.5
+    """
     with threadpool_limits(limits=1, user_api="blas"):
         return _design_lead_for_margins(
             lags, speed_mps, settings, min_lookahead_m, max_lookahead_m, lookahead_step_m, path_curvatures_1pm,
