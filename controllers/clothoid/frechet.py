@@ -186,6 +186,36 @@ def discrete_frechet(P: object, Q: object) -> float:
     curves, between max(|P_0 - Q_0|, |P_n-1 - Q_m-1|) and max_ij |P_i - Q_j|, and an upper bound of the
     continuous Fréchet distance. Raises WorkbenchInputError for a curve of the wrong shape, without points or
     with a non-finite entry.
+
+    Parameters
+    ----------
+    P : array_like of float, shape (n, 2), m
+        The first polyline's vertices (x, y), n >= 1, finite.
+    Q : array_like of float, shape (m, 2), m
+        The second polyline's vertices (x, y), m >= 1, finite.
+
+    Returns
+    -------
+    float, m
+        The discrete Fréchet distance, >= 0.
+
+    Raises
+    ------
+    WorkbenchInputError
+        A curve that is not of shape (k, 2), has no points, or has a NaN or infinite coordinate.
+
+    Examples
+    --------
+    Two parallel lines 1 m apart, and a line against a zigzag about it: only the vertices count, so leaving out
+    the middle vertex of a straight line changes the distance.
+
+    >>> from controllers.clothoid import discrete_frechet
+    >>> discrete_frechet([[0, 0], [1, 0], [2, 0]], [[0, 1], [1, 1], [2, 1]])
+    1.0
+    >>> discrete_frechet([[0, 0], [1, 0], [2, 0]], [[0, 0.5], [1, -0.5], [2, 0]])
+    0.5
+    >>> discrete_frechet([[0, 0], [1, 0], [2, 0]], [[0, 0], [2, 0]])
+    1.0
     """
     p = _as_curve("P", P)
     q = _as_curve("Q", Q)
