@@ -410,7 +410,20 @@ class ClothoidFit:
         return self.status != FIT_UNREACHABLE
 
     def end_error_m(self, x1: float, y1: float) -> float:
-        """Distance (m) from the clothoid's end point to (x1, y1)."""
+        """Distance (m) from the clothoid's end point to (x1, y1).
+
+        Parameters
+        ----------
+        x1 : float, m
+            The target's x, in the frame of the fit.
+        y1 : float, m
+            The target's y, in the frame of the fit.
+
+        Returns
+        -------
+        float, m
+            The distance, >= 0: zero to rounding for a converged fit, the residual of a saturated one.
+        """
         return math.hypot(self.end_x_m - x1, self.end_y_m - y1)
 
 
@@ -428,7 +441,52 @@ def fit_hyper_clothoid(
     x0: float, y0: float, theta0: float, kappa0: float, x1: float, y1: float, max_curvature_rate_1pm2: float
 ) -> ClothoidFit:
     """Fit the hyper-clothoid from the pose (x0, y0, theta0 rad) with curvature kappa0 (1/m) to the target (x1, y1)
-    under |kdot| <= max_curvature_rate_1pm2; see the module docstring."""
+    under |kdot| <= max_curvature_rate_1pm2; see the module docstring.
+
+    Parameters
+    ----------
+    x0 : float, m
+        The start point's x (the rear axle), finite.
+    y0 : float, m
+        The start point's y, finite.
+    theta0 : float, rad
+        The heading at the start, finite; counter-clockwise from the x axis.
+    kappa0 : float, 1/m
+        The curvature at the start, finite; positive turning left.
+    x1 : float, m
+        The target's x, finite.
+    y1 : float, m
+        The target's y, finite.
+    max_curvature_rate_1pm2 : float, 1/m^2
+        The bound on |kdot|, the curvature's rate along the arc, finite and > 0.
+
+    Returns
+    -------
+    ClothoidFit
+        kdot (1/m^2), length (m), end point (m) and status: FIT_OK (on the target), FIT_SATURATED (kdot at its
+        bound, the end as close as it gets) or FIT_UNREACHABLE (target behind, beside or at the start: a finite
+        fallback).
+
+    Raises
+    ------
+    WorkbenchInputError
+        An argument that is not a finite number, or max_curvature_rate_1pm2 <= 0.
+
+    Examples
+    --------
+    From the origin, heading along x on a straight, to a target 10 m ahead and 1 m to the left:
+
+    >>> from controllers.clothoid import fit_hyper_clothoid
+    >>> fit = fit_hyper_clothoid(0.0, 0.0, 0.0, 0.0, 10.0, 1.0, max_curvature_rate_1pm2=1.0)
+    >>> fit.status, round(fit.curvature_rate_1pm2, 5), round(fit.length_m, 3)
+    (0, 0.00588, 10.09)
+
+    With the rate bounded at 0.001 1/m^2 the clothoid saturates and ends short of the target:
+
+    >>> fit = fit_hyper_clothoid(0.0, 0.0, 0.0, 0.0, 10.0, 1.0, max_curvature_rate_1pm2=0.001)
+    >>> fit.saturated, round(fit.end_error_m(10.0, 1.0), 3)
+    (True, 0.832)
+    """
     args = {"x0": x0, "y0": y0, "theta0": theta0, "kappa0": kappa0, "x1": x1, "y1": y1}
     x0, y0, theta0, kappa0, x1, y1 = (_finite(name, value) for name, value in args.items())
     rate = _finite("max_curvature_rate_1pm2", max_curvature_rate_1pm2)
