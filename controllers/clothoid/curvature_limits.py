@@ -65,7 +65,27 @@ class CurvatureLimits:
             raise WorkbenchInputError(f"{self.source}: speed_kmh must increase strictly; got [{speeds}]")
 
     def at_speed(self, speed_mps: float) -> tuple[float, float]:
-        """(max curvature 1/m, max curvature rate 1/(m s)) at this speed (m/s), interpolated."""
+        """(max curvature 1/m, max curvature rate 1/(m s)) at this speed (m/s), interpolated.
+
+        Parameters
+        ----------
+        speed_mps : float, m/s
+            The speed, finite; below the table's first speed or above its last, that row's limits hold.
+
+        Returns
+        -------
+        max_curvature_1pm : float, 1/m
+            The curvature limit, linearly interpolated in speed.
+        max_curvature_rate_1pm_s : float, 1/(m s)
+            The curvature-rate limit, linearly interpolated in speed.
+
+        Examples
+        --------
+        >>> from controllers.clothoid import CurvatureLimits
+        >>> limits = CurvatureLimits((10.0, 50.0), (0.15, 0.02), (0.2, 0.1))
+        >>> [round(value, 4) for value in limits.at_speed(30.0 / 3.6)]
+        [0.085, 0.15]
+        """
         speeds, rows = self.table
         out = np.empty(2)
         table_row(speeds, rows, speed_mps * 3.6, False, out)
@@ -83,7 +103,26 @@ class CurvatureLimits:
     def default_for(
         cls, geometry: VehicleGeometry, max_lateral_accel_g: float = DEFAULT_LIMIT_LATERAL_ACCEL_G
     ) -> CurvatureLimits:
-        """Limits from the vehicle's geometry (see the module docstring), tabulated from 0 to 150 km/h."""
+        """Limits from the vehicle's geometry (see the module docstring), tabulated from 0 to 150 km/h.
+
+        Parameters
+        ----------
+        geometry : VehicleGeometry
+            The vehicle's wheelbase, steering ratio, largest road-wheel angle and steering-wheel rate limit.
+        max_lateral_accel_g : float, g
+            The lateral-acceleration bound a / v^2 of the curvature limit, > 0.
+
+        Returns
+        -------
+        CurvatureLimits
+            Rows every 5 km/h from 0 to 150 km/h: the curvature limit min(lock, a / v^2) and the constant rate
+            limit (steering-wheel rate / steering ratio) / wheelbase.
+
+        Raises
+        ------
+        WorkbenchInputError
+            max_lateral_accel_g is not a finite number > 0.
+        """
         require_positive("max_lateral_accel_g", max_lateral_accel_g)
         speeds = np.arange(0.0, 151.0, 5.0)
         lock = math.tan(geometry.max_road_wheel_angle_rad) / geometry.wheelbase_m

@@ -53,12 +53,60 @@ class FilterSchedule:
 
     @classmethod
     def single(cls, params: LeadFilterParams, speed_kmh: float = 0.0, source: str = "") -> FilterSchedule:
-        """One filter for every speed (speed_kmh, km/h, is only its label)."""
+        """One filter for every speed (speed_kmh, km/h, is only its label).
+
+        Parameters
+        ----------
+        params : LeadFilterParams
+            The lead filter of Eq. 6.
+        speed_kmh : float, km/h
+            The speed the filter is labelled with, 0-300 km/h.
+        source : str
+            Where the filter comes from ("": not said).
+
+        Returns
+        -------
+        FilterSchedule
+            A schedule of one entry, whose `at_speed` is ``params`` at every speed.
+
+        Raises
+        ------
+        WorkbenchInputError
+            speed_kmh outside 0-300 km/h, or params not a LeadFilterParams.
+        """
         return cls((speed_kmh,), (params,), source)
 
     def at_speed(self, speed_kmh: float) -> LeadFilterParams:
         """The filter at speed_kmh (km/h): each parameter interpolated linearly in speed, clamped at the ends.
-        (The parameter ranges and wp / wz bounds are convex, so interpolated filters are valid too.)"""
+        (The parameter ranges and wp / wz bounds are convex, so interpolated filters are valid too.)
+
+        Parameters
+        ----------
+        speed_kmh : float, km/h
+            The speed, finite; below the first speed or above the last, that speed's filter holds.
+
+        Returns
+        -------
+        LeadFilterParams
+            The filter at that speed.
+
+        Raises
+        ------
+        WorkbenchInputError
+            speed_kmh is NaN or infinite.
+
+        Examples
+        --------
+        >>> from controllers.clothoid import FilterSchedule, LeadFilterParams
+        >>> schedule = FilterSchedule(
+        ...     (30.0, 60.0), (LeadFilterParams(10.0, 0.6, 40.0), LeadFilterParams(8.0, 0.7, 30.0))
+        ... )
+        >>> p = schedule.at_speed(45.0)
+        >>> round(p.omega_z_rad_s, 6), round(p.psi, 6), round(p.omega_p_rad_s, 6)
+        (9.0, 0.65, 35.0)
+        >>> schedule.at_speed(100.0) == schedule.params[-1]
+        True
+        """
         speeds = self.speeds_kmh
         if not math.isfinite(speed_kmh):
             raise WorkbenchInputError(f"speed_kmh must be a finite number; got {speed_kmh!r}")
