@@ -217,6 +217,13 @@ class LocalBackend(_StartedInWith):
         self._futures: list[Future[dict[str, Any]]] = []
 
     def describe(self) -> str:
+        """The backend in words for a study's progress line and report.
+
+        Returns
+        -------
+        str
+            E.g. "local process pool, 2 workers".
+        """
         return f"local process pool, {self.workers} worker{'s' if self.workers != 1 else ''}"
 
     @property
@@ -253,6 +260,27 @@ class LocalBackend(_StartedInWith):
             worker.join(max(0.0, deadline - time.monotonic()))
 
     def map_runs(self, runs: Sequence[PlannedRun]) -> Iterator[dict[str, Any]]:
+        """Run `runs` on the pool's workers, yielding each run's row as it finishes (in completion order, not in
+        the runs' order).
+
+        Parameters
+        ----------
+        runs : sequence of PlannedRun
+            The runs to execute (`StudySpec.plan`), each independent of the others.
+
+        Yields
+        ------
+        dict
+            A run's row (`runner.execute_run`): its parameters, the metrics.json fields, status and message; a run
+            that raised is an "error" row.
+
+        Raises
+        ------
+        RuntimeError
+            The backend was not started (use it in a ``with`` block).
+        BackendError
+            A worker process died (killed, out of memory, or crashed in native code); the runs left are cancelled.
+        """
         if self._pool is None:
             raise RuntimeError("start the backend first: with LocalBackend(...) as backend: ...")
         with _stop_signals_blocked():  # the first submit forks the workers
@@ -294,6 +322,13 @@ class DaskBackend(_StartedInWith):
         self._futures: list[Any] = []
 
     def describe(self) -> str:
+        """The backend in words for a study's progress line and report.
+
+        Returns
+        -------
+        str
+            The scheduler's address, or the LocalCluster and its number of workers.
+        """
         if self.scheduler:
             return f"dask scheduler {self.scheduler}"
         return f"dask LocalCluster, {self.workers} single-threaded worker process{'es' if self.workers != 1 else ''}"
@@ -346,6 +381,28 @@ class DaskBackend(_StartedInWith):
             cluster.close()
 
     def map_runs(self, runs: Sequence[PlannedRun]) -> Iterator[dict[str, Any]]:
+        """Run `runs` on the cluster, yielding each run's row as it finishes (in completion order, not in the runs'
+        order).
+
+        Parameters
+        ----------
+        runs : sequence of PlannedRun
+            The runs to execute (`StudySpec.plan`), each independent of the others.
+
+        Yields
+        ------
+        dict
+            A run's row (`runner.execute_run`): its parameters, the metrics.json fields, status and message; a run
+            that raised is an "error" row, and so is a run whose worker died each time it ran it.
+
+        Raises
+        ------
+        RuntimeError
+            The backend was not started (use it in a ``with`` block).
+        BackendError
+            The cluster could not run a run (e.g. the workbench is missing on a worker); the runs left are
+            cancelled.
+        """
         from distributed import as_completed
         from distributed.scheduler import KilledWorker
 
@@ -375,7 +432,37 @@ class DaskBackend(_StartedInWith):
 
 
 def make_backend(name: str = "local", scheduler: str | None = None, workers: int | None = None) -> Backend:
-    """A backend by name: "local" (workers processes) or "dask" (a LocalCluster, or the scheduler given)."""
+    """A backend by name: "local" (workers processes) or "dask" (a LocalCluster, or the scheduler given).
+
+    Parameters
+    ----------
+    name : str
+        One of `BACKENDS`: "local" or "dask".
+    scheduler : str or None
+        A dask scheduler's address, ``tcp://HOST:PORT`` (the dask backend only; None: a LocalCluster).
+    workers : int or None
+        The worker processes, from 1 to `max_workers` (None: one per usable CPU); not with a scheduler, whose
+        cluster brings its own.
+
+    Returns
+    -------
+    Backend
+        A `LocalBackend` or `DaskBackend`, not started: use it as a context manager (``with backend: ...``).
+
+    Raises
+    ------
+    WorkbenchInputError
+        An unknown name, a scheduler for the local backend, a malformed scheduler address, both a scheduler and
+        workers, or workers not a whole number from 1 to `max_workers`.
+
+    Examples
+    --------
+    >>> from workbench.apps.studies import make_backend
+    >>> make_backend("local", workers=2).describe()
+    'local process pool, 2 workers'
+    >>> make_backend("dask", workers=2).describe()
+    'dask LocalCluster, 2 single-threaded worker processes'
+    """
     if name not in BACKENDS:
         raise WorkbenchInputError(f"unknown backend {name!r}; choose one of {', '.join(BACKENDS)}")
     if name == "local":

@@ -154,10 +154,29 @@ class OptimisationResult:
     ran: int = 0
 
     def to_pandas(self) -> pd.DataFrame:
+        """The trial history (a copy).
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row per trial in the order proposed: trial, state ("complete" or "failed"), value, the options as
+            "<controller>.<option>", runs, failed_runs, reason, and mean_<metric> for each objective metric.
+        """
         return self.history.copy()
 
     def plot_history(self, ax: Axes | None = None) -> Axes:
-        """Each trial's objective (failed trials not drawn) and the best so far."""
+        """Each trial's objective (failed trials not drawn) and the best so far.
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+            The axes to draw on (None: a new pyplot figure's).
+
+        Returns
+        -------
+        matplotlib.axes.Axes
+            The axes drawn on.
+        """
         import matplotlib.pyplot as plt
 
         if ax is None:
@@ -175,7 +194,45 @@ class OptimisationResult:
 def run_optimisation(
     spec: StudySpec, out_dir: str | Path, backend: Backend | None = None, progress: bool = False
 ) -> OptimisationResult:
-    """Run (or resume) the optimisation the spec's [optimise] table describes into out_dir (module docstring)."""
+    """Run (or resume) the optimisation the spec's [optimise] table describes into out_dir (module docstring).
+
+    Parameters
+    ----------
+    spec : StudySpec
+        A study of one controller with an [optimise] table (``load_spec(path, kind="optimise")``).
+    out_dir : str or pathlib.Path
+        The study's folder: runs/ (one JSON row per run; rows already there are not run again), results.parquet,
+        history.parquet, history.png, and best.toml and best.json when a trial completed.
+    backend : Backend or None
+        Where the runs execute (`make_backend`); one started by the caller is left running, one started here is
+        closed on return (None: a `LocalBackend` over every usable CPU).
+    progress : bool
+        Show a bar on stderr for each batch of trials.
+
+    Returns
+    -------
+    OptimisationResult
+        The trial history, the best trial and its options (None and {} when no trial completed), best.toml's
+        path, and every run of every trial.
+
+    Raises
+    ------
+    WorkbenchInputError
+        The spec has no [optimise] table, or the output folder cannot be created.
+    BackendError
+        The backend's machinery failed (a worker process died); the runs already written stay, and the same call
+        resumes.
+
+    Examples
+    --------
+    >>> from workbench.apps.studies import load_spec, make_backend, run_optimisation
+    >>> spec = load_spec("examples/optimise_clothoid.toml", kind="optimise")
+    >>> spec.run_count(), spec.total_runs()  # runs per trial, runs of the 40 trials
+    (6, 240)
+    >>> with make_backend("local", workers=2) as backend:  # doctest: +SKIP
+    ...     result = run_optimisation(spec, "runs/tune-clothoid", backend)
+    >>> result.best_params, result.config_file  # doctest: +SKIP
+    """
     import optuna
 
     settings = spec.optimise

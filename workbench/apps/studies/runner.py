@@ -94,7 +94,27 @@ def simulate(run: PlannedRun, progress: bool = False) -> SimulationResult:
 def execute_run(run: PlannedRun) -> dict[str, Any]:
     """The run's row: its parameters, the metrics.json fields, status, message, traceback (errors only) and
     run_time_s (wall time) and cpu_time_s (this process's CPU time while it ran). Exceptions become an "error" row;
-    KeyboardInterrupt and SystemExit propagate."""
+    KeyboardInterrupt and SystemExit propagate.
+
+    Parameters
+    ----------
+    run : PlannedRun
+        One run of a study (`StudySpec.plan`).
+
+    Returns
+    -------
+    dict
+        The run's row: `PlannedRun.parameters`, then `RESULT_COLUMNS` (status "error" with the exception's
+        message and traceback when the run raised). The same run gives the same row bit for bit, but for
+        `TIMING_COLUMNS`.
+
+    Examples
+    --------
+    >>> from workbench.apps.studies import execute_run, load_spec
+    >>> run = load_spec("examples/sweep_dlc.toml").plan()[0]
+    >>> row = execute_run(run)  # doctest: +SKIP
+    >>> row["status"], row["max_abs_cte_m"]  # doctest: +SKIP
+    """
     start, cpu_start = time.perf_counter(), time.process_time()
     row = run.parameters()
     try:

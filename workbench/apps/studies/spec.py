@@ -261,7 +261,14 @@ class PlannedRun:
 
     def parameters(self) -> dict[str, Any]:
         """The run's columns before its metrics: ids, names, speed_kmh (always) and each given parameter
-        (controller options as "<controller>.<option>"), paths as text."""
+        (controller options as "<controller>.<option>"), paths as text.
+
+        Returns
+        -------
+        dict
+            run_id, index, scenario, controller, vehicle, sample, speed_kmh (km/h, the default unless given),
+            then the run's parameters and options.
+        """
 
         def plain(v: Any) -> Any:
             return str(v) if isinstance(v, Path) else v
@@ -517,7 +524,13 @@ class StudySpec:
     def run_count(self) -> int:
         """How many runs `plan()` gives, counted from the axes' sizes without planning them: per scenario and
         vehicle, the sum over controllers of the product of the run-parameter axes, that controller's axes and
-        the samples. (An optimisation runs this many per trial.)"""
+        the samples. (An optimisation runs this many per trial.)
+
+        Returns
+        -------
+        int
+            The number of runs `plan()` gives.
+        """
         runs_per_controller = sum(self._runs_per_controller().values())
         return len(self.scenarios) * len(self.vehicles) * runs_per_controller
 
@@ -530,7 +543,13 @@ class StudySpec:
         }
 
     def total_runs(self) -> int:
-        """The runs the whole study executes: run_count(), times the trials of an optimisation."""
+        """The runs the whole study executes: run_count(), times the trials of an optimisation.
+
+        Returns
+        -------
+        int
+            The number of runs; a study planning more than `max_runs` is refused when built.
+        """
         return self.run_count() * (self.optimise.trials if self.optimise is not None else 1)
 
     def _check_size(self) -> None:
@@ -632,7 +651,20 @@ class StudySpec:
     # ------------------------------------------------------------------------------------------- planning
     def drawn(self, controller: str | None = None) -> dict[str, Any]:
         """The random draws, parameter -> one value per sample: of the run parameters (controller None), or of
-        that controller's options."""
+        that controller's options.
+
+        Parameters
+        ----------
+        controller : str or None
+            One of the study's controllers (its [random.<controller>] table), or None for the run parameters'
+            [random] table.
+
+        Returns
+        -------
+        dict
+            Parameter -> its `samples` values (one per sample), drawn from the study's seed and the parameter's
+            name: the same spec draws the same values; {} when nothing is drawn.
+        """
         samples = self.samples or 1
         if controller is None:
             return {k: d.draw(key_rng(self.seed, k), samples) for k, d in self.random.items()}
@@ -642,7 +674,25 @@ class StudySpec:
     def plan(self, options: Mapping[str, Any] | None = None) -> list[PlannedRun]:
         """Every run of the study, in order: per scenario, vehicle and controller, the product of the run-parameter
         axes (first listed outermost), the controller's axes, and the random samples. `options` adds controller
-        parameters to every run (an optimiser's trial; the study must have one controller)."""
+        parameters to every run (an optimiser's trial; the study must have one controller).
+
+        Parameters
+        ----------
+        options : mapping or None
+            Controller option -> value, added to every run (None: none).
+
+        Returns
+        -------
+        list of PlannedRun
+            `run_count()` runs, their index their place in that list; a run's id depends on its parameters and
+            the content of the files it reads, not on its place.
+
+        Raises
+        ------
+        WorkbenchInputError
+            `options` given for a study of several controllers, an option the controller does not have, or a
+            value it refuses.
+        """
         digests: dict[Path, str | None] = {}
         extra = {}
         if options:
@@ -764,7 +814,39 @@ def load_spec(path: str | Path, kind: str = "sweep", max_runs: int | None = None
     """Read a study spec from a TOML file. kind: "sweep" (no [optimise] table) or "optimise" (one required);
     max_runs: the limit on the study's runs, over the spec's study.max_runs (None: the spec's, else
     DEFAULT_MAX_RUNS). WorkbenchInputError naming the file, the key and what is allowed for anything it cannot
-    use."""
+    use.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The spec's TOML file; relative paths in it are taken from its folder.
+    kind : str
+        "sweep" (the spec may not have an [optimise] table) or "optimise" (it must have one).
+    max_runs : int or None
+        The most runs the study may plan, whole and at least 1 (None: the spec's study.max_runs, else
+        `DEFAULT_MAX_RUNS`).
+
+    Returns
+    -------
+    StudySpec
+        The study, every value it plans checked and typed (paths absolute, the files they name read).
+
+    Raises
+    ------
+    WorkbenchInputError
+        The file is missing or not TOML, a table or key is unknown, a name, value or file is refused, the study
+        plans more than max_runs runs, or a run is too long or on a path a vehicle cannot follow (unless the spec
+        allows them); the message names the file and the key.
+
+    Examples
+    --------
+    >>> from workbench.apps.studies import load_spec
+    >>> spec = load_spec("examples/sweep_dlc.toml")
+    >>> spec.run_count()
+    200
+    >>> spec.plan()[0].parameters()["clothoid.frechet_threshold_m"]
+    0.01
+    """
     if kind not in ("sweep", "optimise"):
         raise WorkbenchInputError(f"kind must be sweep or optimise; got {kind!r}")
     path = Path(path)

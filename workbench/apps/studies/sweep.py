@@ -48,7 +48,44 @@ def run_sweep(
     spec: StudySpec, out_dir: str | Path, backend: Backend | None = None, progress: bool = False
 ) -> SweepResult:
     """Run (or resume) the sweep into out_dir; see the module docstring. backend: a LocalBackend over every CPU
-    unless given (started only if some run is left to do)."""
+    unless given (started only if some run is left to do).
+
+    Parameters
+    ----------
+    spec : StudySpec
+        The study (`load_spec`), its runs planned here (`StudySpec.plan`).
+    out_dir : str or pathlib.Path
+        The study's folder: one JSON row per run under out_dir/runs/ (the rows already there are kept, not run
+        again), then out_dir/results.parquet.
+    backend : Backend or None
+        Where the runs execute (`make_backend`); one started by the caller is left running, one started here is
+        closed on return (None: a `LocalBackend` over every usable CPU).
+    progress : bool
+        Show a bar on stderr counting the runs left to do.
+
+    Returns
+    -------
+    SweepResult
+        One row per planned run in the study's order, with how many ran now (the others were in out_dir).
+
+    Raises
+    ------
+    WorkbenchInputError
+        The output folder cannot be created.
+    BackendError
+        The backend's machinery failed (a worker process died); the rows already written stay, and the same call
+        resumes.
+
+    Examples
+    --------
+    >>> from workbench.apps.studies import load_spec, make_backend, run_sweep
+    >>> spec = load_spec("examples/sweep_dlc.toml")
+    >>> spec.run_count()
+    200
+    >>> with make_backend("local", workers=2) as backend:  # doctest: +SKIP
+    ...     result = run_sweep(spec, "runs/sweep-dlc", backend, progress=True)
+    >>> result.summary()  # doctest: +SKIP
+    """
     out = Path(out_dir)
     store = RunStore(out)
     runs = spec.plan()
