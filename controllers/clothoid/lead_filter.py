@@ -66,15 +66,47 @@ class LeadFilterParams:
     def from_lag(cls, omega_n_rad_s: float, zeta: float, pole_ratio: float = 3.0) -> LeadFilterParams:
         """The default design: the zeros cancel the poles of the lag (Eq. 5: wz = wn, psi = zeta) and the triple
         pole sits at pole_ratio x wn (pole_ratio in [1, 100]). The cascade is then wp^3 / (s + wp)^3, a lag
-        pole_ratio times faster. `tuning` will offer a proper loop-shaping design (bandwidth against
-        high-frequency gain and steering-rate limits); this is the simple starting point."""
+        pole_ratio times faster. `tuning.lead_design.design_lead` chooses the pole by loop shaping instead (the
+        largest wp within bounds on the peak gain and the cascade's resonance); this is the simple starting point.
+
+        Parameters
+        ----------
+        omega_n_rad_s : float, rad/s
+            The lag's natural frequency wn, 0.01-1000 rad/s.
+        zeta : float
+            The lag's damping, in (0, 5].
+        pole_ratio : float
+            wp / wn, 1-100.
+
+        Returns
+        -------
+        LeadFilterParams
+            wz = omega_n_rad_s, psi = zeta, wp = pole_ratio x omega_n_rad_s.
+
+        Raises
+        ------
+        WorkbenchInputError
+            An argument out of its range, or wp above 1000 rad/s.
+
+        Examples
+        --------
+        >>> from controllers.clothoid import LeadFilterParams
+        >>> LeadFilterParams.from_lag(4.44, 0.8)
+        LeadFilterParams(omega_z_rad_s=4.44, psi=0.8, omega_p_rad_s=13.32)
+        """
         require_in_range("omega_n_rad_s", omega_n_rad_s, *OMEGA_RANGE_RAD_S, "rad/s")
         require_in_range("zeta", zeta, 0.0, PSI_MAX, low_open=True)
         require_in_range("pole_ratio", pole_ratio, *POLE_RATIO_RANGE)
         return cls(omega_n_rad_s, zeta, pole_ratio * omega_n_rad_s)
 
     def transfer_function(self) -> control.TransferFunction:
-        """Eq. 6 as a python-control transfer function (input and output in the same unit, e.g. rad)."""
+        """Eq. 6 as a python-control transfer function (input and output in the same unit, e.g. rad).
+
+        Returns
+        -------
+        control.TransferFunction
+            wp^3 (s^2 + 2 psi wz s + wz^2) / (wz^2 (s + wp)^3), continuous time.
+        """
         import control
 
         wz, psi, wp = self.omega_z_rad_s, self.psi, self.omega_p_rad_s
@@ -88,7 +120,24 @@ class LeadFilterParams:
         return float(tf.num[0][0][-1] / tf.den[0][0][-1])
 
     def gain_at(self, omega_rad_s: np.ndarray | float) -> np.ndarray:
-        """|G_lead(j omega)| of Eq. 6 at the given frequencies (rad/s)."""
+        """|G_lead(j omega)| of Eq. 6 at the given frequencies (rad/s).
+
+        Parameters
+        ----------
+        omega_rad_s : float or array_like of float, rad/s
+            The frequencies, >= 0, any shape.
+
+        Returns
+        -------
+        numpy.ndarray of float
+            The gain (linear) at each frequency, in the shape of ``omega_rad_s``: 1 at 0 rad/s.
+
+        Examples
+        --------
+        >>> from controllers.clothoid import LeadFilterParams
+        >>> LeadFilterParams.from_lag(4.44, 0.8).gain_at([0.0, 4.44, 100.0]).round(3).tolist()
+        [1.0, 1.366, 1.168]
+        """
         w2 = np.square(np.asarray(omega_rad_s, dtype=float))
         wz, psi, wp = self.omega_z_rad_s, self.psi, self.omega_p_rad_s
         zeros = np.hypot(wz**2 - w2, 2 * psi * wz * np.sqrt(w2))
@@ -147,6 +196,22 @@ class DiscreteLeadFilter:
 
     The discrete system x[k+1] = A x[k] + B u[k], y[k] = C x[k] + D u[k] is kept as Python floats; `state_space`
     returns it as tuples, `poles` its poles.
+
+    Parameters
+    ----------
+    params : LeadFilterParams
+        The continuous filter of Eq. 6.
+    dt_s : float, s
+        The controller's sample time, > 0.
+    prewarp_rad_s : float or None, rad/s
+        The frequency where the discrete response matches the continuous one, in [0, pi / dt_s) (None or 0: plain
+        Tustin).
+
+    Raises
+    ------
+    WorkbenchInputError
+        dt_s not > 0, prewarp_rad_s out of its range, or a discretisation that is unstable or inaccurate at this
+        sample time.
     """
 
     __slots__ = ("_coeffs", "_x", "dt_s", "params", "poles", "prewarp_rad_s", "state_space")
@@ -220,6 +285,7 @@ class DiscreteLeadFilter:
 
     @property
     def state(self) -> tuple[float, float, float]:
+        """The three states of the lag chain (in the input's unit): all equal to the input at steady state."""
         x1, x2, x3 = self._x.tolist()
         return x1, x2, x3
 
@@ -230,10 +296,37 @@ class DiscreteLeadFilter:
 
     def reset(self, u0: float = 0.0) -> None:
         """Steady state for the constant input u0: the output is u0 until the input changes. (Every state of the
-        lag chain settles at the input; the bilinear map keeps the state coordinates.)"""
+        lag chain settles at the input; the bilinear map keeps the state coordinates.)
+
+        Parameters
+        ----------
+        u0 : float
+            The constant input the filter has settled at, in the input's unit (e.g. rad of steering wheel).
+        """
         u0 = float(u0)
         self._x[:] = u0
 
     def step(self, u: float) -> float:
-        """Advance one sample with input u; return the output y[k] = C x[k] + D u[k] (`lead_step`)."""
+        """Advance one sample with input u; return the output y[k] = C x[k] + D u[k] (`lead_step`).
+
+        Parameters
+        ----------
+        u : float
+            The input at this sample, in any unit (the output has the same).
+
+        Returns
+        -------
+        float
+            The filtered value, in the input's unit.
+
+        Examples
+        --------
+        A unit step into the default lead filter at 50 Hz: the lead overshoots the input while it advances it.
+
+        >>> from controllers.clothoid import DiscreteLeadFilter, LeadFilterParams
+        >>> lead = DiscreteLeadFilter(LeadFilterParams.from_lag(4.44, 0.8), dt_s=0.02)
+        >>> lead.reset(0.0)
+        >>> [round(lead.step(1.0), 3) for _ in range(3)]
+        [0.884, 2.152, 2.633]
+        """
         return lead_step(self._coeffs, self._x, float(u))
