@@ -329,7 +329,18 @@ class ClothoidConfig:
     )
 
     def with_tuning(self, tuning: VehicleTuning) -> ClothoidConfig:
-        """These options with the steered vehicle's own tuning (`tuning.own_tuning.with_vehicle_tuning`)."""
+        """These options with the steered vehicle's own tuning (`tuning.own_tuning.with_vehicle_tuning`).
+
+        Parameters
+        ----------
+        tuning : VehicleTuning
+            The vehicle's identified lags, lead-filter schedule, curvature limits and lookahead floors.
+
+        Returns
+        -------
+        ClothoidConfig
+            A copy of these options with ``tuning`` set; every other option as it is.
+        """
         return replace(self, tuning=tuning)
 
     @property
@@ -371,6 +382,21 @@ class ClothoidController(Controller[ClothoidConfig]):
     feed-forward timing are computed from) is the config's (`ClothoidConfig.tuning`); a `vehicle` given without one
     is refused, so that a controller meant for a vehicle never runs untuned by mistake
     (`tuning.own_tuning.tuned_controller` builds it with the vehicle's own).
+
+    Parameters
+    ----------
+    geometry : VehicleGeometry
+        The steered vehicle's wheelbase, steering ratio, lock and steering-rate limit.
+    config : ClothoidConfig or None
+        The controller's options (None: the defaults, untuned).
+    vehicle : VehicleModel or None
+        The vehicle the controller is meant for; given, the config must carry a tuning (None: no check).
+
+    Raises
+    ------
+    WorkbenchInputError
+        A vehicle given with a config without tuning, or delay_compensation "model" with a known delay and no
+        tuning (the prediction needs the identified lags).
     """
 
     name: ClassVar[str] = "clothoid"
@@ -536,7 +562,23 @@ class ClothoidController(Controller[ClothoidConfig]):
         )
 
     def plant_lags(self, speed_kmh: float) -> PlantLags | None:
-        """The vehicle's identified lags at this speed (None without a tuning)."""
+        """The vehicle's identified lags at this speed (None without a tuning).
+
+        Parameters
+        ----------
+        speed_kmh : float, km/h
+            The speed, finite; the lags are interpolated linearly between the identified speeds, clamped beyond.
+
+        Returns
+        -------
+        PlantLags or None
+            The path lag and the measured (yaw-rate) lag, or None when the controller has no tuning.
+
+        Raises
+        ------
+        WorkbenchInputError
+            speed_kmh is not a finite number.
+        """
         from controllers.clothoid.loop_analysis import PlantLags
 
         if self.tuning is None:
@@ -544,7 +586,21 @@ class ClothoidController(Controller[ClothoidConfig]):
         return PlantLags(self.tuning.lag_at(speed_kmh), self.tuning.measured_lag_at(speed_kmh))
 
     def loop_settings(self, speed_kmh: float) -> LoopSettings:
-        """What the controller does at this speed, for `loop_analysis`."""
+        """What the controller does at this speed, for `loop_analysis`.
+
+        Available after `reset`: the settings hold the run's sample time.
+
+        Parameters
+        ----------
+        speed_kmh : float, km/h
+            The speed whose lead filter (from the filter schedule) the settings hold.
+
+        Returns
+        -------
+        LoopSettings
+            The sample time, the prediction time, the lead filter at this speed (None when off), the known delay
+            and the delay compensation.
+        """
         from controllers.clothoid.loop_analysis import LoopSettings
 
         cfg = self.config
@@ -556,7 +612,21 @@ class ClothoidController(Controller[ClothoidConfig]):
     def lookahead_floor_m(self, speed_mps: float) -> float:
         """The shortest lookahead (m) that keeps the configured margins at this speed (per FLOOR_SPEED_BAND_KMH band,
         computed once per band and run; min_lookahead_m without a tuning or with the margins set to 0). The analysis
-        is cached on all of `loop_settings`, the known delay included."""
+        is cached on all of `loop_settings`, the known delay included.
+
+        Available after `reset`: the floor depends on the run's sample time.
+
+        Parameters
+        ----------
+        speed_mps : float, m/s
+            The speed, >= 0; it selects its FLOOR_SPEED_BAND_KMH band (the lowest band below the first).
+
+        Returns
+        -------
+        float, m
+            The floor; above max_lookahead_m where the margins need a longer lookahead than the range allows
+            (`run_warnings` tells).
+        """
         return self._band_floor_m(max(1, round(speed_mps * 3.6 / FLOOR_SPEED_BAND_KMH)))
 
     def _band_floor_m(self, band: int) -> float:
@@ -663,7 +733,21 @@ class ClothoidController(Controller[ClothoidConfig]):
         up to the floor search's top keeps the margins, it is held at that top without them. The run is not
         refused: the floor is what keeps the loop's margins with this tuning (a study of weak lead filters must
         be able to run it), but it is not the controller the range describes, and the message says what to
-        change. None in the "fixed" lookahead mode (no floor applies) or without planned speeds."""
+        change. None in the "fixed" lookahead mode (no floor applies) or without planned speeds.
+
+        Parameters
+        ----------
+        path : ReferencePath
+            The path to run, with its planned speeds (none: no warning).
+        sample_time_s : float, s
+            The controller's sample time, > 0; the controller is `reset` for the path with it.
+
+        Returns
+        -------
+        list of str
+            One message naming the speed bands whose floor lies above max_lookahead_m and what to change; empty
+            when there is none.
+        """
         cfg = self.config
         if cfg.lookahead_mode == "fixed" or path.speed_mps is None:
             return []
@@ -708,7 +792,20 @@ class ClothoidController(Controller[ClothoidConfig]):
         feed-forward time = the low-frequency delay of lead filter and path lag; reference lead = the path lag's less
         the measured (yaw-rate) lag's, within [0, prediction time]; K of the path lag. A known delay adds to the
         feed-forward time (the steering commanded now takes effect that much later, from a pose that much older)
-        and to the prediction time."""
+        and to the prediction time.
+
+        Available after `reset`: the timing depends on the run's sample time.
+
+        Parameters
+        ----------
+        speed_mps : float, m/s
+            The speed, >= 0.
+
+        Returns
+        -------
+        FeedforwardTiming
+            The feed-forward time (s), the reference lead (s) and the steady-state gain K.
+        """
         ff, ref, gain = sk.feedforward_timing(
             speed_mps, self._params, self._lags, self._measured_lags, self._lag_speeds, self._schedule,
             self._schedule_speeds, np.empty(4),
