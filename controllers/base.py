@@ -121,7 +121,13 @@ class Controller(ABC, Generic[ConfigT]):
 
     @classmethod
     def summary(cls) -> str:
-        """The first line of the controller's module docstring, for `workbench controllers`."""
+        """The first line of the controller's module docstring, for `workbench controllers`.
+
+        Returns
+        -------
+        str
+            That line (the class's name when the module has no docstring).
+        """
         doc = sys.modules[cls.__module__].__doc__ or cls.__name__
         return doc.strip().splitlines()[0]
 
@@ -147,7 +153,20 @@ class Controller(ABC, Generic[ConfigT]):
 
     # ------------------------------------------------------------------ the interface (not overridden)
     def reset(self, path: ReferencePath, sample_time_s: float) -> None:
-        """Forget all state; the next step is the first on `path`; steps come every `sample_time_s` seconds."""
+        """Forget all state; the next step is the first on `path`; steps come every `sample_time_s` seconds.
+
+        Parameters
+        ----------
+        path : ReferencePath
+            The path the run follows, with its planned speeds when it has them.
+        sample_time_s : float, s
+            The controller's period, > 0: `step` is called once per period.
+
+        Raises
+        ------
+        WorkbenchInputError
+            sample_time_s is not a finite number > 0.
+        """
         require_positive("sample_time_s", sample_time_s)
         self._clear_hold()
         self._sample_time_s = float(sample_time_s)
@@ -157,7 +176,22 @@ class Controller(ABC, Generic[ConfigT]):
 
     def step(self, measurement: Measurement, path: ReferencePath) -> float:
         """Steering-wheel angle command (rad) for this step: always finite and within the vehicle's limit (the
-        module docstring's contract: an implausible measurement or a non-finite result holds the last command)."""
+        module docstring's contract: an implausible measurement or a non-finite result holds the last command).
+
+        Parameters
+        ----------
+        measurement : Measurement
+            The vehicle's state this step (pose, speed, yaw rate, time); one with a non-finite or implausible
+            field, or a time earlier than the last accepted one, is rejected (see `diagnostics`).
+        path : ReferencePath
+            The path given to `reset`.
+
+        Returns
+        -------
+        float, rad
+            The steering-wheel angle command, finite and within +-max_steer_wheel_angle_rad: `held_command`
+            when the step was rejected.
+        """
         screened = self._screen(measurement)
         if screened is not None and screened.t_s < self._last_t_s:
             self._rewound_frames += 1
@@ -207,13 +241,37 @@ class Controller(ABC, Generic[ConfigT]):
         return self._held_command
 
     def saturate(self, steer_wheel_rad: float) -> float:
-        """Clip a steering-wheel angle to the vehicle's limit."""
+        """Clip a steering-wheel angle to the vehicle's limit.
+
+        Parameters
+        ----------
+        steer_wheel_rad : float, rad
+            A steering-wheel angle.
+
+        Returns
+        -------
+        float, rad
+            The angle within +-max_steer_wheel_angle_rad of the vehicle's geometry.
+        """
         limit = self.geometry.max_steer_wheel_angle_rad
         return min(max(steer_wheel_rad, -limit), limit)
 
     def run_warnings(self, path: ReferencePath, sample_time_s: float) -> list[str]:
         """What to tell a person before a run on `path` with steps every sample_time_s (s): settings that cannot act
-        as configured on it (`SteeringController.run_warnings`); none unless a subclass says otherwise."""
+        as configured on it (`SteeringController.run_warnings`); none unless a subclass says otherwise.
+
+        Parameters
+        ----------
+        path : ReferencePath
+            The path to run, with its planned speeds when it has them.
+        sample_time_s : float, s
+            The controller's period, > 0.
+
+        Returns
+        -------
+        list of str
+            One message per setting that cannot act as configured; empty when there is none.
+        """
         return []
 
     # ------------------------------------------------------------------ what subclasses implement
