@@ -126,7 +126,21 @@ class Stanley(Controller[StanleyConfig]):
 
     def feedforward_rad(self, curvature_1pm: float, speed_mps: float) -> float:
         """delta_ff (road-wheel angle, rad): the term that makes the law's steady command on a circle of this
-        curvature at this speed the one that holds the rear axle on it (module docstring)."""
+        curvature at this speed the one that holds the rear axle on it (module docstring).
+
+        Parameters
+        ----------
+        curvature_1pm : float, 1/m
+            The path's curvature at the reference point, positive turning left.
+        speed_mps : float, m/s
+            The vehicle's speed, >= 0.
+
+        Returns
+        -------
+        float, rad
+            The feed-forward road-wheel angle: the steady front slip angle (with the vehicle's tyres, else 0)
+            plus the heading term the steady front cross-track error of that circle gives.
+        """
         cfg, wheelbase = self.config, self.geometry.wheelbase_m
         alpha_f = alpha_r = 0.0
         if self._tyres is not None:
