@@ -139,7 +139,8 @@ class Stanley(Controller[StanleyConfig]):
         -------
         float, rad
             The feed-forward road-wheel angle: the steady front slip angle (with the vehicle's tyres, else 0)
-            plus the heading term the steady front cross-track error of that circle gives.
+            plus the law's cross-track term, atan(gain x e / (softening + speed)), at the front cross-track error
+            e of the rear axle held on the circle.
         """
         cfg, wheelbase = self.config, self.geometry.wheelbase_m
         alpha_f = alpha_r = 0.0
