@@ -398,7 +398,30 @@ class MPCController(Controller[MPCConfigT]):
         length s0_m and speed v0_mps: the model integrated along the path (reset first), each segment on the path's
         curvature and speed at its middle (`PathPreview.along`, at progress estimated at the model's speed; the
         Frenet errors and the progress are the model's own), RK4. The speed at the end follows the path's speed
-        profile from v0 as the preview does. Needs input_delay_s or measurement_latency_s > 0."""
+        profile from v0 as the preview does. Needs input_delay_s or measurement_latency_s > 0.
+
+        Parameters
+        ----------
+        x0 : numpy.ndarray of float
+            The prediction model's state at the start, shape (nx,) (`PredictionModel.state_names`).
+        s0_m : float, m
+            The arc length of the vehicle's foot point on the path at the start.
+        v0_mps : float, m/s
+            The speed at the start.
+        durations_s : numpy.ndarray of float, s
+            The segments' durations, each > 0 and at most the delay segment the controller was reset with.
+        rates : numpy.ndarray of float, rad/s
+            The commanded steering angle's rate over each segment, one per duration.
+
+        Returns
+        -------
+        state : numpy.ndarray of float
+            The model's state after the last segment, shape (nx,).
+        s_m : float, m
+            The foot point's arc length then, s0_m plus the model's progress.
+        speed_mps : float, m/s
+            The speed then, v0_mps changed as the path's speed profile changes over the progress.
+        """
         integrate, chunk, nx = self._delay_integrator, self._delay_chunk, self.model.nx
         assert integrate is not None, "predict_ahead needs input_delay_s or measurement_latency_s > 0 and a reset"
         dt, u, nodes = chunked(durations_s, rates, chunk, max(v0_mps, self.ocp.min_speed_mps))
