@@ -55,7 +55,24 @@ _MIN_FRENET_SCALE = 0.1
 def prediction_params_for(vehicle: object) -> PredictionParams:
     """Prediction parameters for a vehicle given as a `VehicleModel` (its `single_track`), a params dataclass of
     one (the fields of a preset), a preset name or TOML file path (str/Path), a `VehicleGeometry` (kinematic
-    default) or already as `PredictionParams`."""
+    default) or already as `PredictionParams`.
+
+    Parameters
+    ----------
+    vehicle : object
+        A `VehicleModel`, a vehicle params dataclass, a preset name or TOML file path (str or pathlib.Path), a
+        `VehicleGeometry` or `PredictionParams`.
+
+    Returns
+    -------
+    PredictionParams
+        The single track's geometry, limits and (when the vehicle gives them) mass, inertia and tyres.
+
+    Raises
+    ------
+    WorkbenchInputError
+        A type not listed above, or an unknown preset or unreadable vehicle file.
+    """
     from workbench.vehicles import load_vehicle
     from workbench.vehicles.presets import MODEL_TYPES
 
@@ -95,6 +112,19 @@ class PredictionModel:
     """The ODE of one model kind as CasADi expressions, and its RK4 discretisation.
 
     x: states (`state_names`); u: [delta_c'] (rad/s); p: [kappa (1/m), v (m/s)], held over an interval.
+
+    Parameters
+    ----------
+    params : PredictionParams
+        The vehicle's single-track parameters (`prediction_params_for`).
+    kind : str or None
+        "dynamic", "kinematic" or "kinematic-lag" (None: "kinematic-lag" with a lag, else "dynamic" when the
+        single track is known, else "kinematic").
+
+    Raises
+    ------
+    WorkbenchInputError
+        An unknown kind, "dynamic" without mass, inertia and tyres, or "kinematic-lag" without a lag.
     """
 
     def __init__(self, params: PredictionParams, kind: str | None = None) -> None:
@@ -172,7 +202,24 @@ class PredictionModel:
     def progress(self, states: np.ndarray, kappa: np.ndarray, speed: np.ndarray, step_s: float) -> np.ndarray:
         """Predicted arc length travelled along the path (m) at each node of a plan, states (N+1, nx) with
         kappa and speed per interval (N,): the trapezoidal integral of s' (`progress_rate`; node N uses the last
-        interval's kappa and speed). Compiled (`_progress_kernel`); the tests check it against `progress_rate`."""
+        interval's kappa and speed). Compiled (`_progress_kernel`); the tests check it against `progress_rate`.
+
+        Parameters
+        ----------
+        states : numpy.ndarray of float
+            The plan's states, shape (N+1, nx).
+        kappa : numpy.ndarray of float, 1/m
+            The path's curvature over each interval, shape (N,).
+        speed : numpy.ndarray of float, m/s
+            The speed over each interval, shape (N,).
+        step_s : float, s
+            The interval's duration, > 0.
+
+        Returns
+        -------
+        numpy.ndarray of float, m
+            The arc length travelled from node 0 to each node, shape (N+1,), starting at 0.
+        """
         if self.kind == "dynamic":
             st = self.params.single_track
             assert st is not None
@@ -228,13 +275,39 @@ class PredictionModel:
         return ca.vertcat(*x)
 
     def reference_states(self, kappa: np.ndarray, speed: np.ndarray) -> np.ndarray:
-        """`_reference` at each (kappa, speed) pair: (n, nx)."""
+        """`_reference` at each (kappa, speed) pair: (n, nx).
+
+        Parameters
+        ----------
+        kappa : array_like of float, 1/m
+            The path's curvatures, n of them (a scalar: one).
+        speed : array_like of float, m/s
+            The speeds, > 0, as many as the curvatures.
+
+        Returns
+        -------
+        numpy.ndarray of float
+            The steady-cornering state on the path (no cross-track error) at each pair, shape (n, nx).
+        """
         kappa, speed = np.atleast_1d(kappa).astype(float), np.atleast_1d(speed).astype(float)
         out = self.reference.map(kappa.size)(np.vstack((kappa, speed)))
         return np.asarray(out.full()).T
 
     def substeps_for(self, step_s: float, min_speed_mps: float) -> int:
-        """RK4 sub-steps per prediction step so that the fastest mode stays within RK4_STABILITY_MARGIN."""
+        """RK4 sub-steps per prediction step so that the fastest mode stays within RK4_STABILITY_MARGIN.
+
+        Parameters
+        ----------
+        step_s : float, s
+            The prediction step, > 0.
+        min_speed_mps : float, m/s
+            The lowest speed predicted at, > 0 (the dynamic model's lateral modes are fastest there).
+
+        Returns
+        -------
+        int
+            The number of sub-steps, >= 1: step_s / substeps x the fastest rate (1/s) stays within 2.
+        """
         prm = self.params
         fastest = 1.0 / prm.steering_time_constant_s
         if self.kind == "dynamic":
@@ -247,7 +320,22 @@ class PredictionModel:
         return max(1, math.ceil(step_s * fastest / RK4_STABILITY_MARGIN - 1e-9))
 
     def discrete(self, step_s: float, substeps: int, name: str = "F") -> ca.Function:
-        """x_next = F(x, u, p): `substeps` RK4 steps over step_s with u and p held (an SX function)."""
+        """x_next = F(x, u, p): `substeps` RK4 steps over step_s with u and p held (an SX function).
+
+        Parameters
+        ----------
+        step_s : float, s
+            The step's duration, > 0.
+        substeps : int
+            The RK4 steps within it, >= 1 (`substeps_for`).
+        name : str
+            The CasADi function's name.
+
+        Returns
+        -------
+        casadi.Function
+            F(x (nx,), u (1,), p (2,)) -> x_next (nx,).
+        """
         x, u, p = ca.SX.sym("x", self.nx), ca.SX.sym("u", 1), ca.SX.sym("p", 2)
         h = step_s / substeps
         xk = x
