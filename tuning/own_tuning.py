@@ -46,7 +46,20 @@ if TYPE_CHECKING:  # the clothoid controller and the tuning tools (python-contro
 
 def cache_key(vehicle: VehicleModel, options: PresetTuningOptions) -> str:
     """Name of the vehicle's cache directory: sha256 of its canonical parameters and of the tuning options resolved
-    for it (so that changed options make a new tuning rather than reuse one made with the old)."""
+    for it (so that changed options make a new tuning rather than reuse one made with the old).
+
+    Parameters
+    ----------
+    vehicle : VehicleModel
+        The vehicle (its payload is left out of its identity: module docstring).
+    options : PresetTuningOptions
+        The tuning options, resolved for the vehicle's model.
+
+    Returns
+    -------
+    str
+        64 hexadecimal digits.
+    """
     from tuning.preset_tuning import options_dict
     from tuning.tuning_dirs import canonical_vehicle_toml
 
@@ -55,7 +68,22 @@ def cache_key(vehicle: VehicleModel, options: PresetTuningOptions) -> str:
 
 
 def shipped_tuning_dir(vehicle: VehicleModel, options: PresetTuningOptions | None = None) -> Path | None:
-    """The shipped tuning made for exactly this vehicle (payload aside) and these options, or None."""
+    """The shipped tuning made for exactly this vehicle (payload aside) and these options, or None.
+
+    Parameters
+    ----------
+    vehicle : VehicleModel
+        The vehicle whose parameters are looked up among the shipped presets' manifests.
+    options : PresetTuningOptions or None
+        The tuning options (None: `tuning.preset_tuning.PRESET_TUNING_OPTIONS`, those the shipped files were made
+        with).
+
+    Returns
+    -------
+    pathlib.Path or None
+        The shipped directory (``workbench/presets/tuning/<preset>/``), or None when none was made for this
+        vehicle and these options.
+    """
     from tuning.preset_tuning import PRESET_TUNING_OPTIONS, options_dict
     from tuning.tuning_dirs import params_sha256, shipped_index
 
@@ -79,7 +107,23 @@ def _stale_preset_hint(vehicle: VehicleModel) -> str:
 
 
 def manual_instructions(vehicle: VehicleModel, options: PresetTuningOptions, vehicle_file: str) -> str:
-    """The `tuning` commands that make this vehicle's files by hand, and the options that then use them."""
+    """The `tuning` commands that make this vehicle's files by hand, and the options that then use them.
+
+    Parameters
+    ----------
+    vehicle : VehicleModel
+        The vehicle to tune.
+    options : PresetTuningOptions
+        The tuning options the commands apply.
+    vehicle_file : str
+        The vehicle TOML file the commands name (``--vehicle-file``).
+
+    Returns
+    -------
+    str
+        One sentence: the commands, joined by ``&&``, and the controller options filter_file and limits_file that
+        use their files.
+    """
     from tuning.preset_tuning import tuning_commands
     from tuning.tuning_dirs import LEAD_FILE, LIMITS_FILE
 
@@ -95,7 +139,29 @@ def manual_instructions(vehicle: VehicleModel, options: PresetTuningOptions, veh
 def generate_vehicle_tuning(vehicle: VehicleModel, directory: str | Path, options: PresetTuningOptions) -> Path:
     """Make the vehicle's tuning in `directory` (which must not exist yet) by the tuning chain, atomically: in a
     temporary sibling directory renamed to `directory` when complete. If another process completed it first, its
-    files are kept. Returns `directory`."""
+    files are kept. Returns `directory`.
+
+    Parameters
+    ----------
+    vehicle : VehicleModel
+        The vehicle to tune.
+    directory : str or pathlib.Path
+        The tuning's directory, not existing yet; its parent is made when missing.
+    options : PresetTuningOptions
+        The tuning options (speeds, design, ...).
+
+    Returns
+    -------
+    pathlib.Path
+        ``directory``, holding the vehicle file, the lead-filter and limits files and the manifest.
+
+    Raises
+    ------
+    WorkbenchInputError
+        A step of the tuning chain refuses the vehicle (an identification or design that fails, saying why).
+    OSError
+        The directory cannot be written.
+    """
     from tuning.tuning_dirs import MANIFEST_FILE, VEHICLE_FILE, canonical_vehicle_toml
 
     target = Path(directory)
@@ -141,7 +207,36 @@ def _duration(seconds: float) -> str:
 def tuning_for(vehicle: VehicleModel, options: PresetTuningOptions | None = None) -> VehicleTuning:
     """The tuning the clothoid controller uses for `vehicle` (module docstring): the shipped files of the preset it
     equals (payload aside), else its own from the cache, generated there on first use. options: the tuning options
-    (default `tuning.preset_tuning.PRESET_TUNING_OPTIONS`, those the shipped files were made with)."""
+    (default `tuning.preset_tuning.PRESET_TUNING_OPTIONS`, those the shipped files were made with).
+
+    Parameters
+    ----------
+    vehicle : VehicleModel
+        The vehicle to be steered.
+    options : PresetTuningOptions or None
+        The tuning options (None: the shipped files' options).
+
+    Returns
+    -------
+    VehicleTuning
+        The vehicle's lead-filter schedule, curvature limits, identified lags and lookahead floors.
+
+    Raises
+    ------
+    WorkbenchInputError
+        No shipped tuning fits and generating one in the cache fails (the message gives the `tuning` commands to
+        run by hand), or the cache directory is not private to the user.
+
+    Examples
+    --------
+    A preset's tuning is shipped, so this reads files and identifies nothing:
+
+    >>> from tuning.own_tuning import tuning_for
+    >>> from workbench.vehicles import make_vehicle
+    >>> tuning = tuning_for(make_vehicle("dynamic-bicycle"))
+    >>> tuning.filter_schedule.speeds_kmh[:3]
+    (10.0, 20.0, 30.0)
+    """
     from tuning.tuning_dirs import read_vehicle_tuning
 
     return read_vehicle_tuning(tuning_dir_for(vehicle, options))
@@ -149,7 +244,27 @@ def tuning_for(vehicle: VehicleModel, options: PresetTuningOptions | None = None
 
 def tuning_dir_for(vehicle: VehicleModel, options: PresetTuningOptions | None = None) -> Path:
     """The directory of the tuning `tuning_for` reads for `vehicle` (the shipped preset's, else the cache's,
-    generated there on first use), for a caller that copies the files (`workbench export-fmu` packs them)."""
+    generated there on first use), for a caller that copies the files (`workbench export-fmu` packs them).
+
+    Parameters
+    ----------
+    vehicle : VehicleModel
+        The vehicle to be steered.
+    options : PresetTuningOptions or None
+        The tuning options (None: the shipped files' options).
+
+    Returns
+    -------
+    pathlib.Path
+        The shipped preset's directory, else the cache's (``$WORKBENCH_TUNING_CACHE``, else
+        ``$XDG_CACHE_HOME/lateral-workbench/tuning``) named by `cache_key`.
+
+    Raises
+    ------
+    WorkbenchInputError
+        Generating the tuning fails (the message gives the `tuning` commands to run by hand), or the cache
+        directory is not private to the user.
+    """
     from tuning.preset_tuning import PRESET_TUNING_OPTIONS
     from tuning.tuning_dirs import (
         CACHE_ENV,
@@ -220,14 +335,47 @@ class TunableConfig(Protocol):
     the config with one. A protocol, so that telling such a config from another imports no controller's module."""
 
     @property
-    def tuning(self) -> VehicleTuning | None: ...
+    def tuning(self) -> VehicleTuning | None:
+        """The vehicle's own tuning the config carries (None: not given)."""
+        ...
 
-    def with_tuning(self, tuning: VehicleTuning) -> Self: ...
+    def with_tuning(self, tuning: VehicleTuning) -> Self:
+        """The config with this tuning.
+
+        Parameters
+        ----------
+        tuning : VehicleTuning
+            The vehicle's own tuning.
+
+        Returns
+        -------
+        Self
+            A copy of the config with ``tuning`` set.
+        """
+        ...
 
 
 def with_vehicle_tuning(config: ConfigT, vehicle: VehicleModel) -> ConfigT:
     """`config` with the vehicle's own tuning (`tuning_for`) when it takes one (`TunableConfig`) and has none; any
-    other config as it is."""
+    other config as it is.
+
+    Parameters
+    ----------
+    config : ConfigT
+        A controller's config (any type).
+    vehicle : VehicleModel
+        The vehicle whose tuning a `TunableConfig` without one is given.
+
+    Returns
+    -------
+    ConfigT
+        The config with the vehicle's tuning, or the config as it came.
+
+    Raises
+    ------
+    WorkbenchInputError
+        The vehicle's tuning cannot be found or made (`tuning_for`).
+    """
     if isinstance(config, TunableConfig) and config.tuning is None:
         return config.with_tuning(tuning_for(vehicle))
     return config
@@ -238,7 +386,37 @@ def tuned_controller(
 ) -> Controller:
     """The controller registered under `name` for `vehicle`, its config (the default when None) given the
     vehicle's own tuning where it takes one (the clothoid controller), then told `delays` when given
-    (`Controller.informed_config`; None: untold): how the applications build controllers."""
+    (`Controller.informed_config`; None: untold): how the applications build controllers.
+
+    Parameters
+    ----------
+    name : str
+        A registered controller's name (``workbench controllers`` lists them: "clothoid", "stanley", ...).
+    vehicle : VehicleModel
+        The vehicle to steer: its geometry, its tuning (clothoid) and its model (the MPCs).
+    config : DataclassInstance or None
+        The controller's config, of its `config_type` (None: the defaults).
+    delays : KnownDelays or None
+        The run's nominal delays, which a controller that compensates them is told (None: untold).
+
+    Returns
+    -------
+    Controller
+        The controller, ready for `Controller.reset`.
+
+    Raises
+    ------
+    WorkbenchInputError
+        An unknown controller name, a config the controller refuses, or a tuning that cannot be found or made.
+
+    Examples
+    --------
+    >>> from tuning.own_tuning import tuned_controller
+    >>> from workbench.vehicles import make_vehicle
+    >>> controller = tuned_controller("clothoid", make_vehicle("dynamic-bicycle"))
+    >>> controller.name, controller.config.tuning is not None
+    ('clothoid', True)
+    """
     from controllers import CONTROLLERS, make_controller
 
     if config is None and name in CONTROLLERS:
