@@ -236,7 +236,20 @@ class Road:
         return self.friction_profile is None or len({scale for _, scale in self.friction_profile}) == 1
 
     def friction_at(self, s_m: float) -> float:
-        """The friction scale at arc length `s_m` (m) of the path (the caller wraps s on a closed path)."""
+        """The friction scale at arc length `s_m` (m) of the path (the caller wraps s on a closed path).
+
+        Parameters
+        ----------
+        s_m : float
+            Arc length along the path (m); before the profile's first distance or after its last, the scale there
+            is held.
+
+        Returns
+        -------
+        float
+            The peak-friction scale (dimensionless, within ROAD_FRICTION_RANGE): `friction_scale` times the
+            profile's scale interpolated linearly at `s_m`, or `friction_scale` alone without a profile.
+        """
         profile = self.friction_profile
         if profile is None:
             return self.friction_scale
@@ -310,7 +323,14 @@ class Conditions:
         return self.sensing_is_ideal and self.actuation.is_ideal and self.road.is_ideal
 
     def describe(self) -> str:
-        """One line in words: what these conditions change."""
+        """One line in words: what these conditions change.
+
+        Returns
+        -------
+        str
+            The settings of each part that changes the run, separated by semicolons, with units; for ideal
+            conditions, that nothing lies between plant and controller.
+        """
         loc, ine, ste, act, road = self.localisation, self.inertial, self.steering_sensor, self.actuation, self.road
         parts = []
         if not loc.is_ideal:
@@ -463,7 +483,31 @@ CONDITIONS: dict[str, Conditions] = {
 # -------------------------------------------------------------------------------------------------------- files
 def load_conditions(name_or_path: str | os.PathLike[str]) -> Conditions:
     """The conditions named `name_or_path` (a key of CONDITIONS) or read from that TOML file (see the module
-    docstring); WorkbenchInputError for an unknown name, an unreadable file or anything in it the format refuses."""
+    docstring); WorkbenchInputError for an unknown name, an unreadable file or anything in it the format refuses.
+
+    Parameters
+    ----------
+    name_or_path : str or os.PathLike
+        A preset ("ideal", "rtk", "automotive", "degraded") or the path of a TOML conditions file.
+
+    Returns
+    -------
+    Conditions
+        The preset, or the file's conditions named by its top-level ``name`` (else the file's stem).
+
+    Raises
+    ------
+    WorkbenchInputError
+        An unknown preset (the message lists them), an unreadable or malformed file, an unknown key, a wrongly
+        typed value, or a value out of its range (the message names the field, the value and the range).
+
+    Examples
+    --------
+    >>> from workbench.simulation.conditions import conditions_to_toml, load_conditions
+    >>> load_conditions("ideal").is_ideal
+    True
+    >>> text = conditions_to_toml(load_conditions("automotive"))  # a file to copy and edit
+    """
     key = os.fspath(name_or_path)
     if key in CONDITIONS:
         return CONDITIONS[key]
@@ -480,7 +524,30 @@ def conditions_from_table(
     document: Mapping[str, Any], label: str, default_name: str = "custom", default_source: str = ""
 ) -> Conditions:
     """Conditions from a parsed conditions file (`label` starts every message); without a top-level name or
-    source, `default_name` and `default_source`."""
+    source, `default_name` and `default_source`.
+
+    Parameters
+    ----------
+    document : Mapping
+        The parsed TOML document: the optional top-level ``name`` and ``source`` and any of the tables
+        ``localisation``, ``inertial``, ``steering_sensor``, ``actuation`` and ``road``.
+    label : str
+        What every error message starts with, naming where the document came from (e.g. the file).
+    default_name : str
+        The conditions' name when the document has none.
+    default_source : str
+        Where the values come from, in words, when the document does not say.
+
+    Returns
+    -------
+    Conditions
+        The conditions; a missing table or field keeps its default, which changes nothing.
+
+    Raises
+    ------
+    WorkbenchInputError
+        An unknown key, a wrongly typed value, or a value out of its range, after `label`.
+    """
     doc = check_keys(f"{label}: top level", document, _TOP_KEYS)
     try:
         name = typed_value("'name'", doc.get("name", default_name), str)
@@ -509,7 +576,19 @@ def _table(cls: type, table: object, key: str) -> Any:
 
 
 def conditions_to_toml(conditions: Conditions) -> str:
-    """The TOML text of `conditions`, which `load_conditions` reads back to equal conditions (to copy and edit)."""
+    """The TOML text of `conditions`, which `load_conditions` reads back to equal conditions (to copy and edit).
+
+    Parameters
+    ----------
+    conditions : Conditions
+        The conditions to write.
+
+    Returns
+    -------
+    str
+        The file's text: ``name``, ``source`` and every table with every field (angles in rad, times in s; an
+        unset optional value as "none").
+    """
     lines = [
         "# Sensing and actuation conditions (workbench/simulation/conditions.py). Angles in rad, times in s; an",
         '# optional value is "none"; a missing key or table keeps its default, which changes nothing.',

@@ -98,12 +98,39 @@ class Metrics:
     left_track: bool | None = None
 
     def to_dict(self) -> dict[str, object]:
+        """The metrics as metrics.json holds them.
+
+        Returns
+        -------
+        dict
+            One entry per field, keyed by `METRIC_KEYS` in that order; None where a quantity does not apply.
+        """
         return asdict(self)
 
 
 def approach_end(cte_m: np.ndarray, tolerance_m: float = CONVERGED_CTE_M) -> int:
     """Index of the first sample with |CTE| within tolerance_m: where a run that started off the path has come
-    onto it (0 for one that started on it; also 0 when it never comes within, so that the whole run counts)."""
+    onto it (0 for one that started on it; also 0 when it never comes within, so that the whole run counts).
+
+    Parameters
+    ----------
+    cte_m : numpy.ndarray
+        The signed cross-track error (m) at each logged step, in order.
+    tolerance_m : float
+        The |CTE| (m, >= 0) within which the run counts as on the path (default `CONVERGED_CTE_M`, 0.1 m).
+
+    Returns
+    -------
+    int
+        The index into `cte_m`: the first sample with |CTE| <= `tolerance_m`, or 0 when there is none.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from workbench.simulation.metrics import approach_end
+    >>> approach_end(np.array([1.0, 0.5, 0.08, -0.2, 0.01]))
+    2
+    """
     within = np.flatnonzero(np.abs(cte_m) <= tolerance_m)
     return int(within[0]) if within.size else 0
 
@@ -118,7 +145,21 @@ def offtracking(path: ReferencePath, x_m: np.ndarray, y_m: np.ndarray) -> np.nda
     """Signed lateral distance (m) of a trailer point from the path, projected with progress tracking.
 
     Sideways only (`Projection.cte_m`): a trailer starts behind an open path's start, where the distance to the
-    start point would count its length as offtracking."""
+    start point would count its length as offtracking.
+
+    Parameters
+    ----------
+    path : ReferencePath
+        The path the vehicle followed.
+    x_m, y_m : numpy.ndarray
+        The trailer point's positions (m) at each logged step, in order (progress along the path is tracked from
+        one to the next).
+
+    Returns
+    -------
+    numpy.ndarray
+        The signed lateral distance (m, left of the path positive) at each step, of the length of `x_m`.
+    """
     return trailer_feet(path, np.asarray(x_m, dtype=float), np.asarray(y_m, dtype=float))[1]
 
 
@@ -134,7 +175,45 @@ def compute_metrics(
     outline: VehicleOutline | None = None,
 ) -> Metrics:
     """Metrics of a trace (columns as the simulator logs them); outline: the vehicle's, for the track margin (None:
-    the track fields are None)."""
+    the track fields are None).
+
+    A `SimulationResult` computes its own (`SimulationResult.metrics`); this function is for a trace read back or
+    cut to a stretch.
+
+    Parameters
+    ----------
+    trace : dict of str to numpy.ndarray
+        The logged signals, one array per column, one row per controller step: at least ``t_s``, ``cte_m``,
+        ``steer_wheel_rad``, ``step_time_s``, ``speed_mps``, ``heading_error_rad`` and ``lat_accel_mps2``; ``ltr``
+        and ``trailer_x_m``, ``trailer_y_m`` when the vehicle outputs them.
+    path : ReferencePath
+        The path the run followed (its track widths give the track margin).
+    scenario, controller, vehicle : str
+        The names written into the metrics.
+    completed : bool
+        Whether the run completed (`Status.COMPLETED`).
+    path_length_m : float
+        The length the run was asked to cover (m): the path's, times the laps of a closed path.
+    outline : VehicleOutline or None
+        The vehicle's plan-view outline, for the track margin (None: the track fields are None).
+
+    Returns
+    -------
+    Metrics
+        The run's summary; None where a quantity does not apply (an empty trace, no trailer, no roll model).
+
+    Examples
+    --------
+    The metrics of the second half of a run (`result`, the `SimulationResult` of fig17 steered by Stanley):
+
+    >>> from workbench.simulation.metrics import compute_metrics
+    >>> half = {name: values[len(values) // 2 :] for name, values in result.trace.items()}  # doctest: +SKIP
+    >>> late = compute_metrics(half, result.path, scenario="fig17", controller="stanley",
+    ...                        vehicle="kinematic-bicycle", completed=True,
+    ...                        path_length_m=result.path.length_m)  # doctest: +SKIP
+    >>> late.rms_cte_m <= result.metrics.rms_cte_m  # doctest: +SKIP
+    True
+    """
     t = trace["t_s"]
     n = t.size
     cte = trace["cte_m"]

@@ -57,10 +57,12 @@ class SimulationResult:
 
     @property
     def completed(self) -> bool:
+        """Whether the run reached the end of its path, or completed its laps (`Status.COMPLETED`)."""
         return self.status is Status.COMPLETED
 
     @property
     def metrics(self) -> Metrics:
+        """The run's metrics (`compute_metrics`, the numbers of metrics.json), computed on first use."""
         if not self._metrics:  # computed once, on first use
             laps = self.config.laps if self.path.closed else 1
             self._metrics.append(
@@ -78,28 +80,83 @@ class SimulationResult:
         return self._metrics[0]
 
     def to_pandas(self) -> pd.DataFrame:
-        """The trace as a DataFrame, one row per controller step."""
+        """The trace as a DataFrame, one row per controller step.
+
+        Returns
+        -------
+        pandas.DataFrame
+            One column per logged signal (SI units, the unit in each name, e.g. ``cte_m``, ``t_s``).
+        """
         import pandas as pd
 
         return pd.DataFrame(self.trace)
 
     # Plots: each draws on the given axes (or a new figure) and returns the axes.
     def plot_trajectory(self, ax: Axes | None = None) -> Axes:
+        """The path (with its track edges and cones, when it has them) and the vehicle's trajectory: the
+        rear-axle centre's, and the trailer's for an articulated vehicle; x and y in m.
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes or None
+            The axes to draw on (None: a new figure's).
+
+        Returns
+        -------
+        matplotlib.axes.Axes
+            The axes drawn on.
+        """
         from workbench.simulation import plots
 
         return plots.trajectory(self, ax)
 
     def plot_cte(self, ax: Axes | None = None) -> Axes:
+        """The cross-track error at the rear-axle centre (m) against the distance along the path (m).
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes or None
+            The axes to draw on (None: a new figure's).
+
+        Returns
+        -------
+        matplotlib.axes.Axes
+            The axes drawn on.
+        """
         from workbench.simulation import plots
 
         return plots.cte_vs_distance(self, ax)
 
     def plot_steering(self, ax: Axes | None = None) -> Axes:
+        """The steering-wheel angle commanded and measured (deg) against time (s).
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes or None
+            The axes to draw on (None: a new figure's).
+
+        Returns
+        -------
+        matplotlib.axes.Axes
+            The axes drawn on.
+        """
         from workbench.simulation import plots
 
         return plots.steering_vs_time(self, ax)
 
     def plot_speed(self, ax: Axes | None = None) -> Axes:
+        """The planned and the actual speed (km/h) against the distance along the path (m).
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes or None
+            The axes to draw on (None: a new figure's).
+
+        Returns
+        -------
+        matplotlib.axes.Axes
+            The axes drawn on.
+        """
         from workbench.simulation import plots
 
         return plots.speed_vs_distance(self, ax)
@@ -110,7 +167,27 @@ class SimulationResult:
         ideal, their name, the seed and inform_delays) and the PNG plots; return the paths. The files a run writes
         that are already in out_dir (an earlier run's, the plots included when with_plots is False) are removed
         first, so the folder never holds files of two runs. plot_worker: a `plot_worker.PlotWorker` that draws the
-        plots meanwhile (here, if it cannot)."""
+        plots meanwhile (here, if it cannot).
+
+        Parameters
+        ----------
+        out_dir : str or pathlib.Path
+            The folder to write into; created when missing.
+        with_plots : bool
+            Also draw the PNG plots (trajectory, CTE, steering, speed).
+        plot_worker : PlotWorker or None
+            A worker that draws the plots while the trace and metrics are written (None: drawn here).
+
+        Returns
+        -------
+        list of pathlib.Path
+            The files written: trace.parquet, metrics.json, then the PNG plots.
+
+        Examples
+        --------
+        >>> result.save("runs/fig17-stanley")  # doctest: +SKIP
+        >>> result.to_pandas()[["t_s", "cte_m"]].describe()  # doctest: +SKIP
+        """
         from workbench.simulation import plots  # matplotlib itself only when the plots are drawn
 
         out = Path(out_dir)
