@@ -18,7 +18,7 @@ run's objects are built), so that a value every run would refuse stops the study
 
 from __future__ import annotations
 
-from workbench.apps.studies.backends import BACKENDS, DaskBackend, LocalBackend, make_backend
+from workbench.apps.studies.backends import BACKENDS, BackendError, DaskBackend, LocalBackend, make_backend
 from workbench.apps.studies.optimise import OptimisationResult, run_optimisation
 from workbench.apps.studies.results import SweepResult
 from workbench.apps.studies.runner import TIMING_COLUMNS, execute_run
@@ -30,6 +30,7 @@ from workbench.apps.studies.tournament_spec import TournamentSpec, load_tourname
 __all__ = [
     "BACKENDS",
     "TIMING_COLUMNS",
+    "BackendError",
     "DaskBackend",
     "LocalBackend",
     "OptimisationResult",

@@ -73,7 +73,29 @@ class TournamentIsolationError(RuntimeError):
 def run_failure(row: Mapping[str, Any], off_path_m: float = DEFAULT_OFF_PATH_M) -> str:
     """Why a run counts as failed in a tournament, "" when it did not: it did not complete (its status and
     message), it left the track, it went more than off_path_m (m) off the path once on it (`max_abs_cte_on_path_m`),
-    or its steering limit-cycled."""
+    or its steering limit-cycled.
+
+    Parameters
+    ----------
+    row : mapping
+        A run's row (`runner.execute_run`): status and message, and the metrics left_track,
+        max_abs_cte_on_path_m (m) and limit_cycle where present.
+    off_path_m : float
+        The largest |CTE| (m) once on the path that does not count as leaving it (the spec's off_path_m).
+
+    Returns
+    -------
+    str
+        The first reason in that order, "" for a run that did not fail.
+
+    Examples
+    --------
+    >>> from workbench.apps.studies.tournament import run_failure
+    >>> run_failure({"status": "completed", "max_abs_cte_on_path_m": 1.4})
+    'left the path (max |CTE| once on it 1.4 m > 1 m)'
+    >>> run_failure({"status": "completed", "max_abs_cte_on_path_m": 0.2})
+    ''
+    """
     if row["status"] != "completed":
         return f"did not complete ({row['status']}: {row['message']})"
     if row.get("left_track"):
@@ -90,7 +112,30 @@ def run_failure(row: Mapping[str, Any], off_path_m: float = DEFAULT_OFF_PATH_M) 
 def trial_objectives(
     rows: Sequence[Mapping[str, Any]], objectives: Sequence[str], off_path_m: float = DEFAULT_OFF_PATH_M
 ) -> tuple[list[float] | None, str]:
-    """(each objective's mean over a trial's runs, "") or (None, why the trial failed: `run_failure`)."""
+    """(each objective's mean over a trial's runs, "") or (None, why the trial failed: `run_failure`).
+
+    Parameters
+    ----------
+    rows : sequence of mapping
+        The trial's runs' rows (`runner.execute_run`), one per training case.
+    objectives : sequence of str
+        The metric columns averaged, in order (the spec's objectives).
+    off_path_m : float
+        The largest |CTE| (m) once on the path that does not count as leaving it (`run_failure`).
+
+    Returns
+    -------
+    tuple of (list of float or None, str)
+        The objectives' means in the order of `objectives` and ""; or None and why the trial failed: a run
+        failed (how many, and the first one's case and reason) or a metric is missing or not finite.
+
+    Examples
+    --------
+    >>> from workbench.apps.studies.tournament import trial_objectives
+    >>> rows = [{"status": "completed", "rms_cte_m": 0.1}, {"status": "completed", "rms_cte_m": 0.3}]
+    >>> trial_objectives(rows, ["rms_cte_m"])
+    ([0.2], '')
+    """
     failures = [(row, why) for row in rows if (why := run_failure(row, off_path_m))]
     if failures:
         row, why = failures[0]
@@ -108,7 +153,24 @@ def trial_objectives(
 
 
 def pareto_front(points: Mapping[int, Sequence[float]]) -> list[int]:
-    """The trials (keys) no other trial dominates (no worse in every objective, better in one), in order."""
+    """The trials (keys) no other trial dominates (no worse in every objective, better in one), in order.
+
+    Parameters
+    ----------
+    points : mapping of int to sequence of float
+        Trial number -> its objectives, every one minimised, in one order for all trials.
+
+    Returns
+    -------
+    list of int
+        The trials on the Pareto front, by increasing number.
+
+    Examples
+    --------
+    >>> from workbench.apps.studies.tournament import pareto_front
+    >>> pareto_front({0: (1.0, 3.0), 1: (2.0, 2.0), 2: (3.0, 3.0), 3: (0.5, 4.0)})
+    [0, 1, 3]
+    """
     front = []
     for trial, values in points.items():
         dominated = any(
@@ -129,7 +191,29 @@ def weighted(values: Sequence[float], objectives: Sequence[str], weights: Mappin
 
 def spread_points(front: Sequence[int], points: Mapping[int, Sequence[float]], count: int) -> list[int]:
     """Up to `count` trials of the front spread along it: ordered by the last objective (then the trial), the first,
-    the last and evenly between."""
+    the last and evenly between.
+
+    Parameters
+    ----------
+    front : sequence of int
+        The front's trials (`pareto_front`).
+    points : mapping of int to sequence of float
+        Trial number -> its objectives.
+    count : int
+        The most trials to pick (0 or less: none).
+
+    Returns
+    -------
+    list of int
+        The picked trials, by increasing last objective; all of the front when it has at most `count`.
+
+    Examples
+    --------
+    >>> from workbench.apps.studies.tournament import spread_points
+    >>> points = {0: (1.0, 3.0), 1: (2.0, 2.0), 3: (0.5, 4.0)}
+    >>> spread_points([0, 1, 3], points, 2)
+    [1, 3]
+    """
     ordered = sorted(front, key=lambda t: (points[t][-1], t))
     if count <= 0 or not ordered:
         return []
@@ -158,7 +242,30 @@ class TournamentResult:
 def run_command(run: PlannedRun, config_file: Path) -> str:
     """The `workbench run` command line that reproduces a judged run bit for bit: its scenario (name, circuit or
     file), controller, vehicle (preset or file), speed, conditions, seed, informed delays, track file, circuit
-    ranges file and the controller-config file of its configuration; it writes to replay/<run id>."""
+    ranges file and the controller-config file of its configuration; it writes to replay/<run id>.
+
+    Parameters
+    ----------
+    run : PlannedRun
+        A test run of the tournament (`TournamentSpec.plan`).
+    config_file : pathlib.Path
+        The controller-config file of the run's configuration (`write_config_files`), written into the command
+        as given.
+
+    Returns
+    -------
+    str
+        The command line, quoted for a POSIX shell.
+
+    Examples
+    --------
+    >>> from pathlib import Path
+    >>> from workbench.apps.studies import load_tournament
+    >>> from workbench.apps.studies.tournament import run_command
+    >>> run = load_tournament("examples/tournament_quick.toml").plan("clothoid", "test")[0]
+    >>> run_command(run, Path("best/clothoid.toml"))  # doctest: +ELLIPSIS
+    'workbench run figure8 --controller clothoid --vehicle dynamic-bicycle --speed 40.0 --conditions automotive ...'
+    """
     values = dict(run.values)
     words = ["workbench", "run", run.scenario, "--controller", run.controller]
     words += ["--vehicle", run.vehicle] if run.vehicle in VEHICLES else ["--vehicle-file", run.vehicle]
@@ -190,7 +297,33 @@ def write_config_files(
 ) -> dict[str, Path]:
     """Write a configuration of `controller` (its fixed options and `options`) as controller-config files in
     `folder`: `<name>.toml`, and `<name>@<vehicle>.toml` for a vehicle whose config differs from the first
-    vehicle's (a lead filter scaled from its own); return vehicle -> file."""
+    vehicle's (a lead filter scaled from its own); return vehicle -> file.
+
+    Parameters
+    ----------
+    spec : TournamentSpec
+        The tournament: its vehicles, and the controller's fixed options.
+    controller : str
+        One of the tournament's controllers.
+    options : mapping
+        Searched parameter -> value of the configuration (a trial's; {} for the default).
+    folder : pathlib.Path
+        Where the files go (made if missing).
+    name : str
+        The files' stem: the controller's name, or "<controller>-<k>" for a front point.
+    header : str
+        Comment lines at the top of each file (plain text, one comment line per line).
+
+    Returns
+    -------
+    dict of str to pathlib.Path
+        Each vehicle of the tournament -> the absolute path of its file (vehicles of one config share a file).
+
+    Raises
+    ------
+    WorkbenchInputError
+        An option the controller does not have or a value it refuses.
+    """
     folder.mkdir(parents=True, exist_ok=True)
     first_runs: dict[str, PlannedRun] = {}
     for run in spec.plan(controller, TEST, options):
@@ -360,7 +493,47 @@ def run_tournament(
 ) -> TournamentResult:
     """Run (or resume) the tournament into out_dir (module docstring). backend: a LocalBackend over every CPU
     unless given; progress: a progress bar per batch on stderr; report: judge the runs and write DIR/report.html;
-    log: where each controller's stage is told (None: nowhere)."""
+    log: where each controller's stage is told (None: nowhere).
+
+    Parameters
+    ----------
+    spec : TournamentSpec
+        The tournament (`load_tournament`).
+    out_dir : str or pathlib.Path
+        The tournament's folder: runs/ (one JSON row per run; rows already there are not run again),
+        results.parquet, history.parquet, tournament.json, best/, front/, default/ and report.html.
+    backend : Backend or None
+        Where the runs execute (`make_backend`); one started by the caller is left running, one started here is
+        closed on return (None: a `LocalBackend` over every usable CPU).
+    progress : bool
+        Show a bar on stderr for each batch of runs.
+    report : bool
+        Judge the test runs (`tournament_judging.judge`) and write report.html.
+    log : callable or None
+        Called with a line for each controller's stage (None: silent); by default printed to stderr.
+
+    Returns
+    -------
+    TournamentResult
+        Every run, the trial history, each controller's chosen trial and configuration file, and with `report`
+        the verdict and report.html's path.
+
+    Raises
+    ------
+    BackendError
+        The backend's machinery failed (a worker process died); the runs already written stay, and the same call
+        resumes.
+    TournamentIsolationError
+        A training trial ran a test case (a defect: the spec refuses such a case).
+
+    Examples
+    --------
+    >>> from workbench.apps.studies import load_tournament, make_backend, run_tournament
+    >>> spec = load_tournament("examples/tournament_quick.toml")
+    >>> with make_backend("local", workers=2) as backend:  # doctest: +SKIP
+    ...     result = run_tournament(spec, "runs/tournament-quick", backend)
+    >>> result.chosen, result.report  # doctest: +SKIP
+    """
     out = Path(out_dir).resolve()
     store = RunStore(out)
     say = log or (lambda message: None)

@@ -462,7 +462,18 @@ class TournamentSpec:
 
     # ------------------------------------------------------------------------------------------- planning
     def cases(self, set_name: str) -> int:
-        """How many cases a set has (scenarios x vehicles x speeds x conditions x seeds)."""
+        """How many cases a set has (scenarios x vehicles x speeds x conditions x seeds).
+
+        Parameters
+        ----------
+        set_name : str
+            "train" or "test".
+
+        Returns
+        -------
+        int
+            The number of cases, each run once per configuration judged or trial.
+        """
         case_set = self.train if set_name == "train" else self.test
         return (
             len(case_set.scenarios)
@@ -473,38 +484,93 @@ class TournamentSpec:
         )
 
     def cases_text(self, set_name: str) -> str:
-        """A set's number of cases in words: "1 training case", "12 test cases"."""
+        """A set's number of cases in words: "1 training case", "12 test cases".
+
+        Parameters
+        ----------
+        set_name : str
+            "train" or "test".
+
+        Returns
+        -------
+        str
+            The count and the set's name, in the singular for one case.
+        """
         count = self.cases(set_name)
         return f"{count} {'training' if set_name == 'train' else 'test'} case{'s' * (count != 1)}"
 
     def total_runs(self) -> int:
         """The most runs the tournament executes: per controller, its trials on the training cases and its default,
-        tuned and carried front configurations on the test cases."""
+        tuned and carried front configurations on the test cases.
+
+        Returns
+        -------
+        int
+            controllers x (trials x training cases + (2 + front_points) x test cases); at most max_runs.
+        """
         per_controller = self.trials * self.cases("train") + (2 + self.front_points) * self.cases("test")
         return len(self.controllers) * per_controller
 
     def plan(self, controller: str, set_name: str, options: Mapping[str, Any] | None = None) -> list[PlannedRun]:
-        """The runs of `controller` on a set's cases with `options` (searched parameters) over its fixed ones."""
+        """The runs of `controller` on a set's cases with `options` (searched parameters) over its fixed ones.
+
+        Parameters
+        ----------
+        controller : str
+            One of the tournament's controllers.
+        set_name : str
+            "train" or "test".
+        options : mapping or None
+            Searched parameter -> value (a trial's or a chosen configuration's; None: the controller's defaults).
+
+        Returns
+        -------
+        list of PlannedRun
+            One run per case of the set, in the set's order.
+
+        Raises
+        ------
+        WorkbenchInputError
+            An unknown set, or an option the controller does not have or a value it refuses.
+        """
         if set_name not in SETS:
             raise WorkbenchInputError(f"set must be one of {', '.join(SETS)}; got {set_name!r}")
         return self.studies[(controller, set_name)].plan(dict(options or {}))
 
     def selection_text(self) -> str:
-        """The selection rule in words."""
+        """The selection rule in words.
+
+        Returns
+        -------
+        str
+            The rule that names each controller's chosen point of its training front, for the report.
+        """
         return (
             f"the point of the controller's training front (objectives {', '.join(self.objectives)}, each the mean "
             f"over the training cases) with the least {weights_text(self.selection)}; ties: the earlier trial"
         )
 
     def ranking_text(self) -> str:
-        """The ranking scalar of a test run in words."""
+        """The ranking scalar of a test run in words.
+
+        Returns
+        -------
+        str
+            The weighted sum and what a failed run scores, for the report.
+        """
         return (
             f"{weights_text(self.ranking)} per test run; a failed run (did not complete, left the track, more than "
             f"{self.off_path_m:g} m off the path once on it, limit cycle) scores {self.failure_score:g}"
         )
 
     def solve_budget_text(self) -> str:
-        """The MPCs' solve budget in words."""
+        """The MPCs' solve budget in words.
+
+        Returns
+        -------
+        str
+            Each MPC's `SOLVE_BUDGET_OPTION` in s, or that no controller has one.
+        """
         mpcs = [c for c in self.controllers if SOLVE_BUDGET_OPTION in self.fixed[c]]
         if not mpcs:
             return "no controller in the tournament has a solve budget"
@@ -548,7 +614,36 @@ def _in_tournament_terms(message: str, set_name: str, controller: str) -> str:
 
 def load_tournament(path: str | Path, max_runs: int | None = None) -> TournamentSpec:
     """Read a tournament spec from a TOML file; max_runs (`--max-runs`) over the spec's tournament.max_runs.
-    WorkbenchInputError naming the file, the key and what is allowed for anything it cannot use."""
+    WorkbenchInputError naming the file, the key and what is allowed for anything it cannot use.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The spec's TOML file; relative paths in it are taken from its folder.
+    max_runs : int or None
+        The most runs the tournament may plan (None: the spec's tournament.max_runs, else `DEFAULT_MAX_RUNS`).
+
+    Returns
+    -------
+    TournamentSpec
+        The tournament, each controller's training and test study built and checked.
+
+    Raises
+    ------
+    WorkbenchInputError
+        The file is missing or not TOML, a table or key is unknown, a name, value, weight or file is refused, a
+        case is in both sets, or the tournament plans more than max_runs runs; the message names the file and
+        the key.
+
+    Examples
+    --------
+    >>> from workbench.apps.studies import load_tournament
+    >>> spec = load_tournament("examples/tournament_quick.toml")
+    >>> spec.controllers
+    ('clothoid', 'nmpc', 'lmpc', 'stanley', 'pure-pursuit')
+    >>> spec.cases_text("train"), spec.cases_text("test"), spec.total_runs()
+    ('1 training case', '1 test case', 35)
+    """
     path = Path(path)
     document = read_toml(path, f"tournament spec {str(path)!r}")
     try:
