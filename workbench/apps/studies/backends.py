@@ -206,7 +206,19 @@ class _StartedInWith:
 
 
 class LocalBackend(_StartedInWith):
-    """A process pool on this machine (module docstring)."""
+    """A process pool on this machine (module docstring).
+
+    Parameters
+    ----------
+    workers : int or None
+        The worker processes, a whole number from 1 to `max_workers` (None: one per usable CPU,
+        `default_workers`).
+
+    Raises
+    ------
+    WorkbenchInputError
+        workers is not a whole number from 1 to `max_workers`.
+    """
 
     name = "local"
 
@@ -228,6 +240,7 @@ class LocalBackend(_StartedInWith):
 
     @property
     def started(self) -> bool:
+        """Whether the pool is running (between `start` and `close`)."""
         return self._pool is not None
 
     def start(self) -> None:
@@ -302,7 +315,23 @@ class LocalBackend(_StartedInWith):
 
 
 class DaskBackend(_StartedInWith):
-    """dask.distributed: a LocalCluster, or the scheduler at `scheduler` (module docstring)."""
+    """dask.distributed: a LocalCluster, or the scheduler at `scheduler` (module docstring).
+
+    Parameters
+    ----------
+    scheduler : str or None
+        A dask scheduler's address, ``tcp://HOST:PORT`` with a port from 1 to 65535 (None: a LocalCluster started
+        on this machine).
+    workers : int or None
+        The LocalCluster's single-threaded worker processes, a whole number from 1 to `max_workers` (None: one per
+        usable CPU); not with a scheduler.
+
+    Raises
+    ------
+    WorkbenchInputError
+        A malformed scheduler address, both a scheduler and workers, or workers not a whole number from 1 to
+        `max_workers`.
+    """
 
     name = "dask"
 
@@ -335,10 +364,17 @@ class DaskBackend(_StartedInWith):
 
     @property
     def started(self) -> bool:
+        """Whether the client is connected (between `start` and `close`)."""
         return self._client is not None
 
     def start(self) -> None:
-        """Connect to the scheduler, or start a LocalCluster and connect to it."""
+        """Connect to the scheduler, or start a LocalCluster and connect to it.
+
+        Raises
+        ------
+        WorkbenchInputError
+            The scheduler does not answer within `SCHEDULER_TIMEOUT_S`.
+        """
         from distributed import Client, LocalCluster
 
         if self._client is not None:
