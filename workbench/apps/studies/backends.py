@@ -102,12 +102,24 @@ class Backend(Protocol):
 
 
 def default_workers() -> int:
-    """The CPUs this process may run on (`plot_worker.usable_cpus`)."""
+    """The CPUs this process may run on (`plot_worker.usable_cpus`).
+
+    Returns
+    -------
+    int
+        At least 1.
+    """
     return usable_cpus()
 
 
 def max_workers() -> int:
-    """The most workers a backend starts here: MAX_WORKERS_PER_CPU per usable CPU."""
+    """The most workers a backend starts here: MAX_WORKERS_PER_CPU per usable CPU.
+
+    Returns
+    -------
+    int
+        MAX_WORKERS_PER_CPU times `default_workers`.
+    """
     return MAX_WORKERS_PER_CPU * default_workers()
 
 

@@ -55,7 +55,23 @@ HISTORY_FIGURE = "history.png"
 
 
 def objective_text(spec: StudySpec) -> str:
-    """The objective in words, e.g. "mean over runs of 1 x rms_cte_m + 0.002 x rms_steer_rate_deg_s"."""
+    """The objective in words, e.g. "mean over runs of 1 x rms_cte_m + 0.002 x rms_steer_rate_deg_s".
+
+    Parameters
+    ----------
+    spec : StudySpec
+        An optimisation's study, with its [optimise] table.
+
+    Returns
+    -------
+    str
+        The aggregate and the weighted sum.
+
+    Raises
+    ------
+    WorkbenchInputError
+        The spec has no [optimise] table.
+    """
     settings = spec.optimise
     if settings is None:
         raise WorkbenchInputError("the spec has no [optimise] table")
@@ -64,7 +80,23 @@ def objective_text(spec: StudySpec) -> str:
 
 
 def trial_value(rows: list[dict[str, Any]], weights: dict[str, float], aggregate: str) -> tuple[float | None, str]:
-    """(the trial's objective, "") or (None, why it failed) from its runs' rows."""
+    """(the trial's objective, "") or (None, why it failed) from its runs' rows.
+
+    Parameters
+    ----------
+    rows : list of dict
+        The trial's runs' rows (`runner.execute_run`).
+    weights : dict of str to float
+        Metric -> weight of the weighted sum taken per run.
+    aggregate : str
+        "mean" or "max": how the runs' sums combine.
+
+    Returns
+    -------
+    tuple of (float or None, str)
+        The objective and ""; or None and why the trial failed: a run did not complete, or a metric is missing
+        or not finite.
+    """
     bad = [r for r in rows if r["status"] != "completed"]
     if bad:
         first = bad[0]
@@ -112,7 +144,26 @@ def write_controller_config(
     """Write every field of a controller config as a controller-config TOML file (one [controller] table; None
     as "none"; paths inside the file's folder relative to it, others absolute); an object a file option was read
     into (`FILE_OPTIONS`) is written to a file beside it, its name starting with `stem` (`_write_object`), and
-    named by that option; return the path."""
+    named by that option; return the path.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        The TOML file to write (replaced if it exists); objects go beside it.
+    controller : str
+        The controller the config is of: the file's one table.
+    config : dataclass instance
+        The controller's config (e.g. `controllers.clothoid.ClothoidConfig`).
+    header : str
+        Comment lines at the top of the file (plain text, one comment line per line).
+    stem : str
+        The start of the names of the files objects are written to.
+
+    Returns
+    -------
+    pathlib.Path
+        The file written.
+    """
     from workbench.apps.controller_config import FILE_OPTIONS
 
     file_keys = {option.field: name for name, option in FILE_OPTIONS.items()}

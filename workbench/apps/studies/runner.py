@@ -61,7 +61,27 @@ def build_controller_config(
     """The run's controller config: the controller-config file's table, then the run's options (file options read
     into their objects), then the vehicle's tuning (when a vehicle is given), then told `delays` when given
     (`Controller.informed_config`; the run parameter inform_delays gives its conditions'). With lead-filter scales
-    other than 1, the config holds the scaled filter (of its own lead filter, else of the vehicle's tuning)."""
+    other than 1, the config holds the scaled filter (of its own lead filter, else of the vehicle's tuning).
+
+    Parameters
+    ----------
+    run : PlannedRun
+        The run: its controller, controller-config file and options.
+    vehicle : VehicleModel or None
+        The vehicle the controller is tuned for (None: no vehicle tuning).
+    delays : KnownDelays or None
+        The delays the controller is told (None: none).
+
+    Returns
+    -------
+    object
+        An instance of the controller class's `config_type` (e.g. `ClothoidConfig`).
+
+    Raises
+    ------
+    WorkbenchInputError
+        An option the controller does not have, a value it refuses, or a file it cannot read.
+    """
     geometry = vehicle.geometry if vehicle is not None else None
     config, scales = untuned_controller_config(run.controller, run.controller_config, dict(run.options), geometry)
     if vehicle is not None:
@@ -72,7 +92,25 @@ def build_controller_config(
 
 
 def simulate(run: PlannedRun, progress: bool = False) -> SimulationResult:
-    """Build and simulate the run; return the SimulationResult."""
+    """Build and simulate the run; return the SimulationResult.
+
+    Parameters
+    ----------
+    run : PlannedRun
+        The run (`StudySpec.plan`).
+    progress : bool
+        Show the run's metres on stderr.
+
+    Returns
+    -------
+    SimulationResult
+        The run's trace, metrics and status.
+
+    Raises
+    ------
+    WorkbenchInputError
+        A value the vehicle, scenario or controller refuses (`execute_run` records it as an "error" row).
+    """
     values, extra = split_values(dict(run.values))
     config = simulation_config(values)
     # The controller is built for the vehicle with controller_payload_kg when given (a payload mismatch), else for
@@ -135,7 +173,20 @@ def execute_run(run: PlannedRun) -> dict[str, Any]:
 
 
 def failed_row(run: PlannedRun, message: str) -> dict[str, Any]:
-    """The row of a run the backend could not execute (e.g. its worker died every time it ran it)."""
+    """The row of a run the backend could not execute (e.g. its worker died every time it ran it).
+
+    Parameters
+    ----------
+    run : PlannedRun
+        The run.
+    message : str
+        Why it could not be executed.
+
+    Returns
+    -------
+    dict
+        `PlannedRun.parameters`, no metrics, status "error" and the message.
+    """
     return (
         run.parameters()
         | dict.fromkeys(ROW_METRICS)

@@ -122,7 +122,18 @@ DEFAULT_MAX_RUNS = 100_000
 def controller_parameters(controller: str) -> dict[str, Any]:
     """The parameters of a controller's runs and their types: its config options (`option_types`: a file option
     such as filter_file in place of the object it is read into), and the lead-filter scales when it reads a lead
-    filter."""
+    filter.
+
+    Parameters
+    ----------
+    controller : str
+        A registered controller's name (`controllers.CONTROLLERS`).
+
+    Returns
+    -------
+    dict
+        Option name -> its type annotation, in the config's field order.
+    """
     from workbench.apps.controller_config import option_types
 
     params = option_types(CONTROLLERS[controller].config_type)

@@ -25,7 +25,31 @@ def execute_runs(
 ) -> tuple[list[dict[str, Any]], int]:
     """The rows of `runs` in their order, running on `backend` those the store does not hold yet (each written as
     it finishes); also how many ran now. The backend is started if it has runs to do and is left running (the
-    caller closes it)."""
+    caller closes it).
+
+    Parameters
+    ----------
+    runs : sequence of PlannedRun
+        The runs wanted, in the order of the rows returned.
+    store : RunStore
+        Where rows are kept, one JSON file per run.
+    backend : Backend
+        Where the runs left to do execute.
+    progress : bool
+        Show a bar on stderr counting the runs left to do.
+    desc : str
+        The bar's label.
+
+    Returns
+    -------
+    tuple of (list of dict, int)
+        One row per run in the order of `runs`, and how many ran in this call.
+
+    Raises
+    ------
+    BackendError
+        The backend's machinery failed; the rows already written stay.
+    """
     store.clean_temporaries()
     finished = store.read(r.run_id for r in runs)
     todo = list({r.run_id: r for r in runs if r.run_id not in finished}.values())

@@ -99,7 +99,27 @@ SOLVE_BUDGET_OPTION = "max_solve_time_s"
 
 def case_id(row: Mapping[str, Any]) -> str:
     """A case's id from a run's row or parameters: "scenario|vehicle|speed_kmh|conditions|seed" (speed as %g); a
-    circuit drawn within a circuit_ranges file is "circuit:SEED (FILE NAME)"."""
+    circuit drawn within a circuit_ranges file is "circuit:SEED (FILE NAME)".
+
+    Parameters
+    ----------
+    row : mapping
+        A run's row or `PlannedRun.parameters`: scenario, vehicle, speed_kmh (km/h), conditions, seed, and
+        circuit_ranges when given.
+
+    Returns
+    -------
+    str
+        The id, the same for every controller and configuration run on the case.
+
+    Examples
+    --------
+    >>> from workbench.apps.studies.tournament_spec import case_id
+    >>> row = {"scenario": "dlc", "vehicle": "dynamic-bicycle", "speed_kmh": 40.0,
+    ...        "conditions": "automotive", "seed": 0}
+    >>> case_id(row)
+    'dlc|dynamic-bicycle|40|automotive|0'
+    """
     scenario, ranges = row["scenario"], row.get("circuit_ranges")
     if isinstance(ranges, str | Path) and str(ranges):
         scenario = f"{scenario} ({Path(ranges).name})"
@@ -107,7 +127,18 @@ def case_id(row: Mapping[str, Any]) -> str:
 
 
 def weights_text(weights: Mapping[str, float]) -> str:
-    """A weighted sum in words, e.g. "1 x max_abs_cte_on_path_m + 0.002 x rms_steer_rate_deg_s"."""
+    """A weighted sum in words, e.g. "1 x max_abs_cte_on_path_m + 0.002 x rms_steer_rate_deg_s".
+
+    Parameters
+    ----------
+    weights : mapping of str to float
+        Metric -> weight, in the order the sum names them.
+
+    Returns
+    -------
+    str
+        The terms joined by " + ".
+    """
     return " + ".join(f"{w:g} x {k}" for k, w in weights.items())
 
 
@@ -127,6 +158,26 @@ class CaseSet:
 
     @classmethod
     def from_table(cls, name: str, table: object) -> CaseSet:
+        """A set from its spec table ([train] or [test]), every value checked and typed.
+
+        Parameters
+        ----------
+        name : str
+            "train" or "test": the table's name, in messages.
+        table : mapping
+            The parsed table: scenarios and speeds_kmh (required), conditions, seeds, circuit_ranges.
+
+        Returns
+        -------
+        CaseSet
+            The set.
+
+        Raises
+        ------
+        WorkbenchInputError
+            Not a table, an unknown or missing key, an empty list or a value listed twice, a value of the wrong
+            type, a speed not above 0 km/h or a negative seed.
+        """
         if not isinstance(table, Mapping):
             raise WorkbenchInputError(f"[{name}] must be a table with {', '.join(SET_KEYS)}; got {value_text(table)}")
         unknown = [k for k in table if k not in SET_KEYS]
@@ -655,7 +706,29 @@ def load_tournament(path: str | Path, max_runs: int | None = None) -> Tournament
 def tournament_from_document(
     document: Mapping[str, Any], base_dir: Path, max_runs: int | None = None, source: Path | None = None
 ) -> TournamentSpec:
-    """A TournamentSpec from a parsed TOML document (paths relative to base_dir)."""
+    """A TournamentSpec from a parsed TOML document (paths relative to base_dir).
+
+    Parameters
+    ----------
+    document : mapping
+        The parsed spec: its [tournament], [train], [test], [search.NAME], [fixed.NAME] and [circuits] tables.
+    base_dir : pathlib.Path
+        The folder relative paths are taken from.
+    max_runs : int or None
+        The most runs the tournament may plan, over the spec's tournament.max_runs (None: the spec's).
+    source : pathlib.Path or None
+        The spec file, named in the report and in messages (None: not read from a file).
+
+    Returns
+    -------
+    TournamentSpec
+        The tournament, each controller's training and test study built and checked.
+
+    Raises
+    ------
+    WorkbenchInputError
+        As `load_tournament`, without the file's name in the message.
+    """
     unknown = [k for k in document if k not in TABLES]
     if unknown:
         hint = " ([study], [grid] and [optimise] belong to sweep and optimise specs)" if "study" in unknown else ""
