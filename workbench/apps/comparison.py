@@ -98,7 +98,7 @@ class RunSpec:
         Returns
         -------
         VehicleModel
-            A new model, its state not shared with any other run.
+            A fresh model, its state not shared with any other run.
 
         Raises
         ------
@@ -289,7 +289,7 @@ class Comparison:
         Parameters
         ----------
         ax : matplotlib.axes.Axes, optional
-            The axes to draw on (None: a new figure's).
+            The axes to draw on (None: a fresh figure's).
 
         Returns
         -------
@@ -306,7 +306,7 @@ class Comparison:
         Parameters
         ----------
         ax : matplotlib.axes.Axes, optional
-            The axes to draw on (None: a new figure's).
+            The axes to draw on (None: a fresh figure's).
         zoom : bool
             Shade the stretch the trajectories' inset magnifies (`hardest_stretch`).
 
@@ -326,7 +326,7 @@ class Comparison:
         Parameters
         ----------
         ax : matplotlib.axes.Axes, optional
-            The axes to draw on (None: a new figure's).
+            The axes to draw on (None: a fresh figure's).
 
         Returns
         -------
@@ -343,7 +343,7 @@ class Comparison:
         Parameters
         ----------
         ax : matplotlib.axes.Axes, optional
-            The axes to draw on (None: a new figure's).
+            The axes to draw on (None: a fresh figure's).
 
         Returns
         -------

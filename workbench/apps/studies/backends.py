@@ -302,7 +302,7 @@ class LocalBackend(_StartedInWith):
         Raises
         ------
         RuntimeError
-            The backend was not started (use it in a ``with`` block).
+            The backend is not started (use it in a ``with`` block).
         BackendError
             A worker process died (killed, out of memory, or crashed in native code); the runs left are cancelled.
         """
@@ -446,7 +446,7 @@ class DaskBackend(_StartedInWith):
         Raises
         ------
         RuntimeError
-            The backend was not started (use it in a ``with`` block).
+            The backend is not started (use it in a ``with`` block).
         BackendError
             The cluster could not run a run (e.g. the workbench is missing on a worker); the runs left are
             cancelled.

@@ -221,7 +221,7 @@ class OptimisationResult:
         Parameters
         ----------
         ax : matplotlib.axes.Axes, optional
-            The axes to draw on (None: a new pyplot figure's).
+            The axes to draw on (None: a fresh pyplot figure's).
 
         Returns
         -------

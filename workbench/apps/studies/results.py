@@ -173,7 +173,7 @@ class SweepResult:
         Parameters
         ----------
         ax : matplotlib.axes.Axes, optional
-            The axes to draw on (None: a new figure's).
+            The axes to draw on (None: a fresh figure's).
         metric : str
             The column drawn, a numeric column of the table, e.g. "rms_cte_m" or "max_abs_cte_m" (m).
 
@@ -192,7 +192,7 @@ class SweepResult:
         Parameters
         ----------
         ax : matplotlib.axes.Axes, optional
-            The axes to draw on (None: a new figure's).
+            The axes to draw on (None: a fresh figure's).
         effort : str
             The column on the x axis (steering effort), a numeric column of the table, e.g. "rms_steer_rate_deg_s".
         error : str

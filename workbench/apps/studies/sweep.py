@@ -90,7 +90,8 @@ def run_sweep(
     Returns
     -------
     SweepResult
-        One row per planned run in the study's order, with how many ran now (the others were in out_dir).
+        One row per planned run in the study's order, and `ran`, how many of them executed in this call (the
+        others were already in out_dir).
 
     Raises
     ------
