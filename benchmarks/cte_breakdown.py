@@ -49,7 +49,6 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
-import json
 import math
 import os
 import sys
@@ -59,6 +58,7 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 
 import numpy as np
+from benchmark_report import machine, write_results
 
 from tuning.own_tuning import tuned_controller
 from workbench.simulation.conditions import CONDITIONS
@@ -393,13 +393,19 @@ def main(argv: list[str] | None = None) -> int:
             path = folder / f"cte_breakdown_{v}.png"
             figure(v, worst, traces, runs, path)
             figures.append(str(path))
-    payload = {
-        "created_unix_s": time.time(), "speed_kmh": SPEED_KMH, "runs": [asdict(r) for r, _ in results],
-        "summary": table, "loop_analysis": loops, "figures": figures,
-    }  # fmt: skip
-    args.out.write_text(json.dumps(payload, indent=2) + "\n")
-    print(f"wrote {args.out} and {', '.join(figures)}")
+    write_results(args.out, result_document([r for r, _ in results], table, loops, figures),
+                  f" and {', '.join(figures)}")  # fmt: skip
     return 0
+
+
+def result_document(runs: list[Run], table: list[dict[str, object]], loops: list[dict[str, object]],
+                    figures: list[str]) -> dict[str, object]:  # fmt: skip
+    """What the benchmark writes: the machine it ran on, when, the speed, every run, the summary table, the loop
+    analysis rows and the figures' paths."""
+    return {
+        "machine": machine(), "created_unix_s": time.time(), "speed_kmh": SPEED_KMH,
+        "runs": [asdict(r) for r in runs], "summary": table, "loop_analysis": loops, "figures": figures,
+    }  # fmt: skip
 
 
 if __name__ == "__main__":

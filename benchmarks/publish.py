@@ -3,8 +3,8 @@ into docs/benchmark-results/<name>.json (committed), reduced to what the Benchma
 date and machine it was measured on, the summary rows and any further tables.
 
 The docs build (docs/_ext/workbench_figures.py) renders those files as tables; the per-run lists stay in
-benchmarks/results/ (git-ignored). A result that did not record its machine is given this machine, with a note
-saying so (publish on the machine that measured it).
+benchmarks/results/ (git-ignored). Each benchmark records the machine it ran on (`benchmark_report.machine`); a
+result without that record is refused rather than given the machine it is published on.
 
 Usage (after running the benchmarks whose results should go to the docs):
 
@@ -22,7 +22,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
-from benchmark_report import machine, write_results
+from benchmark_report import write_results
 
 RESULTS = Path(__file__).parent / "results"
 PUBLISHED = Path(__file__).parent.parent / "docs" / "benchmark-results"
@@ -102,27 +102,22 @@ def _finite(value: object) -> object:
 
 def published_document(name: str, result: Mapping[str, object]) -> dict[str, object]:
     """What docs/benchmark-results/<name>.json holds for this benchmark's result: benchmark, command,
-    measured_unix_s and measured_utc (from the result's created_unix_s), machine (the result's, else this
-    machine's with machine_note saying so), summary (rows) and tables (title and rows)."""
+    measured_unix_s and measured_utc (from the result's created_unix_s), machine (the one the result records),
+    summary (rows) and tables (title and rows). A result without its creation time or its machine is refused."""
     spec = BENCHMARKS[name]
     created = result.get("created_unix_s")
     if not isinstance(created, int | float):
         raise SystemExit(f"publish: {name}: the result has no created_unix_s (got {created!r}); rerun the benchmark")
     recorded = result.get("machine")
-    note = ""
     if not isinstance(recorded, Mapping):
-        recorded = machine()
-        if isinstance(result.get("cpu_count"), int):
-            recorded["cpus"] = result["cpu_count"]
-        recorded["load_average"] = result.get("load_average")
-        note = "the result did not record its machine: this is the machine it was published on"
+        raise SystemExit(f"publish: {name}: the result does not record the machine it ran on (got {recorded!r}); "
+                         "rerun the benchmark")  # fmt: skip
     document: dict[str, object] = {
         "benchmark": name,
         "command": spec.command,
         "measured_unix_s": float(created),
         "measured_utc": datetime.datetime.fromtimestamp(float(created), datetime.UTC).strftime("%Y-%m-%d %H:%M UTC"),
         "machine": dict(recorded),
-        "machine_note": note,
         "summary": spec.summary.rows(result),
         "tables": [{"title": table.title, "rows": table.rows(result)} for table in spec.tables],
     }

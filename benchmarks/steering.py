@@ -44,7 +44,6 @@ JSON.
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import os
 import statistics
@@ -53,6 +52,8 @@ import time
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import asdict, dataclass
 from pathlib import Path
+
+from benchmark_report import machine, write_results
 
 from tuning.own_tuning import tuned_controller
 from workbench.apps.comparison import converge_distance_m
@@ -478,6 +479,7 @@ def main(argv: list[str] | None = None) -> int:
     print(f"\n{len(missed)} of {goals_total} goals missed" + ("" if not missed else ":\n  " + "\n  ".join(missed)))
     print(f"{len(jobs)} runs in {pool_wall:.0f} s on {args.workers} workers")
     document = {
+        "machine": machine(),
         "created_unix_s": time.time(),
         "speed_kmh": SPEED_KMH,
         "development_seeds": list(DEVELOPMENT_SEEDS),
@@ -501,12 +503,8 @@ def main(argv: list[str] | None = None) -> int:
         "runs": len(jobs),
         "wall_s": pool_wall,
         "workers": args.workers,
-        "cpu_count": os.cpu_count(),
-        "load_average": os.getloadavg()[0] if hasattr(os, "getloadavg") else math.nan,
     }
-    args.out.parent.mkdir(parents=True, exist_ok=True)
-    args.out.write_text(json.dumps(document, indent=2) + "\n")
-    print(f"wrote {args.out}")
+    write_results(args.out, document)
     return 1 if (args.check and missed) else 0
 
 

@@ -4,6 +4,7 @@ circuits are refused, and the summary's arithmetic (gap to the NMPC closed, rati
 from __future__ import annotations
 
 import dataclasses
+import time
 
 import pytest
 
@@ -113,3 +114,14 @@ def test_the_summary_arithmetic(breakdown) -> None:
         "floor_off",
         "nmpc_identified_lag",
     }  # switches not run are not summarised
+
+
+def test_the_result_records_the_machine_and_the_date(breakdown) -> None:
+    from benchmark_report import machine
+
+    before = time.time()
+    document = breakdown.result_document([], [{"vehicle": "v"}], [], ["f.png"])
+    assert document["machine"]["platform"] == machine()["platform"]
+    assert document["machine"]["cpus"] == machine()["cpus"]
+    assert before <= document["created_unix_s"] <= time.time()
+    assert (document["summary"], document["figures"], document["runs"]) == ([{"vehicle": "v"}], ["f.png"], [])

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import math
+import time
 
 import pytest
 
@@ -158,3 +159,18 @@ def test_a_circuit_the_feasibility_check_refuses_is_reported_excluded(steering, 
     (row,) = document["summary"]
     assert (row["runs"], row["excluded"], row["goals_missed"]) == (3, 1, 0)
     assert f"dynamic-bicycle ideal circuit:1003: {reason}" in capsys.readouterr().out
+
+
+def test_the_result_records_the_machine_and_the_date(steering, monkeypatch, tmp_path) -> None:
+    from benchmark_report import machine
+
+    monkeypatch.setattr(steering, "run_all", _fake_runs(steering, 1.0))
+    out = tmp_path / "s.json"
+    before = time.time()
+    argv = ["--quick", "--vehicles", "dynamic-bicycle", "--conditions", "ideal", "--scenarios", "development"]
+    assert steering.main([*argv, "--out", str(out)]) == 0
+    document = json.loads(out.read_text())
+    here = machine()
+    assert document["machine"]["platform"] == here["platform"] and document["machine"]["cpus"] == here["cpus"]
+    assert document["machine"]["python"] == here["python"]
+    assert before <= document["created_unix_s"] <= time.time()
