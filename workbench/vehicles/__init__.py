@@ -40,6 +40,40 @@ def make_vehicle(
 
     With a file, `name` may be omitted; if given it must match the file's model type. `payload_kg` (kg) is only
     accepted by vehicles with a payload (the tractor-semitrailer); others raise WorkbenchInputError.
+
+    Parameters
+    ----------
+    name : str or None
+        A registered vehicle (`VEHICLES`: "kinematic-bicycle", "dynamic-bicycle", "tractor-semitrailer",
+        "commonroad-mb" and any an installed package registers); None with `vehicle_file`.
+    payload_kg : float or None
+        The payload (kg, 0 to 40000 for the tractor-semitrailer) in place of the preset's or the file's; None
+        keeps it.
+    vehicle_file : str or os.PathLike or None
+        A TOML vehicle file (`workbench vehicles --show NAME` prints one to copy and edit); None for the preset.
+
+    Returns
+    -------
+    VehicleModel
+        The vehicle, ready to simulate; ``vehicle.geometry`` is what controllers are built for.
+
+    Raises
+    ------
+    WorkbenchInputError
+        An unknown name (the message lists the registered ones), a model type that needs its own file (``fmu``), a
+        name that does not match the file's model type, a malformed file or a parameter out of its range, or a
+        payload for a vehicle without one.
+
+    Examples
+    --------
+    >>> from workbench.vehicles import make_vehicle
+    >>> car = make_vehicle("kinematic-bicycle")
+    >>> car.geometry.wheelbase_m
+    2.579
+    >>> truck = make_vehicle("tractor-semitrailer", payload_kg=10000.0)
+    >>> truck.params.payload_kg
+    10000.0
+    >>> mine = make_vehicle(vehicle_file="my_car.toml")  # doctest: +SKIP
     """
     if vehicle_file is not None:
         vehicle = load_vehicle(str(vehicle_file), payload_kg)

@@ -102,7 +102,22 @@ class VehicleModel(ABC, Generic[ParamsT]):
         return self._geometry
 
     def initial_state(self, x_m: float, y_m: float, yaw_rad: float, speed_mps: float) -> np.ndarray:
-        """State at rest in steering (straight wheels), reference point at (x, y), heading yaw, moving at speed."""
+        """State at rest in steering (straight wheels), reference point at (x, y), heading yaw, moving at speed.
+
+        Parameters
+        ----------
+        x_m, y_m : float
+            Position of the reference point, the (tractor's) rear-axle centre (m).
+        yaw_rad : float
+            Heading (rad, counter-clockwise from x); trailing units start in line with it.
+        speed_mps : float
+            Longitudinal speed (m/s).
+
+        Returns
+        -------
+        numpy.ndarray
+            The state, one value per name of `state_names`.
+        """
         state = np.zeros(len(self.state_names))
         state[0], state[1], state[2], state[3] = x_m, y_m, yaw_rad, speed_mps
         for name in self.heading_states:
@@ -140,6 +155,17 @@ class VehicleModel(ABC, Generic[ParamsT]):
         built. `params`, `single_track()` (what a controller is told) and the model's state are unchanged: the
         road is not the vehicle. `scale` must be a finite number in ROAD_FRICTION_RANGE; a model without tyres
         accepts only 1.0.
+
+        Parameters
+        ----------
+        scale : float
+            The peak-friction scale lambda_mu (dimensionless, 0.05 to 1.5; 1.0 the road of the tyre data).
+
+        Raises
+        ------
+        WorkbenchInputError
+            A scale that is not a finite number in ROAD_FRICTION_RANGE, or other than 1.0 for a model without
+            tyres (the message lists the models with tyres).
         """
         require_in_range("road_friction", scale, *ROAD_FRICTION_RANGE)
         scale = float(scale)
@@ -163,24 +189,80 @@ class VehicleModel(ABC, Generic[ParamsT]):
     def advance(
         self, state: np.ndarray, steer_wheel_cmd_rad: float, accel_cmd_mps2: float, dt_s: float, substeps: int
     ) -> np.ndarray:
-        """Integrate `substeps` fixed steps of dt_s / substeps with the inputs held; return the new state."""
+        """Integrate `substeps` fixed steps of dt_s / substeps with the inputs held; return the new state.
+
+        The commands are clipped to the vehicle's limits (road-wheel angle, acceleration and braking) before they
+        drive the model.
+
+        Parameters
+        ----------
+        state : numpy.ndarray
+            The state at the start of the step, one value per name of `state_names`.
+        steer_wheel_cmd_rad : float
+            Steering-wheel angle command (rad, left positive); the road wheels get it divided by the steering ratio.
+        accel_cmd_mps2 : float
+            Longitudinal acceleration command (m/s^2, braking negative).
+        dt_s : float
+            The step (s, > 0): one controller period.
+        substeps : int
+            Fixed integration steps within `dt_s` (>= 1): the plant rate divided by the controller rate.
+
+        Returns
+        -------
+        numpy.ndarray
+            The state at the end of the step.
+        """
 
     @abstractmethod
     def outputs(self, state: np.ndarray, steer_wheel_cmd_rad: float, accel_cmd_mps2: float) -> np.ndarray:
-        """STANDARD_OUTPUTS followed by extra_output_names, as one float array."""
+        """STANDARD_OUTPUTS followed by extra_output_names, as one float array.
+
+        Parameters
+        ----------
+        state : numpy.ndarray
+            The state, one value per name of `state_names`.
+        steer_wheel_cmd_rad : float
+            Steering-wheel angle command in force (rad), for the outputs that depend on the inputs.
+        accel_cmd_mps2 : float
+            Longitudinal acceleration command in force (m/s^2).
+
+        Returns
+        -------
+        numpy.ndarray
+            One value per name of `output_names`, SI units.
+        """
 
     @property
     def output_names(self) -> tuple[str, ...]:
+        """The names of `outputs`, in order: STANDARD_OUTPUTS, then `extra_output_names`."""
         return STANDARD_OUTPUTS + self.extra_output_names
 
     def single_track(self, source: str | None = None) -> PredictionParams:
         """The vehicle's single-track equivalent, what a model-based controller predicts with (`single_track.py`);
-        this default, for a model that knows no better, is the kinematic single track of its geometry."""
+        this default, for a model that knows no better, is the kinematic single track of its geometry.
 
+        Parameters
+        ----------
+        source : str or None
+            Where the numbers come from, for messages and reports; this default names its own (the geometry only),
+            a model that overrides it names its parameters when None.
+
+        Returns
+        -------
+        PredictionParams
+            The geometry and steering limits with an assumed actuator time constant and no tyres
+            (`params_from_geometry`).
+        """
         return params_from_geometry(self.geometry)
 
     def describe(self) -> str:
-        """One line with the key parameters, for `workbench vehicles`."""
+        """One line with the key parameters, for `workbench vehicles`.
+
+        Returns
+        -------
+        str
+            The wheelbase (m), steering ratio, maximum road-wheel angle (deg) and width (m).
+        """
         g = self.geometry
         return (
             f"wheelbase {g.wheelbase_m:.3f} m, steering ratio {g.steering_ratio:g}, "
@@ -204,10 +286,50 @@ class CompiledVehicleModel(VehicleModel[ParamsT]):
     def advance(
         self, state: np.ndarray, steer_wheel_cmd_rad: float, accel_cmd_mps2: float, dt_s: float, substeps: int
     ) -> np.ndarray:
+        """Integrate `substeps` fixed RK4 steps of dt_s / substeps with the inputs held, in the compiled kernel;
+        return the new state.
+
+        The commands are clipped to the vehicle's limits (road-wheel angle, acceleration and braking) before they
+        drive the model.
+
+        Parameters
+        ----------
+        state : numpy.ndarray
+            The state at the start of the step, one value per name of `state_names`.
+        steer_wheel_cmd_rad : float
+            Steering-wheel angle command (rad, left positive); the road wheels get it divided by the steering ratio.
+        accel_cmd_mps2 : float
+            Longitudinal acceleration command (m/s^2, braking negative).
+        dt_s : float
+            The step (s, > 0): one controller period.
+        substeps : int
+            Fixed integration steps within `dt_s` (>= 1): the plant rate divided by the controller rate.
+
+        Returns
+        -------
+        numpy.ndarray
+            The state at the end of the step.
+        """
         delta_cmd, accel = self._inputs(steer_wheel_cmd_rad, accel_cmd_mps2)
         return self._advance_kernel(state, self._p, delta_cmd, accel, dt_s / substeps, substeps)
 
     def outputs(self, state: np.ndarray, steer_wheel_cmd_rad: float, accel_cmd_mps2: float) -> np.ndarray:
+        """STANDARD_OUTPUTS followed by extra_output_names, as one float array, from the compiled kernel.
+
+        Parameters
+        ----------
+        state : numpy.ndarray
+            The state, one value per name of `state_names`.
+        steer_wheel_cmd_rad : float
+            Steering-wheel angle command in force (rad), for the outputs that depend on the inputs.
+        accel_cmd_mps2 : float
+            Longitudinal acceleration command in force (m/s^2).
+
+        Returns
+        -------
+        numpy.ndarray
+            One value per name of `output_names`, SI units.
+        """
         delta_cmd, accel = self._inputs(steer_wheel_cmd_rad, accel_cmd_mps2)
         return self._outputs_kernel(
             np.asarray(state, dtype=float), self._p, delta_cmd, accel, self.params.steering_ratio
@@ -217,7 +339,13 @@ class CompiledVehicleModel(VehicleModel[ParamsT]):
 def models_with_tyres() -> list[str]:
     """The names of the vehicle models with tyres (`VehicleModel.has_tyres`), sorted: those a road friction other
     than 1.0 needs. Read from the model classes themselves, every one of them defined once the package
-    `workbench.vehicles` (its registry, which imports this module) is imported."""
+    `workbench.vehicles` (its registry, which imports this module) is imported.
+
+    Returns
+    -------
+    list of str
+        The models' registered names, e.g. "commonroad-mb", "dynamic-bicycle" and "tractor-semitrailer".
+    """
     names: set[str] = set()
     classes = VehicleModel.__subclasses__()
     while classes:

@@ -132,7 +132,19 @@ class CommonRoadMB(VehicleModel[CommonRoadMBParams]):
         )
 
     def single_track(self, source: str | None = None) -> PredictionParams:
-        """CommonRoad's car parameters as a single track with CommonRoad's tyre coefficients."""
+        """CommonRoad's car parameters as a single track with CommonRoad's tyre coefficients.
+
+        Parameters
+        ----------
+        source : str or None
+            Where the numbers come from, for messages and reports (None: this model's parameters).
+
+        Returns
+        -------
+        PredictionParams
+            The geometry, the steering actuator and the single track's mass, yaw inertia and axle tyres: what the MPC
+            controllers predict with.
+        """
         p, cr = self.params, self._cr
         a, b, m = float(cr.a), float(cr.b), float(cr.m)
         fzf, fzr = m * COMMONROAD_G_MPS2 * b / (a + b), m * COMMONROAD_G_MPS2 * a / (a + b)
@@ -172,6 +184,23 @@ class CommonRoadMB(VehicleModel[CommonRoadMBParams]):
         self._cr_road = dataclasses.replace(cr, tire=dataclasses.replace(cr.tire, **scaled))
 
     def initial_state(self, x_m: float, y_m: float, yaw_rad: float, speed_mps: float) -> np.ndarray:
+        """CommonRoad's own initial state (`init_mb`: the wheels rolling at the speed) of the car whose
+        rear-axle centre is at (x, y), straight wheels, heading yaw, moving at speed.
+
+        Parameters
+        ----------
+        x_m, y_m : float
+            Position of the reference point, the (tractor's) rear-axle centre (m).
+        yaw_rad : float
+            Heading (rad, counter-clockwise from x); trailing units start in line with it.
+        speed_mps : float
+            Longitudinal speed (m/s).
+
+        Returns
+        -------
+        numpy.ndarray
+            The state, one value per name of `state_names`.
+        """
         xc, yc = x_m + self._b * math.cos(yaw_rad), y_m + self._b * math.sin(yaw_rad)
         return np.array(self._init([xc, yc, 0.0, speed_mps, yaw_rad, 0.0, 0.0], self._cr), dtype=float)
 
@@ -187,6 +216,30 @@ class CommonRoadMB(VehicleModel[CommonRoadMBParams]):
     def advance(
         self, state: np.ndarray, steer_wheel_cmd_rad: float, accel_cmd_mps2: float, dt_s: float, substeps: int
     ) -> np.ndarray:
+        """Integrate the MB model with the inputs held over `dt_s`, in `substeps` fixed RK4 steps or more, so that
+        no step is longer than `max_step_s` (the model is stiff); return the new state.
+
+        The commands are clipped to the vehicle's limits (road-wheel angle, acceleration and braking) before they
+        drive the model.
+
+        Parameters
+        ----------
+        state : numpy.ndarray
+            The state at the start of the step, one value per name of `state_names`.
+        steer_wheel_cmd_rad : float
+            Steering-wheel angle command (rad, left positive); the road wheels get it divided by the steering ratio.
+        accel_cmd_mps2 : float
+            Longitudinal acceleration command (m/s^2, braking negative).
+        dt_s : float
+            The step (s, > 0): one controller period.
+        substeps : int
+            Fixed integration steps within `dt_s` (>= 1): the plant rate divided by the controller rate.
+
+        Returns
+        -------
+        numpy.ndarray
+            The state at the end of the step.
+        """
         delta_cmd, accel = self._inputs(steer_wheel_cmd_rad, accel_cmd_mps2)
         n = max(substeps, math.ceil(dt_s / self.params.max_step_s - 1e-9))
         h = dt_s / n
@@ -198,6 +251,23 @@ class CommonRoadMB(VehicleModel[CommonRoadMBParams]):
         return s
 
     def outputs(self, state: np.ndarray, steer_wheel_cmd_rad: float, accel_cmd_mps2: float) -> np.ndarray:
+        """STANDARD_OUTPUTS at the rear-axle centre (moved there from CommonRoad's centre of gravity), then the
+        sprung mass's roll (rad) and the path curvature of the reference point (1/m).
+
+        Parameters
+        ----------
+        state : numpy.ndarray
+            The state, one value per name of `state_names`.
+        steer_wheel_cmd_rad : float
+            Steering-wheel angle command in force (rad), for the outputs that depend on the inputs.
+        accel_cmd_mps2 : float
+            Longitudinal acceleration command in force (m/s^2).
+
+        Returns
+        -------
+        numpy.ndarray
+            One value per name of `output_names`, SI units.
+        """
         delta_cmd, accel = self._inputs(steer_wheel_cmd_rad, accel_cmd_mps2)
         x = np.asarray(state, dtype=float)
         d = self._rhs(x, delta_cmd, accel)

@@ -202,7 +202,19 @@ class DynamicBicycle(CompiledVehicleModel[DynamicBicycleParams]):
 
     def single_track(self, source: str | None = None) -> PredictionParams:
         """This model as a single track: its axles, static axle loads, tyres (cornering stiffness = coefficient x
-        load, peak = friction x load) and actuator."""
+        load, peak = friction x load) and actuator.
+
+        Parameters
+        ----------
+        source : str or None
+            Where the numbers come from, for messages and reports (None: this model's parameters).
+
+        Returns
+        -------
+        PredictionParams
+            The geometry, the steering actuator and the single track's mass, yaw inertia and axle tyres: what the MPC
+            controllers predict with.
+        """
         p = self.params
         a, b = p.cg_to_front_axle_m, p.cg_to_rear_axle_m
         fzf, fzr = p.mass_kg * COMMONROAD_G_MPS2 * b / (a + b), p.mass_kg * COMMONROAD_G_MPS2 * a / (a + b)

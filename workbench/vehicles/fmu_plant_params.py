@@ -194,17 +194,35 @@ class FmuPlantParams:
         return self.mass_kg is not None
 
     def input_names(self) -> tuple[str, ...]:
-        """The FMU's input variables this mapping sets, steering first."""
+        """The FMU's input variables this mapping sets, steering first.
+
+        Returns
+        -------
+        tuple of str
+            The steering input, then the acceleration input, or the throttle and brake inputs.
+        """
         if self.longitudinal_input_is == "acceleration":
             return (self.steering_input, str(self.accel_input))
         return (self.steering_input, str(self.throttle_input), str(self.brake_input))
 
     def output_fields(self) -> tuple[str, ...]:
-        """The mapping's output fields in use: REQUIRED_OUTPUTS, then the OPTIONAL_OUTPUTS given."""
+        """The mapping's output fields in use: REQUIRED_OUTPUTS, then the OPTIONAL_OUTPUTS given.
+
+        Returns
+        -------
+        tuple of str
+            The names of the fields of this dataclass that name an FMU output variable, in that order.
+        """
         return REQUIRED_OUTPUTS + tuple(name for name in OPTIONAL_OUTPUTS if getattr(self, name) is not None)
 
     def parameter_names(self) -> tuple[str, ...]:
-        """The FMU parameters this mapping sets before a run: speed, payload, friction (those given)."""
+        """The FMU parameters this mapping sets before a run: speed, payload, friction (those given).
+
+        Returns
+        -------
+        tuple of str
+            The FMU's parameter variable names, in that order; empty when none is given.
+        """
         names = (self.speed_parameter, self.payload_parameter, self.friction_parameter)
         return tuple(name for name in names if name is not None)
 

@@ -34,12 +34,32 @@ class VehicleGeometry:
 
     @property
     def max_steer_wheel_angle_rad(self) -> float:
+        """The steering-wheel angle at the road wheels' lock (rad): the road-wheel limit times the steering ratio."""
         return self.max_road_wheel_angle_rad * self.steering_ratio
 
     @classmethod
     def from_params(cls, params: Any, wheelbase_m: float) -> VehicleGeometry:
         """From a model's parameters with the usual fields (steering_ratio, max_road_wheel_angle_rad,
-        max_road_wheel_rate_rad_s, width_m); the steering-wheel rate limit is the road-wheel one x the ratio."""
+        max_road_wheel_rate_rad_s, width_m); the steering-wheel rate limit is the road-wheel one x the ratio.
+
+        Parameters
+        ----------
+        params : object
+            A model's params dataclass with ``steering_ratio``, ``max_road_wheel_angle_rad`` (rad),
+            ``max_road_wheel_rate_rad_s`` (rad/s) and ``width_m`` (m).
+        wheelbase_m : float
+            Front axle to rear axle (group centre) of the steered unit (m, 0.5 to 15).
+
+        Returns
+        -------
+        VehicleGeometry
+            The geometry and steering limits a controller is built for.
+
+        Raises
+        ------
+        WorkbenchInputError
+            A value out of its range (the message names the field, the value and the range).
+        """
         return cls(
             wheelbase_m=wheelbase_m,
             steering_ratio=params.steering_ratio,
@@ -49,5 +69,23 @@ class VehicleGeometry:
         )
 
     def steer_wheel_for_curvature(self, curvature_1pm: float) -> float:
-        """Steering-wheel angle (rad) that gives this path curvature kinematically: tan(phi) = L kappa."""
+        """Steering-wheel angle (rad) that gives this path curvature kinematically: tan(phi) = L kappa.
+
+        Parameters
+        ----------
+        curvature_1pm : float
+            The path's curvature (1/m, left positive).
+
+        Returns
+        -------
+        float
+            The steering-wheel angle (rad, left positive), not limited to the lock.
+
+        Examples
+        --------
+        >>> from workbench.vehicles import make_vehicle
+        >>> geometry = make_vehicle("kinematic-bicycle").geometry
+        >>> round(geometry.steer_wheel_for_curvature(1.0 / 30.0), 3)  # a 30 m radius, left
+        1.286
+        """
         return math.atan(self.wheelbase_m * curvature_1pm) * self.steering_ratio

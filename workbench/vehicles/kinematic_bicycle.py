@@ -85,12 +85,41 @@ class KinematicBicycle(CompiledVehicleModel[KinematicBicycleParams]):
         self._geometry = VehicleGeometry.from_params(p, p.wheelbase_m)
 
     def outputs(self, state: np.ndarray, steer_wheel_cmd_rad: float, accel_cmd_mps2: float) -> np.ndarray:
+        """STANDARD_OUTPUTS from the state alone: no slip, so the lateral speed is zero and the yaw rate is
+        v tan(delta) / L.
+
+        Parameters
+        ----------
+        state : numpy.ndarray
+            The state, one value per name of `state_names`.
+        steer_wheel_cmd_rad : float
+            Steering-wheel angle command in force (rad), for the outputs that depend on the inputs.
+        accel_cmd_mps2 : float
+            Longitudinal acceleration command in force (m/s^2).
+
+        Returns
+        -------
+        numpy.ndarray
+            One value per name of `output_names`, SI units.
+        """
         x, y, yaw, v, delta = state
         yaw_rate = v * math.tan(delta) / self.params.wheelbase_m
         return np.array([x, y, yaw, v, 0.0, yaw_rate, delta * self.params.steering_ratio, delta, v * yaw_rate])
 
     def single_track(self, source: str | None = None) -> PredictionParams:
-        """The kinematic single track with this model's actuator (no tyres)."""
+        """The kinematic single track with this model's actuator (no tyres).
+
+        Parameters
+        ----------
+        source : str or None
+            Where the numbers come from, for messages and reports (None: this model's parameters).
+
+        Returns
+        -------
+        PredictionParams
+            The geometry, the steering actuator and no tyres (the kinematic prediction kinds only): what the MPC
+            controllers predict with.
+        """
         p = self.params
         return PredictionParams.from_actuator(p, p.wheelbase_m, source or f"the {self.name} model's parameters")
 

@@ -97,7 +97,14 @@ def _preset_dir() -> Any:
 
 def list_presets() -> dict[str, str]:
     """Preset name -> its description, for every TOML file shipped in workbench/presets, then every installed
-    package's vehicle model (its preset: its params' defaults)."""
+    package's vehicle model (its preset: its params' defaults).
+
+    Returns
+    -------
+    dict of str to str
+        Preset name -> its one-line description, the shipped presets in alphabetical order, then the installed
+        models.
+    """
     found = {}
     for entry in sorted(_preset_dir().iterdir(), key=lambda e: e.name):
         if entry.name.endswith(".toml"):
@@ -110,7 +117,24 @@ def list_presets() -> dict[str, str]:
 
 def preset_text(name: str) -> str:
     """The TOML text of a preset (to copy and edit): a shipped file, an installed model's defaults, or the template
-    of a model type that exists only as a user's file (TEMPLATE_ONLY_TYPES)."""
+    of a model type that exists only as a user's file (TEMPLATE_ONLY_TYPES).
+
+    Parameters
+    ----------
+    name : str
+        A preset (`list_presets`) or a template-only model type ("fmu").
+
+    Returns
+    -------
+    str
+        The TOML text: a [model] table with the type and description and a [parameters] table with every
+        parameter of the model, which `load_vehicle` reads back.
+
+    Raises
+    ------
+    WorkbenchInputError
+        When `name` is neither a preset nor a template-only model type (the message lists the presets).
+    """
     if name in TEMPLATE_ONLY_TYPES:
         return _preset_dir().joinpath("templates", f"{name}.toml").read_text(encoding="utf-8")
     if name not in list_presets():
@@ -152,7 +176,39 @@ def params_from_toml(text: str, source: str, base_dir: Path | None = None) -> tu
 
 
 def load_vehicle(name_or_file: str, payload_kg: float | None = None) -> VehicleModel:
-    """Build a vehicle from a shipped preset name or a TOML file; payload_kg overrides the preset's payload."""
+    """Build a vehicle from a shipped preset name or a TOML file; payload_kg overrides the preset's payload.
+
+    `make_vehicle` is the same with a registered name or a file given apart; this takes either in one argument, as
+    the command line's --vehicle does.
+
+    Parameters
+    ----------
+    name_or_file : str
+        A preset (`list_presets`) or the path of a TOML vehicle file; a relative file path inside the file (an
+        FMU's) is taken relative to the file's folder.
+    payload_kg : float or None
+        The payload (kg) in place of the preset's or the file's, for a model type with a payload; None keeps it.
+
+    Returns
+    -------
+    VehicleModel
+        The vehicle the preset or file describes.
+
+    Raises
+    ------
+    WorkbenchInputError
+        Neither a preset nor an existing file, an unreadable or malformed file (an unknown model type, an unknown
+        or missing key, a parameter out of its range: the message names the file, the key and the allowed values),
+        or a payload for a vehicle without one.
+
+    Examples
+    --------
+    >>> from workbench.vehicles.presets import load_vehicle, preset_text
+    >>> load_vehicle("dynamic-bicycle").name
+    'dynamic-bicycle'
+    >>> text = preset_text("dynamic-bicycle")  # write it to my_car.toml, edit, then:
+    >>> load_vehicle("my_car.toml")  # doctest: +SKIP
+    """
     base_dir = None
     if name_or_file in list_presets():
         source = f"preset {name_or_file!r}"

@@ -60,10 +60,18 @@ class SingleTrackParams:
 
     @property
     def wheelbase_m(self) -> float:
+        """The distance between the axles (m): CG to front axle plus CG to rear axle."""
         return self.cg_to_front_axle_m + self.cg_to_rear_axle_m
 
     def understeer_gradient_rad_per_mps2(self) -> float:
-        """K in delta = L kappa + K a_y (linear tyres): (m / L) (b / Cf - a / Cr)."""
+        """K in delta = L kappa + K a_y (linear tyres): (m / L) (b / Cf - a / Cr).
+
+        Returns
+        -------
+        float
+            The understeer gradient (rad per m/s^2 of lateral acceleration): positive understeers, negative
+            oversteers, zero is neutral.
+        """
         a, b, m = self.cg_to_front_axle_m, self.cg_to_rear_axle_m, self.mass_kg
         cf, cr = self.front_cornering_stiffness_n_per_rad, self.rear_cornering_stiffness_n_per_rad
         return m / (a + b) * (b / cf - a / cr)
@@ -72,7 +80,18 @@ class SingleTrackParams:
         """Front and rear axle slip angles (rad) in steady cornering at this lateral acceleration (m/s^2, signed):
         the axle forces that hold the turn, m a_y b / L and m a_y a / L (moment balance about the CG, cos(delta)
         taken as 1), each through the magic formula inverted without its small curvature factor E (a force
-        beyond 99 % of the axle's peak is taken as 99 % of it)."""
+        beyond 99 % of the axle's peak is taken as 99 % of it).
+
+        Parameters
+        ----------
+        lateral_accel_mps2 : float
+            The steady lateral acceleration (m/s^2, left positive).
+
+        Returns
+        -------
+        tuple of (float, float)
+            The front and rear axle slip angles (rad), of the sign of `lateral_accel_mps2`.
+        """
         a, b, m = self.cg_to_front_axle_m, self.cg_to_rear_axle_m, self.mass_kg
         shape, force = self.tyre_shape_factor, m * lateral_accel_mps2 / (a + b)
         slips = []
@@ -85,7 +104,20 @@ class SingleTrackParams:
         return slips[0], slips[1]
 
     def fastest_lateral_mode_per_s(self, speed_mps: float) -> float:
-        """|lambda|max of the linear single track's (v_y, r) dynamics at this speed (1/s)."""
+        """|lambda|max of the linear single track's (v_y, r) dynamics at this speed (1/s).
+
+        What bounds the step an explicit integration of the single track may take at that speed.
+
+        Parameters
+        ----------
+        speed_mps : float
+            The longitudinal speed (m/s, > 0).
+
+        Returns
+        -------
+        float
+            The largest magnitude of the two eigenvalues of the linear lateral dynamics (1/s).
+        """
         a, b, m, iz = self.cg_to_front_axle_m, self.cg_to_rear_axle_m, self.mass_kg, self.yaw_inertia_kgm2
         cf, cr = self.front_cornering_stiffness_n_per_rad, self.rear_cornering_stiffness_n_per_rad
         v = speed_mps
@@ -157,7 +189,32 @@ class PredictionParams:
     ) -> PredictionParams:
         """A model's prediction parameters: its steering actuator's (`actuator`: the steering ratio, the road-wheel
         angle and rate limits, the time constant, which every model's params hold) with the wheelbase (m), single
-        track, identified lag and source the model gives."""
+        track, identified lag and source the model gives.
+
+        Parameters
+        ----------
+        actuator : SteeringActuator
+            A model's params: the steering ratio, the road-wheel angle (rad) and rate (rad/s) limits and the
+            actuator's time constant (s).
+        wheelbase_m : float
+            The single track's wheelbase (m, 0.5 to 15).
+        source : str
+            Where the numbers come from, for messages and reports.
+        single_track : SingleTrackParams or None
+            Mass, inertia and axle tyres (None: unknown, the kinematic kinds only).
+        lag : SteeringLag or None
+            The identified steering-wheel-to-curvature lag (None: none).
+
+        Returns
+        -------
+        PredictionParams
+            The prediction parameters.
+
+        Raises
+        ------
+        WorkbenchInputError
+            A value out of its range, or a single track whose axle positions do not add up to `wheelbase_m`.
+        """
         return cls(
             wheelbase_m=wheelbase_m,
             steering_ratio=actuator.steering_ratio,
@@ -170,11 +227,28 @@ class PredictionParams:
         )
 
     def with_lag(self, lag: SteeringLag | None) -> PredictionParams:
-        """A copy with this identified lag (None removes it)."""
+        """A copy with this identified lag (None removes it).
+
+        Parameters
+        ----------
+        lag : SteeringLag or None
+            The identified steering-wheel-to-curvature lag (Eq. 5), or None.
+
+        Returns
+        -------
+        PredictionParams
+            The same parameters with `lag` in place of this one's.
+        """
         return dataclasses.replace(self, lag=lag)
 
     def default_kind(self) -> str:
-        """ "kinematic-lag" with a lag, else "dynamic" when the single track is known, else "kinematic"."""
+        """ "kinematic-lag" with a lag, else "dynamic" when the single track is known, else "kinematic".
+
+        Returns
+        -------
+        str
+            The MPC's prediction-model kind these parameters support best.
+        """
         if self.lag is not None:
             return "kinematic-lag"
         return "dynamic" if self.single_track is not None else "kinematic"
@@ -182,7 +256,24 @@ class PredictionParams:
 
 def params_from_geometry(geometry: VehicleGeometry) -> PredictionParams:
     """The default when nothing but the geometry is known: a kinematic single track with the geometry's limits
-    and an assumed actuator time constant (DEFAULT_STEERING_TIME_CONSTANT_S)."""
+    and an assumed actuator time constant (DEFAULT_STEERING_TIME_CONSTANT_S).
+
+    Parameters
+    ----------
+    geometry : VehicleGeometry
+        The vehicle's wheelbase, steering ratio and limits; the road-wheel rate limit is its steering-wheel rate
+        limit divided by the steering ratio.
+
+    Returns
+    -------
+    PredictionParams
+        A kinematic single track (no tyres, no lag) with DEFAULT_STEERING_TIME_CONSTANT_S.
+
+    Raises
+    ------
+    WorkbenchInputError
+        A geometry outside the prediction parameters' ranges (e.g. a wheelbase over 15 m).
+    """
     return PredictionParams(
         wheelbase_m=geometry.wheelbase_m,
         steering_ratio=geometry.steering_ratio,

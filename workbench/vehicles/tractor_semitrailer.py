@@ -216,7 +216,33 @@ class Derived:
 
 
 def derive(p: TractorSemitrailerParams) -> Derived:
-    """Masses, CGs, inertias, static axle-group loads and the quasi-static LTR coefficients."""
+    """Masses, CGs, inertias, static axle-group loads and the quasi-static LTR coefficients.
+
+    Checks what the parameters' own ranges cannot: that each axle group carries a share of the weight, and that
+    each unit's roll stiffness holds its sprung mass up.
+
+    Parameters
+    ----------
+    p : TractorSemitrailerParams
+        The vehicle's parameters.
+
+    Returns
+    -------
+    Derived
+        The whole-unit quantities (SI), the static rollover threshold (g) among them.
+
+    Raises
+    ------
+    WorkbenchInputError
+        When an axle group would carry under 5 % of the vehicle's weight (the message names the group and the
+        parameters that place the loads), or a unit's roll stiffness is at most 1.2 m g h of its sprung mass.
+
+    Examples
+    --------
+    >>> from workbench.vehicles.tractor_semitrailer import TractorSemitrailerParams, derive
+    >>> round(derive(TractorSemitrailerParams()).rollover_threshold_g, 2)
+    0.45
+    """
     l1, lt, hoff = p.cg_to_front_axle_m + p.cg_to_drive_axle_m, p.hitch_to_trailer_axle_m, p.hitch_ahead_of_drive_m
     # tractor: x forward from the sprung CG
     parts1 = (
@@ -452,7 +478,19 @@ class TractorSemitrailer(CompiledVehicleModel[TractorSemitrailerParams]):
         """Equivalent single track (module docstring): the tractor plus the kingpin's share of the trailer as a
         point mass at the fifth wheel; axle loads and cornering stiffnesses of the articulated model (drive group
         including the kingpin load). Exact for the tractor in steady cornering; it neglects the trailer's yaw
-        transient, which an identified lag captures."""
+        transient, which an identified lag captures.
+
+        Parameters
+        ----------
+        source : str or None
+            Where the numbers come from, for messages and reports (None: this model's parameters).
+
+        Returns
+        -------
+        PredictionParams
+            The geometry, the steering actuator and the equivalent single track's mass, yaw inertia and
+            axle tyres: what the MPC controllers predict with.
+        """
         p, d = self.params, self.derived
         l1 = p.cg_to_front_axle_m + p.cg_to_drive_axle_m
         lt = p.hitch_to_trailer_axle_m
@@ -482,6 +520,15 @@ class TractorSemitrailer(CompiledVehicleModel[TractorSemitrailerParams]):
         return PredictionParams.from_actuator(p, l1, source, track)
 
     def describe(self) -> str:
+        """One line with the key parameters, for `workbench vehicles`: the geometry's, then the mass, the payload
+        and the static rollover threshold.
+
+        Returns
+        -------
+        str
+            The wheelbase (m), steering ratio, maximum road-wheel angle (deg), width (m), total mass and payload
+            (kg) and static rollover threshold (g).
+        """
         dv = self.derived
         return (
             f"{super().describe()}, mass {dv.m1 + dv.m2:.0f} kg (payload {self.params.payload_kg:.0f} kg), "
