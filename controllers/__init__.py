@@ -221,6 +221,7 @@ __all__ = [
     "ClothoidConfig",
     "ClothoidController",
     "Controller",
+    "ControllerRegistry",
     "LMPCConfig",
     "LMPCController",
     "Measurement",

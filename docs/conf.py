@@ -107,14 +107,9 @@ nitpick_ignore_regex = [
     ("py:.*", r"(float|int|str|bool|bytes|None|object|tuple|list|dict|set|frozenset|type|complex)(\[.*)?"),
     ("py:.*", r"(Ellipsis|NoneType|T|_T|P|R|abc\.ABC|DataclassInstance)"),
     ("py:.*", r"[a-z_][a-z0-9_]*"),  # a lowercase bare word in a type phrase: a unit ("s") or a field name
+    # a unit after the type ("float, km/h", "float, 1/(m s)", split at the parentheses) or a size in a shape
+    ("py:.*", r"(1/|1/m(\^2)?|1/s|km/h|m/s(\^2)?|rad/s|deg/s|Hz|dB|N|Nm|\d+)"),
     ("py:.*", r"(.*\.)?(ConfigT|ParamsT|MPCConfigT|T)"),  # type variables
-    # Types named in the public signatures that belong to internal modules the reference does not document.
-    ("py:.*", r"(.*\.)?(KnownDelays|PresetTuningOptions|LoopSettings|PlantLags|FeedforwardTiming|Plan|CaseSet|"
-     r"OptimiseSettings|VehicleOutline|TopSpeed|Stretch|RunStyle|LimitCycle|VehicleLog|Waypoints|CompiledPath|"
-     r"PathTracker|FloorInputs|FloorDesign|Margins|ControllerRegistry|SteeringController|Resolution|PlotWorker|"
-     r"InfeasibleSpan|CircuitRanges|SubFigure|_[A-Za-z]+)"),
-    # Forward references written without their module (TYPE_CHECKING imports); the types are in the reference.
-    ("py:.*", r"(Scenario|ScenarioOptions|SimulationConfig|Tunable|ReferencePath|SteeringLag|VehicleTuning|Backend)"),
 ]
 
 
