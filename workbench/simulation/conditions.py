@@ -95,6 +95,7 @@ class Localisation:
 
     @property
     def is_ideal(self) -> bool:
+        """Whether the pose and velocity reach the controller unchanged: no noise, drift, update rate or latency."""
         return (
             self.position_noise_m == 0.0
             and self.position_drift_m == 0.0
@@ -130,6 +131,7 @@ class Inertial:
 
     @property
     def is_ideal(self) -> bool:
+        """Whether the yaw rate and the speed reach the controller unchanged: no noise, bias or latency."""
         return (
             self.yaw_rate_noise_rad_s == 0.0
             and self.yaw_rate_bias_rad_s == 0.0
@@ -159,6 +161,7 @@ class SteeringSensor:
 
     @property
     def is_ideal(self) -> bool:
+        """Whether the steering-wheel angle reaches the controller unchanged: no noise, quantisation or latency."""
         return self.noise_rad == 0.0 and self.quantisation_rad == 0.0 and self.latency_s == 0.0
 
 
@@ -187,6 +190,7 @@ class Actuation:
 
     @property
     def is_ideal(self) -> bool:
+        """Whether the command reaches the plant unchanged: no dead time and no rate limit tighter than the plant's."""
         return self.dead_time_s == 0.0 and self.max_steer_wheel_rate_rad_s is None
 
 
@@ -227,6 +231,7 @@ class Road:
 
     @property
     def is_ideal(self) -> bool:
+        """Whether the road is that of the tyre data everywhere: a friction scale of 1.0 all along the path."""
         profile_flat = self.friction_profile is None or all(scale == 1.0 for _, scale in self.friction_profile)
         return self.friction_scale == 1.0 and profile_flat
 

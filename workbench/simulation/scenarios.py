@@ -130,6 +130,7 @@ class DoubleLaneChangeLayout:
 
     @property
     def lane_widths_m(self) -> tuple[float, float, float]:
+        """Widths (m) of lanes 1, 3 and 5: 1.1 b + 0.25, 1.2 b + 0.25 and 1.3 b + 0.25 for a vehicle b m wide."""
         b = self.vehicle_width_m
         return 1.1 * b + 0.25, 1.2 * b + 0.25, 1.3 * b + 0.25
 
@@ -140,6 +141,7 @@ class DoubleLaneChangeLayout:
 
     @property
     def offset_lane_centre_m(self) -> float:
+        """y (m, left positive) of the centre of the offset lane (section 3) from the entry lane's centre line."""
         w1, w3, _ = self.lane_widths_m
         return -w1 / 2 + self.lateral_offset_m + w3 / 2
 

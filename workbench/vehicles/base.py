@@ -45,13 +45,19 @@ class VehicleParams(Protocol):
     and the longitudinal limits the acceleration command is clipped to."""
 
     @property
-    def steering_ratio(self) -> float: ...
+    def steering_ratio(self) -> float:
+        """Steering-wheel angle / road-wheel angle."""
+        ...
 
     @property
-    def max_accel_mps2(self) -> float: ...
+    def max_accel_mps2(self) -> float:
+        """The largest acceleration command (m/s^2, > 0); larger ones are clipped to it."""
+        ...
 
     @property
-    def max_decel_mps2(self) -> float: ...
+    def max_decel_mps2(self) -> float:
+        """The largest braking (m/s^2, > 0); an acceleration command below minus this is clipped to it."""
+        ...
 
 
 #: A model's parameter dataclass (`VehicleModel[TheirParams]`).

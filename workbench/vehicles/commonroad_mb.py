@@ -106,7 +106,14 @@ def _commonroad_parameters(vehicle_id: int) -> Any:
 
 class CommonRoadMB(VehicleModel[CommonRoadMBParams]):
     """CommonRoad's 29-state multi-body car as a plant, registered as "commonroad-mb" (module docstring): the
-    published model behind this workbench's steering actuator, reported at the rear-axle centre."""
+    published model behind this workbench's steering actuator, reported at the rear-axle centre.
+
+    Parameters
+    ----------
+    params : CommonRoadMBParams or None
+        The model's parameters (None: the dataclass's defaults); `make_vehicle` builds the model from its preset
+        or a vehicle file instead.
+    """
 
     name: ClassVar[str] = "commonroad-mb"
     state_names: ClassVar[tuple[str, ...]] = _MB_STATES

@@ -68,6 +68,7 @@ class DynamicBicycleParams:
 
     @property
     def wheelbase_m(self) -> float:
+        """The distance between the axles (m): CG to front axle plus CG to rear axle."""
         return self.cg_to_front_axle_m + self.cg_to_rear_axle_m
 
     @property
@@ -152,7 +153,14 @@ def _outputs(s, p, delta_cmd, accel, ratio):  # pragma: no cover - compiled
 
 class DynamicBicycle(CompiledVehicleModel[DynamicBicycleParams]):
     """The dynamic single-track car with magic-formula tyres and relaxation length, registered as
-    "dynamic-bicycle" (module docstring for its equations and states)."""
+    "dynamic-bicycle" (module docstring for its equations and states).
+
+    Parameters
+    ----------
+    params : DynamicBicycleParams or None
+        The model's parameters (None: the dataclass's defaults); `make_vehicle` builds the model from its preset
+        or a vehicle file instead.
+    """
 
     name: ClassVar[str] = "dynamic-bicycle"
     state_names: ClassVar[tuple[str, ...]] = (

@@ -69,7 +69,14 @@ def _advance(state, p, delta_cmd, accel, h, n):  # pragma: no cover - compiled
 
 class KinematicBicycle(CompiledVehicleModel[KinematicBicycleParams]):
     """The kinematic bicycle with a first-order, rate-limited steering actuator, registered as
-    "kinematic-bicycle": no tyre slip (module docstring for its equations and states)."""
+    "kinematic-bicycle": no tyre slip (module docstring for its equations and states).
+
+    Parameters
+    ----------
+    params : KinematicBicycleParams or None
+        The model's parameters (None: the dataclass's defaults); `make_vehicle` builds the model from its preset
+        or a vehicle file instead.
+    """
 
     name: ClassVar[str] = "kinematic-bicycle"
     state_names: ClassVar[tuple[str, ...]] = ("x_m", "y_m", "yaw_rad", "speed_mps", "road_wheel_angle_rad")

@@ -135,16 +135,24 @@ class SteeringActuator(Protocol):
     road-wheel angle (rad) and rate (rad/s) limits and the first-order time constant (s)."""
 
     @property
-    def steering_ratio(self) -> float: ...
+    def steering_ratio(self) -> float:
+        """Steering-wheel angle / road-wheel angle."""
+        ...
 
     @property
-    def max_road_wheel_angle_rad(self) -> float: ...
+    def max_road_wheel_angle_rad(self) -> float:
+        """The road wheels' lock (rad)."""
+        ...
 
     @property
-    def max_road_wheel_rate_rad_s(self) -> float: ...
+    def max_road_wheel_rate_rad_s(self) -> float:
+        """The road wheels' largest steering rate (rad/s)."""
+        ...
 
     @property
-    def steering_time_constant_s(self) -> float: ...
+    def steering_time_constant_s(self) -> float:
+        """The first-order steering actuator's time constant (s)."""
+        ...
 
 
 @dataclass(frozen=True)

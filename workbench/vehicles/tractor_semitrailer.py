@@ -423,7 +423,20 @@ def _outputs(s, p, delta_cmd, accel, ratio):  # pragma: no cover - compiled
 
 class TractorSemitrailer(CompiledVehicleModel[TractorSemitrailerParams]):
     """The articulated tractor-semitrailer with saturating tyres, a steering system and quasi-static roll,
-    registered as "tractor-semitrailer", referenced at the tractor's drive-group centre (module docstring)."""
+    registered as "tractor-semitrailer", referenced at the tractor's drive-group centre (module docstring).
+
+    Parameters
+    ----------
+    params : TractorSemitrailerParams or None
+        The model's parameters (None: the dataclass's defaults); `make_vehicle` builds the model from its preset
+        or a vehicle file instead.
+
+    Raises
+    ------
+    WorkbenchInputError
+        Parameters that place too little load on an axle group, or a roll stiffness too low for a unit's sprung
+        mass (`derive`).
+    """
 
     name: ClassVar[str] = "tractor-semitrailer"
     state_names: ClassVar[tuple[str, ...]] = (
