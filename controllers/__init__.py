@@ -110,7 +110,18 @@ class ControllerRegistry(Mapping[str, "type[Controller]"]):
         return name in self._entries
 
     def require(self, name: str) -> None:
-        """Refuse a name no controller is registered under, naming the registered ones (imports nothing)."""
+        """Refuse a name no controller is registered under, naming the registered ones (imports nothing).
+
+        Parameters
+        ----------
+        name : str
+            A controller's name, e.g. "clothoid" (``workbench controllers`` lists the registered ones).
+
+        Raises
+        ------
+        WorkbenchInputError
+            No controller is registered under ``name``; the message lists the registered names.
+        """
         if name not in self._entries:
             from workbench.base.errors import WorkbenchInputError
 
