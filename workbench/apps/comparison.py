@@ -525,7 +525,8 @@ def compare(
     Examples
     --------
     >>> from workbench.apps.comparison import RunSpec, compare
-    >>> result = compare("dlc", [RunSpec("clothoid", "kinematic-bicycle"), RunSpec("stanley", "kinematic-bicycle")])
+    >>> runs = [RunSpec("clothoid", "kinematic-bicycle"), RunSpec("stanley", "kinematic-bicycle")]
+    >>> result = compare("dlc", runs)  # doctest: +SKIP
     >>> result.summary()[["controller", "max_abs_cte_m"]]  # doctest: +SKIP
     """
     if not runs:

@@ -423,8 +423,9 @@ def write_report(
     --------
     >>> from workbench.apps.comparison import RunSpec, compare
     >>> from workbench.apps.report import ReportSection, write_report
-    >>> result = compare("dlc", [RunSpec("clothoid", "kinematic-bicycle"), RunSpec("stanley", "kinematic-bicycle")])
-    >>> section = ReportSection("Double lane change", "Two controllers on the kinematic bicycle.", result)
+    >>> runs = [RunSpec("clothoid", "kinematic-bicycle"), RunSpec("stanley", "kinematic-bicycle")]
+    >>> result = compare("dlc", runs)  # doctest: +SKIP
+    >>> section = ReportSection("Double lane change", "Two controllers, kinematic bicycle.", result)  # doctest: +SKIP
     >>> write_report("out/report.html", "Clothoid against Stanley", [section])  # doctest: +SKIP
     PosixPath('out/report.html')
     """
