@@ -298,7 +298,7 @@ class Simulation:
         Parameters
         ----------
         progress : bool
-            Show the metres covered on a progress bar on stderr (shown only for a run longer than 2 s).
+            Show the metres covered on a progress bar on stderr (it appears once the run has taken 2 s).
 
         Returns
         -------
