@@ -18,6 +18,7 @@ MODULES = (
     "workbench.apps.comparison",
     "workbench.apps.report",
     "workbench.apps.studies.backends",
+    "workbench.apps.studies.distributions",
     "workbench.apps.studies.optimise",
     "workbench.apps.studies.results",
     "workbench.apps.studies.runner",

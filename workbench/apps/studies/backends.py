@@ -77,6 +77,9 @@ _SCHEDULER_ADDRESS = re.compile(r"tcp://(?P<host>[A-Za-z0-9._-]+|\[[0-9A-Fa-f:.]
 
 
 class Backend(Protocol):
+    """What a study needs of a backend (`LocalBackend`, `DaskBackend`): a name and worker count, start and close
+    (or a ``with`` block), `map_runs` and `describe`."""
+
     @property
     def name(self) -> str: ...
 
@@ -96,9 +99,30 @@ class Backend(Protocol):
         self, exc_type: type[BaseException] | None, exc: BaseException | None, tb: TracebackType | None
     ) -> None: ...
 
-    def map_runs(self, runs: Sequence[PlannedRun]) -> Iterator[dict[str, Any]]: ...
+    def map_runs(self, runs: Sequence[PlannedRun]) -> Iterator[dict[str, Any]]:
+        """Run `runs`, yielding each run's row as it finishes (in completion order).
 
-    def describe(self) -> str: ...
+        Parameters
+        ----------
+        runs : sequence of PlannedRun
+            The runs to execute, each independent of the others.
+
+        Yields
+        ------
+        dict
+            A run's row (`runner.execute_run`).
+        """
+        ...
+
+    def describe(self) -> str:
+        """The backend in words, for a study's progress line and report.
+
+        Returns
+        -------
+        str
+            The kind of backend and its workers.
+        """
+        ...
 
 
 def default_workers() -> int:

@@ -83,7 +83,32 @@ class Distribution:
 
     @classmethod
     def parse(cls, where: str, table: object) -> Distribution:
-        """A distribution from its spec table (`{uniform = [1, 2]}`); `where` names it in errors."""
+        """A distribution from its spec table (`{uniform = [1, 2]}`); `where` names it in errors.
+
+        Parameters
+        ----------
+        where : str
+            The spec key the table is the value of (e.g. "random.speed_kmh"), named in a message.
+        table : dict
+            A one-entry table: a kind of `KINDS` -> its list.
+
+        Returns
+        -------
+        Distribution
+            The checked distribution.
+
+        Raises
+        ------
+        WorkbenchInputError
+            Not a one-entry table, an unknown kind, or a list the kind refuses (`KINDS` says what each holds).
+
+        Examples
+        --------
+        >>> from workbench.apps.studies.distributions import Distribution, key_rng
+        >>> speed = Distribution.parse("random.speed_kmh", {"integers": [20, 60]})
+        >>> speed.draw(key_rng(0, "speed_kmh"), 3)
+        [47, 22, 45]
+        """
         if not isinstance(table, dict) or len(table) != 1:
             raise WorkbenchInputError(
                 f"{where} must be a one-entry table naming a distribution, e.g. {{uniform = [1, 2]}}; allowed: "
@@ -104,7 +129,20 @@ class Distribution:
         return {"integers": "int", "choice": "choice"}.get(self.kind, "float")
 
     def draw(self, rng: np.random.Generator, n: int) -> list[Any]:
-        """n values drawn with rng, as Python values (float, int, or the choices themselves)."""
+        """n values drawn with rng, as Python values (float, int, or the choices themselves).
+
+        Parameters
+        ----------
+        rng : numpy.random.Generator
+            The generator (`key_rng`: one per key, so that a key's draws do not depend on the others).
+        n : int
+            How many values, at least 0.
+
+        Returns
+        -------
+        list
+            n floats, whole numbers or choices.
+        """
         a, b = self.values[0], self.values[-1]
         if self.kind == "uniform":
             return [float(v) for v in rng.uniform(a, b, n)]
@@ -117,7 +155,18 @@ class Distribution:
         return [self.values[int(i)] for i in rng.integers(0, len(self.values), n)]
 
     def to_optuna(self) -> optuna.distributions.BaseDistribution:
-        """The same distribution as an optuna search-space entry (bounded kinds only)."""
+        """The same distribution as an optuna search-space entry (bounded kinds only).
+
+        Returns
+        -------
+        optuna.distributions.BaseDistribution
+            A FloatDistribution (log for log_uniform), IntDistribution or CategoricalDistribution.
+
+        Raises
+        ------
+        WorkbenchInputError
+            The kind is not bounded (normal): not one of `SEARCHABLE`.
+        """
         from optuna import distributions
 
         a, b = self.values[0], self.values[-1]
@@ -133,7 +182,20 @@ class Distribution:
 
 
 def key_rng(seed: int, key: str) -> np.random.Generator:
-    """The generator of one key's draws: seeded by the study's seed and a stable hash of the key's name."""
+    """The generator of one key's draws: seeded by the study's seed and a stable hash of the key's name.
+
+    Parameters
+    ----------
+    seed : int
+        The study's seed, at least 0.
+    key : str
+        The drawn parameter's name ("<controller>.<option>" for a controller's option).
+
+    Returns
+    -------
+    numpy.random.Generator
+        The same generator for the same seed and key, in any process.
+    """
     digest = int.from_bytes(hashlib.sha256(key.encode()).digest()[:8], "little")
     return np.random.default_rng([seed, digest])
 

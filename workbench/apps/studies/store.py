@@ -27,7 +27,18 @@ _TMP_SUFFIX = ".tmp"
 
 
 class RunStore:
-    """The rows of a study under out_dir/runs/<run_id>.json."""
+    """The rows of a study under out_dir/runs/<run_id>.json.
+
+    Parameters
+    ----------
+    out_dir : str or pathlib.Path
+        The study's folder; out_dir/runs/ is made if missing.
+
+    Raises
+    ------
+    WorkbenchInputError
+        out_dir/runs/ cannot be created.
+    """
 
     def __init__(self, out_dir: str | Path) -> None:
         self.out_dir = Path(out_dir)
@@ -38,10 +49,33 @@ class RunStore:
             raise WorkbenchInputError(f"cannot create the output folder {str(self.runs_dir)!r}: {exc}") from None
 
     def path(self, run_id: str) -> Path:
+        """Where a run's row is kept.
+
+        Parameters
+        ----------
+        run_id : str
+            The run's id (`PlannedRun.run_id`).
+
+        Returns
+        -------
+        pathlib.Path
+            out_dir/runs/<run_id>.json.
+        """
         return self.runs_dir / f"{run_id}.json"
 
     def read(self, run_ids: Iterable[str]) -> dict[str, dict[str, Any]]:
-        """The finished rows among run_ids (run_id -> row); runs without a readable row are left out."""
+        """The finished rows among run_ids (run_id -> row); runs without a readable row are left out.
+
+        Parameters
+        ----------
+        run_ids : iterable of str
+            The runs asked for.
+
+        Returns
+        -------
+        dict of str to dict
+            run_id -> its row, for each run whose file holds a JSON row of that run_id (others run again).
+        """
         rows = {}
         for run_id in run_ids:
             try:
@@ -53,7 +87,18 @@ class RunStore:
         return rows
 
     def write(self, row: Mapping[str, Any]) -> Path:
-        """Write one run's row atomically; return its path."""
+        """Write one run's row atomically; return its path.
+
+        Parameters
+        ----------
+        row : mapping
+            The run's row (`runner.execute_run`), with its run_id; JSON-serialisable.
+
+        Returns
+        -------
+        pathlib.Path
+            The row's file (`path`), replaced whole: a reader never sees half a row.
+        """
         run_id = str(row["run_id"])
         final = self.path(run_id)
         tmp = final.with_name(f".{run_id}.{os.getpid()}{_TMP_SUFFIX}")
@@ -62,7 +107,13 @@ class RunStore:
         return final
 
     def clean_temporaries(self) -> int:
-        """Remove temporaries left by an interrupted write; return how many."""
+        """Remove temporaries left by an interrupted write; return how many.
+
+        Returns
+        -------
+        int
+            The number of files removed.
+        """
         count = 0
         for tmp in self.runs_dir.glob(f".*{_TMP_SUFFIX}"):
             tmp.unlink(missing_ok=True)
@@ -73,7 +124,18 @@ class RunStore:
 def rows_frame(rows: Sequence[Mapping[str, Any]]) -> pd.DataFrame:
     """Rows as a DataFrame in the given order: the parameter columns in the order they first appear, then the
     metrics, status, message, traceback and run_time_s (RESULT_COLUMNS); a key a row lacks (another controller's
-    option) is null there."""
+    option) is null there.
+
+    Parameters
+    ----------
+    rows : sequence of mapping
+        The runs' rows, in the order of the table.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per run.
+    """
     columns: dict[str, None] = {}
     for row in rows:
         columns.update(dict.fromkeys(k for k in row if k not in RESULT_COLUMNS))
@@ -82,7 +144,20 @@ def rows_frame(rows: Sequence[Mapping[str, Any]]) -> pd.DataFrame:
 
 
 def write_results(out_dir: str | Path, rows: Sequence[Mapping[str, Any]]) -> Path:
-    """Write out_dir/results.parquet from the rows (one per run, in the study's order); return its path."""
+    """Write out_dir/results.parquet from the rows (one per run, in the study's order); return its path.
+
+    Parameters
+    ----------
+    out_dir : str or pathlib.Path
+        The study's folder (it exists).
+    rows : sequence of mapping
+        The runs' rows, in the study's order (`rows_frame`).
+
+    Returns
+    -------
+    pathlib.Path
+        The file, replaced whole.
+    """
     path = Path(out_dir) / RESULTS_FILE
     tmp = path.with_name(f".{RESULTS_FILE}.{os.getpid()}{_TMP_SUFFIX}")
     rows_frame(rows).to_parquet(tmp, index=False)
