@@ -20,7 +20,28 @@ from workbench.base.errors import WorkbenchInputError, require_positive, value_t
 
 
 def scale_schedule(schedule: FilterSchedule, zero_scale: float = 1.0, pole_scale: float = 1.0) -> FilterSchedule:
-    """The schedule with every filter's omega_z times zero_scale and omega_p times pole_scale."""
+    """The schedule with every filter's omega_z times zero_scale and omega_p times pole_scale.
+
+    Parameters
+    ----------
+    schedule : FilterSchedule
+        The lead filter per speed.
+    zero_scale : float
+        Factor on every filter's omega_z (the zeros), positive.
+    pole_scale : float
+        Factor on every filter's omega_p (the triple pole), positive.
+
+    Returns
+    -------
+    FilterSchedule
+        The same speeds and psi, the frequencies scaled.
+
+    Raises
+    ------
+    WorkbenchInputError
+        A scale not positive, or a scaled filter Eq. 6 does not allow (omega_p / omega_z outside [1, 100], a
+        frequency outside [0.01, 1000] rad/s).
+    """
     require_positive("lead_filter_zero_scale", zero_scale)
     require_positive("lead_filter_pole_scale", pole_scale)
     try:
@@ -42,7 +63,30 @@ def scaled_filter(
     vehicle_schedule: FilterSchedule | None = None,
 ) -> FilterSchedule:
     """The run's lead filter (`configured`, else the vehicle's own `vehicle_schedule`, else DEFAULT_FILTER) scaled
-    as `scale_schedule` does, its source saying so."""
+    as `scale_schedule` does, its source saying so.
+
+    Parameters
+    ----------
+    configured : FilterSchedule or None
+        The run's configured lead filter (`ClothoidConfig.lead_filter`; None: none).
+    zero_scale : float
+        Factor on every filter's omega_z (the zeros), positive.
+    pole_scale : float
+        Factor on every filter's omega_p (the triple pole), positive.
+    vehicle_schedule : FilterSchedule or None
+        The steered vehicle's own schedule, the base without a configured filter (None: DEFAULT_FILTER).
+
+    Returns
+    -------
+    FilterSchedule
+        The scaled filter, its source naming the base and the factors.
+
+    Raises
+    ------
+    WorkbenchInputError
+        A scale not positive, or a scaled filter Eq. 6 does not allow (omega_p / omega_z outside [1, 100], a
+        frequency outside [0.01, 1000] rad/s).
+    """
     if configured is not None:
         base, name = configured, f"the configured lead filter ({configured.source or 'a filter file'})"
     elif vehicle_schedule is not None:

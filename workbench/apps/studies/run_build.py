@@ -38,14 +38,41 @@ LEAD_FILTER_SCALES = ("lead_filter_zero_scale", "lead_filter_pole_scale")
 
 def split_values(values: Mapping[str, Any]) -> tuple[dict[str, Any], dict[str, Any]]:
     """A run's parameters as (the SimulationConfig's, conditions included; EXTRA_RUN_PARAMETERS, None when not
-    given)."""
+    given).
+
+    Parameters
+    ----------
+    values : mapping
+        A run's parameters (`PlannedRun.values`), typed.
+
+    Returns
+    -------
+    tuple of (dict, dict)
+        The SimulationConfig's parameters as given, and every key of EXTRA_RUN_PARAMETERS with its value or None.
+    """
     config = {k: v for k, v in values.items() if k not in EXTRA_RUN_PARAMETERS}
     return config, {k: values.get(k) for k in EXTRA_RUN_PARAMETERS}
 
 
 def simulation_config(values: Mapping[str, Any]) -> SimulationConfig:
     """The SimulationConfig of a run's SimulationConfig parameters: its fields, `conditions` (a preset name or a
-    file; None: ideal) and the condition fields set on top of it (`condition_parameters.py`)."""
+    file; None: ideal) and the condition fields set on top of it (`condition_parameters.py`).
+
+    Parameters
+    ----------
+    values : mapping
+        SimulationConfig fields, conditions and condition fields (`split_values`), typed.
+
+    Returns
+    -------
+    SimulationConfig
+        The run's simulation settings.
+
+    Raises
+    ------
+    WorkbenchInputError
+        A value SimulationConfig or the conditions refuse, or a conditions file it cannot read.
+    """
     values = dict(values)
     name = values.pop("conditions", None)
     fields = {k: values.pop(k) for k in list(values) if k in CONDITION_FIELDS}
@@ -57,7 +84,29 @@ def started_scenario(
 ) -> Scenario:
     """The scenario started with the lateral offset (m) and heading error (deg) asked for (None: the scenario's
     own). A start further from the path than max_abs_cte_m (the distance at which a run has left the path and
-    stops) is refused: such a run would stop before its first step."""
+    stops) is refused: such a run would stop before its first step.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        The scenario as built.
+    offset_m : float or None
+        Lateral offset (m) of the start from the path (None: the scenario's own).
+    heading_deg : float or None
+        Heading error (deg) of the start (None: the scenario's own).
+    max_abs_cte_m : float
+        The |CTE| (m) at which a run has left the path (`SimulationConfig.max_abs_cte_m`).
+
+    Returns
+    -------
+    Scenario
+        The scenario with that start.
+
+    Raises
+    ------
+    WorkbenchInputError
+        |offset| at or beyond max_abs_cte_m.
+    """
     started = scenario.with_initial_error(offset_m, None if heading_deg is None else math.radians(heading_deg))
     if not abs(started.initial_offset_m) < max_abs_cte_m:
         raise WorkbenchInputError(
@@ -72,7 +121,27 @@ def plant_and_controller_vehicles(
     vehicle: VehicleModel, payload_kg: float | None, controller_payload_kg: float | None
 ) -> tuple[VehicleModel, VehicleModel]:
     """(the plant: the vehicle with payload_kg, its own payload when None; the vehicle the controller is built for:
-    the vehicle with controller_payload_kg when given, a payload mismatch, else the plant itself)."""
+    the vehicle with controller_payload_kg when given, a payload mismatch, else the plant itself).
+
+    Parameters
+    ----------
+    vehicle : VehicleModel
+        The run's vehicle, with its own payload.
+    payload_kg : float or None
+        The plant's payload (kg; None: the vehicle's own).
+    controller_payload_kg : float or None
+        The payload (kg) the controller is built for (None: the plant's).
+
+    Returns
+    -------
+    tuple of (VehicleModel, VehicleModel)
+        The plant, and the vehicle the controller is built for (the plant itself without a mismatch).
+
+    Raises
+    ------
+    WorkbenchInputError
+        A payload for a vehicle that carries none, or not a number.
+    """
     from workbench.vehicles.presets import with_payload
 
     plant = vehicle if payload_kg is None else with_payload(vehicle, payload_kg)
@@ -82,7 +151,24 @@ def plant_and_controller_vehicles(
 
 
 def option_text(value: Any) -> str:
-    """A typed option value as the text of a `--set KEY=VALUE` override (floats by repr: exact round trip)."""
+    """A typed option value as the text of a `--set KEY=VALUE` override (floats by repr: exact round trip).
+
+    Parameters
+    ----------
+    value : object
+        None, a bool, a number or text.
+
+    Returns
+    -------
+    str
+        "none", "true"/"false", repr of a float, str of anything else.
+
+    Examples
+    --------
+    >>> from workbench.apps.studies.run_build import option_text
+    >>> [option_text(v) for v in (None, True, 0.1, 3, "adaptive")]
+    ['none', 'true', '0.1', '3', 'adaptive']
+    """
     if value is None:
         return "none"
     if isinstance(value, bool):
@@ -99,7 +185,30 @@ def untuned_controller_config(
     geometry: VehicleGeometry | None,
 ) -> tuple[Any, dict[str, float]]:
     """(the controller's config from the controller-config file's table with the run's options on top, file
-    options read into their objects, without any vehicle's tuning; the lead-filter scales given)."""
+    options read into their objects, without any vehicle's tuning; the lead-filter scales given).
+
+    Parameters
+    ----------
+    controller : str
+        A registered controller's name.
+    config_file : pathlib.Path or None
+        A controller-config TOML file (None: the defaults).
+    options : mapping
+        Option -> typed value, over the file's; the lead-filter scales (`LEAD_FILTER_SCALES`) among them are
+        returned apart.
+    geometry : VehicleGeometry or None
+        The vehicle's geometry, for options that depend on it (None: none).
+
+    Returns
+    -------
+    tuple of (object, dict of str to float)
+        The controller's config, and the lead-filter scales given.
+
+    Raises
+    ------
+    WorkbenchInputError
+        An option the controller does not have, a value it refuses, or a file it cannot read.
+    """
     options = dict(options)
     scales = {k: options.pop(k) for k in LEAD_FILTER_SCALES if k in options}
     config_type = CONTROLLERS[controller].config_type
@@ -109,7 +218,20 @@ def untuned_controller_config(
 
 def with_scaled_filter(config: Any, scales: Mapping[str, float]) -> Any:
     """The config with its lead filter scaled (`lead_filter_scaling.scaled_filter`: its own lead filter, else the
-    vehicle's tuning's, else the default) when a scale other than 1 is given; as it is otherwise."""
+    vehicle's tuning's, else the default) when a scale other than 1 is given; as it is otherwise.
+
+    Parameters
+    ----------
+    config : object
+        A controller's config; one with a lead_filter field when a scale other than 1 is given.
+    scales : mapping of str to float
+        `LEAD_FILTER_SCALES` -> factor (a missing one: 1).
+
+    Returns
+    -------
+    object
+        The config, its lead filter scaled when asked.
+    """
     from workbench.apps.studies.lead_filter_scaling import scaled_filter
 
     zero, pole = (scales.get(k, 1.0) for k in LEAD_FILTER_SCALES)
@@ -122,7 +244,20 @@ def with_scaled_filter(config: Any, scales: Mapping[str, float]) -> Any:
 
 def check_scales(config: Any, scales: Mapping[str, float]) -> None:
     """The lead-filter scales checked as far as they can be without the vehicle's tuning: positive, and the
-    configured lead filter (when the config has one) scaled as a run scales it."""
+    configured lead filter (when the config has one) scaled as a run scales it.
+
+    Parameters
+    ----------
+    config : object
+        A controller's config.
+    scales : mapping of str to float
+        `LEAD_FILTER_SCALES` -> factor.
+
+    Raises
+    ------
+    WorkbenchInputError
+        A scale not positive, or scales that give the configured lead filter a zero or pole Eq. 6 does not allow.
+    """
     for key, value in scales.items():
         require_positive(key, value)
     if getattr(config, "lead_filter", None) is not None:
