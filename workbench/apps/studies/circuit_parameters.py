@@ -31,12 +31,42 @@ CIRCUIT_RANGES = "circuit_ranges"
 
 
 def is_circuit(scenario: str) -> bool:
-    """Whether a study's scenario (a name or an absolute file path) is a generated circuit, circuit:SEED."""
+    """Whether a study's scenario (a name or an absolute file path) is a generated circuit, circuit:SEED.
+
+    Parameters
+    ----------
+    scenario : str
+        A scenario name or a waypoint file's path.
+
+    Returns
+    -------
+    bool
+        True for circuit:SEED.
+
+    Examples
+    --------
+    >>> from workbench.apps.studies.circuit_parameters import is_circuit
+    >>> is_circuit("circuit:7"), is_circuit("dlc")
+    (True, False)
+    """
     return circuit_seed(scenario) is not None
 
 
 def scenario_values(scenario: str, values: Mapping[str, Any]) -> dict[str, Any]:
-    """A run's parameters on `scenario`: circuit_ranges left out unless the scenario is a generated circuit."""
+    """A run's parameters on `scenario`: circuit_ranges left out unless the scenario is a generated circuit.
+
+    Parameters
+    ----------
+    scenario : str
+        The run's scenario.
+    values : mapping
+        The run's parameters.
+
+    Returns
+    -------
+    dict
+        The parameters the run carries (and its id is made of).
+    """
     if is_circuit(scenario):
         return dict(values)
     return {k: v for k, v in values.items() if k != CIRCUIT_RANGES}
@@ -45,7 +75,23 @@ def scenario_values(scenario: str, values: Mapping[str, Any]) -> dict[str, Any]:
 def ranges_identity(path: Path) -> dict[str, Any]:
     """What a run's id takes of its circuit_ranges file: the ranges it holds, field by field (not the file's name
     or its other tables, so that a spec that names itself plans the same ids when its other tables change).
-    Read once per file version (its path, size and modification time)."""
+    Read once per file version (its path, size and modification time).
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        A circuit_ranges file.
+
+    Returns
+    -------
+    dict
+        {"circuits": the ranges' fields}.
+
+    Raises
+    ------
+    WorkbenchInputError
+        The file is missing or cannot be read as ranges.
+    """
     try:
         stat = os.stat(path)
     except OSError:
@@ -55,7 +101,23 @@ def ranges_identity(path: Path) -> dict[str, Any]:
 
 def drawn_ranges_key(path: Path | None) -> str:
     """Which circuits a run's circuit_ranges file draws, as text: "" for none or for a file of the default ranges
-    (the same circuits), else the ranges it holds, so that two files of the same ranges give the same key."""
+    (the same circuits), else the ranges it holds, so that two files of the same ranges give the same key.
+
+    Parameters
+    ----------
+    path : pathlib.Path or None
+        A circuit_ranges file (None: none).
+
+    Returns
+    -------
+    str
+        "" or the ranges as JSON, keys sorted.
+
+    Raises
+    ------
+    WorkbenchInputError
+        The file is missing or cannot be read as ranges.
+    """
     if path is None:
         return ""
     ranges = ranges_identity(path)[CIRCUITS_TABLE]
@@ -71,7 +133,24 @@ def _identity(path: str, size: int, mtime_ns: int) -> dict[str, Any]:
 
 def planned_circuit_ranges(spec: Any) -> dict[Path, CircuitRanges]:
     """Each circuit_ranges file `spec` (a typed StudySpec) plans, read, by its (absolute) path; empty when it plans
-    none. WorkbenchInputError for the refusals of the module docstring, naming the spec key."""
+    none. WorkbenchInputError for the refusals of the module docstring, naming the spec key.
+
+    Parameters
+    ----------
+    spec : StudySpec
+        The study, its values typed.
+
+    Returns
+    -------
+    dict
+        Absolute path -> the CircuitRanges it holds.
+
+    Raises
+    ------
+    WorkbenchInputError
+        A file that cannot be read as ranges, a study without a generated circuit, or several files in [grid]
+        beside a scenario that is not a circuit.
+    """
     planned = planned_values(spec).get(CIRCUIT_RANGES)
     if planned is None:
         return {}
@@ -102,7 +181,24 @@ def ranged_options(
 ) -> dict[str, ScenarioOptions]:
     """The ScenarioOptions the runs on `scenario` build it with, by a label for messages: a generated circuit's
     with each ranges planned ("circuit:7 (circuit_ranges 'ranges.toml')", the file relative to base_dir), any
-    other scenario's (or every one when no ranges are planned) as given, under its own name."""
+    other scenario's (or every one when no ranges are planned) as given, under its own name.
+
+    Parameters
+    ----------
+    scenario : str
+        A scenario of the study.
+    options : ScenarioOptions
+        The options the scenario is built with, before the ranges.
+    ranges : mapping
+        Absolute path -> CircuitRanges (`planned_circuit_ranges`).
+    base_dir : pathlib.Path
+        The spec's folder, that the labels' paths are relative to.
+
+    Returns
+    -------
+    dict
+        Label -> ScenarioOptions, one per ranges file for a circuit, else one under the scenario's name.
+    """
     if not ranges or not is_circuit(scenario):
         return {scenario: options}
     return {
@@ -116,7 +212,24 @@ def ranged_options(
 def check_circuits_table(document: Mapping[str, Any], spec_file: Path, named: Iterable[Path], how: str) -> None:
     """Refuse a spec's [circuits] table that no run reads: one is read only by runs whose circuit_ranges names the
     spec file itself (`named`: the circuit_ranges files the spec plans, absolute). how: where the spec names a
-    file for circuit_ranges, for the message."""
+    file for circuit_ranges, for the message.
+
+    Parameters
+    ----------
+    document : mapping
+        The parsed spec.
+    spec_file : pathlib.Path
+        The spec's file.
+    named : iterable of pathlib.Path
+        The circuit_ranges files the spec plans, absolute.
+    how : str
+        Where the spec would name the file (e.g. "in [grid]"), for the message.
+
+    Raises
+    ------
+    WorkbenchInputError
+        The document has a [circuits] table and no planned circuit_ranges names the spec file.
+    """
     if CIRCUITS_TABLE not in document:
         return
     own = Path(spec_file).resolve()
