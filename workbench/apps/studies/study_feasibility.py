@@ -32,7 +32,23 @@ ALLOW = "study.allow_infeasible = true in [study]"
 
 def fastest_config(values: Mapping[str, tuple[str, list[Any]]]) -> SimulationConfig:
     """The config of the study's fastest run: the largest of each FASTEST field planned (`planned_values`), the
-    others at their defaults."""
+    others at their defaults.
+
+    Parameters
+    ----------
+    values : mapping
+        Run parameter -> (where it is in the spec, its planned values) (`planned_values`).
+
+    Returns
+    -------
+    SimulationConfig
+        The fastest run's settings.
+
+    Raises
+    ------
+    WorkbenchInputError
+        Values SimulationConfig refuses together (those runs' own errors: the caller lets them be).
+    """
     return SimulationConfig(**{k: max(values[k][1]) for k in FASTEST if k in values})
 
 
@@ -40,7 +56,22 @@ def check_feasibility(spec: Any, models: Mapping[str, Any], scenarios: Mapping[s
     """Refuse a study (`spec`, a typed StudySpec) one of whose vehicles cannot follow one of its scenarios at the
     study's fastest run, unless spec.allow_infeasible: the refusal names study.scenarios, the scenario (a file by
     its path), the vehicle and the speed, then the places and the limit of the first such pair, and how many
-    other pairs there are. models: each vehicle's model; scenarios: each scenario built, by the spec's names."""
+    other pairs there are. models: each vehicle's model; scenarios: each scenario built, by the spec's names.
+
+    Parameters
+    ----------
+    spec : StudySpec
+        The study, its values typed.
+    models : mapping
+        Vehicle name -> its model (VehicleModel).
+    scenarios : mapping
+        Scenario name -> the scenario built (Scenario).
+
+    Raises
+    ------
+    WorkbenchInputError
+        A vehicle cannot follow a scenario at the fastest run's planned speed, without study.allow_infeasible.
+    """
     if spec.allow_infeasible:
         return
     from workbench.vehicles.presets import with_payload

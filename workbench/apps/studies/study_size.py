@@ -36,7 +36,18 @@ ALLOW = "study.allow_long_runs = true in [study]"
 
 
 def planned_values(spec: Any) -> dict[str, tuple[str, list[Any]]]:
-    """Each run parameter the study plans: where it is in the spec and every value of it (grid and draws)."""
+    """Each run parameter the study plans: where it is in the spec and every value of it (grid and draws).
+
+    Parameters
+    ----------
+    spec : StudySpec
+        The study, its values typed.
+
+    Returns
+    -------
+    dict
+        Parameter -> ("grid.<key>" or "random.<key>", its values).
+    """
     values = {k: (f"grid.{k}", list(v)) for k, v in spec.grid.items()}
     values |= {k: (f"random.{k}", list(v)) for k, v in spec.drawn().items()}
     return values
@@ -45,7 +56,23 @@ def planned_values(spec: Any) -> dict[str, tuple[str, list[Any]]]:
 def longest_config(values: Mapping[str, tuple[str, list[Any]]]) -> list[SimulationConfig]:
     """The configs of the study's longest runs: the extreme of each LONGEST field planned (the others at their
     defaults), with the largest max_time_s given and, when a run has none, without one (the default time-out);
-    the plant rate is the controller rate (it does not change the steps)."""
+    the plant rate is the controller rate (it does not change the steps).
+
+    Parameters
+    ----------
+    values : mapping
+        Run parameter -> (where it is in the spec, its planned values) (`planned_values`).
+
+    Returns
+    -------
+    list of SimulationConfig
+        One or two configs: with the largest max_time_s given, and without one when a run has none.
+
+    Raises
+    ------
+    WorkbenchInputError
+        Values SimulationConfig refuses together (those runs' own errors: the caller lets them be).
+    """
     fields = {k: pick(values[k][1]) for k, pick in LONGEST.items() if k in values}
     fields.setdefault("controller_rate_hz", SimulationConfig.controller_rate_hz)
     fields["plant_rate_hz"] = fields["controller_rate_hz"]
@@ -58,7 +85,23 @@ def longest_config(values: Mapping[str, tuple[str, list[Any]]]) -> list[Simulati
 def check_run_sizes(spec: Any, models: Mapping[str, Any], scenarios: Mapping[str, Any]) -> None:
     """Refuse a study (`spec`, a typed StudySpec) whose longest run exceeds the bounds, unless
     spec.allow_long_runs, and laps on a study of open paths only. models: each vehicle's model; scenarios: each
-    scenario built, by the spec's names."""
+    scenario built, by the spec's names.
+
+    Parameters
+    ----------
+    spec : StudySpec
+        The study, its values typed.
+    models : mapping
+        Vehicle name -> its model (VehicleModel).
+    scenarios : mapping
+        Scenario name -> the scenario built (Scenario).
+
+    Raises
+    ------
+    WorkbenchInputError
+        Laps above 1 on open paths only, or a longest run beyond the bounds of `run_size` without
+        study.allow_long_runs.
+    """
     values = planned_values(spec)
     if "laps" in values and max(values["laps"][1]) > 1 and not any(s.path.closed for s in scenarios.values()):
         where, laps = values["laps"]

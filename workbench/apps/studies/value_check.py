@@ -85,7 +85,26 @@ def check_object(
     """Refuse a value of one object's parameters (axes and draws) that fails to build (`build(context, values)`)
     in every context and every planned combination with the object's other values: first a value that fails on
     its own (the others at their defaults), so that the value to blame is named, then one that fails only with the
-    others planned. See the module docstring."""
+    others planned. See the module docstring.
+
+    Parameters
+    ----------
+    axes : mapping
+        The object's grid parameters: key -> (where it is in the spec, its values).
+    draws : mapping
+        The object's drawn parameters: key -> (where it is in the spec, one value per sample).
+    samples : int
+        The study's number of samples (1 without draws).
+    contexts : sequence
+        What the object is built in (e.g. each vehicle's geometry; [None] for none).
+    build : callable
+        Called as ``build(context, values)``; raises WorkbenchInputError for values it refuses.
+
+    Raises
+    ------
+    WorkbenchInputError
+        A value that fails to build in every context and every planned combination, naming its spec key.
+    """
     # (parameter, where it is set, value, the random draw's index: None for a grid value)
     given: list[tuple[str, str, Any, int | None]] = [
         (k, where, v, None) for k, (where, values) in axes.items() for v in values
@@ -126,7 +145,22 @@ def _parameters(
 
 def check_values(spec: Any, models: Mapping[str, Any], scenarios: Mapping[str, Any]) -> None:
     """Check every value `spec` (a StudySpec, typed) plans, as the module docstring says. models: each vehicle's
-    model (by the spec's name for it); scenarios: each scenario built (by the spec's name for it)."""
+    model (by the spec's name for it); scenarios: each scenario built (by the spec's name for it).
+
+    Parameters
+    ----------
+    spec : StudySpec
+        The study, its values typed.
+    models : mapping
+        Vehicle name -> its model (VehicleModel).
+    scenarios : mapping
+        Scenario name -> the scenario built (Scenario).
+
+    Raises
+    ------
+    WorkbenchInputError
+        A value every run with it would refuse, naming the spec key and the value.
+    """
     samples = spec.samples or 1
     for vehicle, model in models.items():
         try:
