@@ -16,6 +16,13 @@ class SingleThreadedLibraries(WorkerPlugin):
     name = "workbench-single-threaded-libraries"
 
     def setup(self, worker: object) -> None:
+        """Called by Dask on each worker as it joins (`WorkerPlugin.setup`).
+
+        Parameters
+        ----------
+        worker : distributed.Worker
+            The worker (not used: the preparation is of its process).
+        """
         prepare_worker_process()
 
 

@@ -359,6 +359,23 @@ class OptimiseSettings:
 
     @classmethod
     def from_table(cls, table: object) -> OptimiseSettings:
+        """The settings from a spec's [optimise] table, every value checked.
+
+        Parameters
+        ----------
+        table : mapping
+            The parsed table: trials, objective and search (required), and the other keys of OPTIMISE_KEYS.
+
+        Returns
+        -------
+        OptimiseSettings
+            The checked settings.
+
+        Raises
+        ------
+        WorkbenchInputError
+            Not a table, an unknown or missing key, or a value the settings refuse.
+        """
         if not isinstance(table, Mapping):
             raise WorkbenchInputError(f"[optimise] must be a table; got {table!r}")
         unknown = [k for k in table if k not in OPTIMISE_KEYS]
