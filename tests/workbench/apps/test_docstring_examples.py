@@ -21,6 +21,7 @@ MODULES = (
     "workbench.apps.studies.circuit_parameters",
     "workbench.apps.studies.distributions",
     "workbench.apps.studies.optimise",
+    "workbench.apps.studies.plots",
     "workbench.apps.studies.results",
     "workbench.apps.studies.run_build",
     "workbench.apps.studies.runner",
