@@ -45,6 +45,8 @@ extensions = [
     "sphinx.ext.autodoc",
     "sphinx.ext.autosummary",
     "sphinx.ext.mathjax",
+    # MathJax served from the built site (_static/mathjax), not from a CDN: the equations render offline too.
+    "sphinx-mathjax-offline",
 ]
 if (DOCS / "_ext" / "workbench_figures.py").exists():
     extensions.append("workbench_figures")
