@@ -28,6 +28,7 @@ MODULES = (
     "workbench.apps.studies.spec",
     "workbench.apps.studies.sweep",
     "workbench.apps.studies.tournament",
+    "workbench.apps.studies.tournament_judging",
     "workbench.apps.studies.tournament_spec",
 )
 

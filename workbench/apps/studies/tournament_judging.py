@@ -115,6 +115,18 @@ class Interval:
     high: float
 
     def contains(self, value: float) -> bool:
+        """Whether `value` lies in [low, high], ends included.
+
+        Parameters
+        ----------
+        value : float
+            The value, in the unit of the mean.
+
+        Returns
+        -------
+        bool
+            False for NaN ends.
+        """
         return self.low <= value <= self.high
 
 
@@ -151,7 +163,13 @@ class Judgement:
     resamples: int
 
     def to_pandas(self) -> dict[str, pd.DataFrame]:
-        """The tables by name: leaderboard, scores, per_case, gap, pairwise."""
+        """The tables by name: leaderboard, scores, per_case, gap, pairwise.
+
+        Returns
+        -------
+        dict of str to pandas.DataFrame
+            The tables themselves (not copies), in that order.
+        """
         return {
             "leaderboard": self.leaderboard,
             "scores": self.scores,
@@ -178,7 +196,20 @@ def _require_metrics(name: str, metrics: Sequence[str]) -> None:
 
 def statistic_rng(seed: int, *key: str) -> np.random.Generator:
     """The generator of one statistic's resamples: seeded by the seed and the statistic's key (e.g. the
-    controller, config and metric), so that each interval is the same whatever else is judged beside it."""
+    controller, config and metric), so that each interval is the same whatever else is judged beside it.
+
+    Parameters
+    ----------
+    seed : int
+        The tournament's seed, at least 0.
+    *key : str
+        The statistic's key, e.g. the controller, config and metric.
+
+    Returns
+    -------
+    numpy.random.Generator
+        The same generator for the same seed and key, in any process.
+    """
     return np.random.default_rng(np.random.SeedSequence([seed, *(zlib.crc32(k.encode()) for k in key)]))
 
 
@@ -188,7 +219,34 @@ def bootstrap_mean(
     """The mean of `values` (one per case) and its percentile-bootstrap interval: the values drawn with replacement
     `resamples` times, the interval's ends the (1 - CONFIDENCE) / 2 and (1 + CONFIDENCE) / 2 quantiles of the
     resampled means, widened to the mean where rounding puts it a hair outside (equal values). One value gives
-    [value, value] (nothing to resample); none gives NaN."""
+    [value, value] (nothing to resample); none gives NaN.
+
+    Parameters
+    ----------
+    values : sequence of float or numpy.ndarray
+        One value per case, finite.
+    rng : numpy.random.Generator
+        The resampling generator (`statistic_rng`).
+    resamples : int
+        How many bootstrap resamples.
+
+    Returns
+    -------
+    Interval
+        The mean and its interval at CONFIDENCE.
+
+    Raises
+    ------
+    WorkbenchInputError
+        A value that is not finite.
+
+    Examples
+    --------
+    >>> from workbench.apps.studies.tournament_judging import bootstrap_mean, statistic_rng
+    >>> interval = bootstrap_mean([1.0, 2.0, 3.0, 4.0], statistic_rng(0, "clothoid", "tuned", "score"))
+    >>> interval.mean, interval.contains(2.5)
+    (2.5, True)
+    """
     x = np.asarray(values, dtype=float)
     if x.size == 0:
         return Interval(math.nan, math.nan, math.nan)
@@ -208,7 +266,27 @@ def paired_difference(
     resamples: int = DEFAULT_RESAMPLES,
 ) -> Interval:
     """The mean of a - b over paired cases (entry i of each is the same case) and its bootstrap interval: the cases
-    are resampled as pairs, so what the cases share (a hard track for both) cancels."""
+    are resampled as pairs, so what the cases share (a hard track for both) cancels.
+
+    Parameters
+    ----------
+    a, b : sequence of float or numpy.ndarray
+        One value per case each, entry i of both the same case; finite.
+    rng : numpy.random.Generator
+        The resampling generator (`statistic_rng`).
+    resamples : int
+        How many bootstrap resamples.
+
+    Returns
+    -------
+    Interval
+        The mean difference a - b and its interval at CONFIDENCE.
+
+    Raises
+    ------
+    WorkbenchInputError
+        a and b differ in length, or a value is not finite.
+    """
     a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
     if a.shape != b.shape:
         raise WorkbenchInputError(f"paired values come in pairs; got {a.size} and {b.size} values")
@@ -217,7 +295,27 @@ def paired_difference(
 
 def ranking_scores(results: pd.DataFrame, ranking: Mapping[str, float], failure_score: float) -> pd.Series:
     """Each run's ranking scalar: sum of weight x metric over `ranking`, `failure_score` for a failed run. A run
-    that did not fail needs every ranking metric finite (it is refused otherwise, naming the run)."""
+    that did not fail needs every ranking metric finite (it is refused otherwise, naming the run).
+
+    Parameters
+    ----------
+    results : pandas.DataFrame
+        One row per run, with failed, run_id, controller, case and the ranking metrics.
+    ranking : mapping of str to float
+        Metric -> weight.
+    failure_score : float
+        A failed run's scalar.
+
+    Returns
+    -------
+    pandas.Series
+        The scalar of each run, named SCORE, on the results' index.
+
+    Raises
+    ------
+    WorkbenchInputError
+        A run that did not fail with a ranking metric missing or not finite.
+    """
     failed = results["failed"].astype(bool).to_numpy()
     total = np.zeros(len(results))
     for metric, weight in ranking.items():
@@ -407,6 +505,32 @@ def judge(
     `statistic_rng`); resamples: per interval; failure_score: a failed run's scalar; objectives: the metrics judged
     beside the scalar. Refused (WorkbenchInputError): a missing column, an unknown set, config or metric, a case in
     both sets, a controller judged without a tuned configuration, a run that did not fail without a ranking metric.
+
+    Parameters
+    ----------
+    results : pandas.DataFrame
+        One row per run, with the columns REQUIRED_COLUMNS, the ranking metrics and the objectives.
+    ranking : mapping of str to float
+        Metric -> weight of the ranking scalar; at least one, every weight finite.
+    seed : int
+        The bootstraps' seed, at least 0.
+    resamples : int
+        Bootstrap resamples per interval, at least MIN_RESAMPLES.
+    failure_score : float
+        A failed run's scalar, finite.
+    objectives : sequence of str
+        The metrics judged beside the scalar, each of OBJECTIVE_METRICS.
+
+    Returns
+    -------
+    Judgement
+        The leaderboard, scores, per-case scores, train-test gap and pairwise differences.
+
+    Raises
+    ------
+    WorkbenchInputError
+        Any of the refusals above, or an unknown metric, a weight or failure_score not finite, a seed below 0 or
+        resamples below MIN_RESAMPLES.
     """
     if not ranking:
         raise WorkbenchInputError("the ranking needs at least one metric and its weight; got none")
