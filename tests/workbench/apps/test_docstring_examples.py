@@ -29,6 +29,7 @@ MODULES = (
     "workbench.apps.studies.sweep",
     "workbench.apps.studies.tournament",
     "workbench.apps.studies.tournament_judging",
+    "workbench.apps.studies.tournament_report",
     "workbench.apps.studies.tournament_spec",
 )
 

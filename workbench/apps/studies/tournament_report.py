@@ -78,7 +78,26 @@ def _new_axes(size: tuple[float, float] = plots.FIGURE_SIZE_IN, panels: int = 1,
 def front_metrics(objectives: Sequence[str], ranking: Mapping[str, float]) -> tuple[str, str]:
     """(effort, error): the objectives the fronts are drawn with. Effort: the RMS steering rate when it is an
     objective, else the last objective; error: of the TRACKING_METRICS the first the ranking weighs when it is an
-    objective, else the first that is one, else the first objective."""
+    objective, else the first that is one, else the first objective.
+
+    Parameters
+    ----------
+    objectives : sequence of str
+        The tournament's objectives, at least one.
+    ranking : mapping of str to float
+        The ranking's metric -> weight.
+
+    Returns
+    -------
+    tuple of (str, str)
+        (effort, error).
+
+    Examples
+    --------
+    >>> from workbench.apps.studies.tournament_report import front_metrics
+    >>> front_metrics(["rms_cte_m", "max_abs_cte_on_path_m", "rms_steer_rate_deg_s"], {"max_abs_cte_on_path_m": 1.0})
+    ('rms_steer_rate_deg_s', 'max_abs_cte_on_path_m')
+    """
     effort = EFFORT if EFFORT in objectives else objectives[-1]
     weighed = [m for m in TRACKING_METRICS if m in ranking]
     preferred = [*weighed, *TRACKING_METRICS]
@@ -96,7 +115,26 @@ def training_front(
     """The controller's trials on the training cases (the history's train_ means of `error` against `effort`):
     every trial, the points of its front (over every objective: with more than two, a front point may look beaten
     in this projection), the default (trial 0), the chosen trial and the front points carried to the test set
-    (F1.., by their rank)."""
+    (F1.., by their rank).
+
+    Parameters
+    ----------
+    history : pandas.DataFrame
+        One row per controller and trial (HISTORY_COLUMNS and the train_ means).
+    controller : str
+        The controller drawn.
+    ax : matplotlib.axes.Axes
+        The axes to draw on.
+    error : str
+        The tracking objective (y), e.g. "max_abs_cte_on_path_m" (`front_metrics`).
+    effort : str
+        The effort objective (x), e.g. "rms_steer_rate_deg_s".
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        The axes drawn on.
+    """
     own = history[history["controller"] == controller]
     xs, ys = f"train_{effort}", f"train_{error}"
     x, y = own[xs].astype(float), own[ys].astype(float)
@@ -133,7 +171,26 @@ def judged_points(
     scores: pd.DataFrame, controller: str, ax: Axes, error: str = "max_abs_cte_on_path_m", effort: str = EFFORT
 ) -> Axes:
     """The controller's judged configurations on the test cases: mean `error` against mean `effort`, with their
-    intervals as error bars: the default, the tuned configuration and the carried front points (F1..)."""
+    intervals as error bars: the default, the tuned configuration and the carried front points (F1..).
+
+    Parameters
+    ----------
+    scores : pandas.DataFrame
+        `Judgement.scores`.
+    controller : str
+        The controller drawn.
+    ax : matplotlib.axes.Axes
+        The axes to draw on.
+    error : str
+        The tracking objective (y), e.g. "max_abs_cte_on_path_m" (`front_metrics`).
+    effort : str
+        The effort objective (x), e.g. "rms_steer_rate_deg_s".
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        The axes drawn on.
+    """
     own = scores[scores["controller"] == controller]
     for row in own.itertuples():
         config = str(row.config)
@@ -167,7 +224,20 @@ def _interval_bars(
 
 
 def default_against_tuned(leaderboard: pd.DataFrame, ax: Axes) -> Axes:
-    """Each controller's test score (mean and interval), default beside tuned, in the leaderboard's order."""
+    """Each controller's test score (mean and interval), default beside tuned, in the leaderboard's order.
+
+    Parameters
+    ----------
+    leaderboard : pandas.DataFrame
+        `Judgement.leaderboard`.
+    ax : matplotlib.axes.Axes
+        The axes to draw on.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        The axes drawn on.
+    """
     x = np.arange(len(leaderboard))
     board = leaderboard
     _interval_bars(
@@ -201,7 +271,24 @@ def default_against_tuned(leaderboard: pd.DataFrame, ax: Axes) -> Axes:
 def train_against_test(gap: pd.DataFrame, order: Sequence[str], ax: Axes, metric: str = SCORE) -> Axes:
     """Each controller's `metric` on the training cases (its trial's runs) and on the test cases, for the tuned
     and the default configuration, joined by a line: a line going up is a setting that holds less well off the
-    cases it was tuned on."""
+    cases it was tuned on.
+
+    Parameters
+    ----------
+    gap : pandas.DataFrame
+        `Judgement.gap`.
+    order : sequence of str
+        The controllers, left to right.
+    ax : matplotlib.axes.Axes
+        The axes to draw on.
+    metric : str
+        SCORE (the ranking scalar) or one of the objectives.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        The axes drawn on.
+    """
     rows = gap[gap["metric"] == metric].set_index(["controller", "config"])
     for config, colour, offset, marker in ((DEFAULT, "tab:gray", -0.12, "s"), (TUNED, "tab:orange", 0.12, "*")):
         for k, controller in enumerate(order):
@@ -227,7 +314,24 @@ def steering_rate_comparison(
     styles: Sequence[plots.RunStyle] | None = None,
 ) -> Axes:
     """The measured steering-wheel rate against time (differenced at the controller rate, as the metrics take
-    it), every run on one axis."""
+    it), every run on one axis.
+
+    Parameters
+    ----------
+    results : sequence of PlottedRun
+        The runs (a SimulationResult is one).
+    labels : sequence of str
+        The legend's label of each run.
+    ax : matplotlib.axes.Axes
+        The axes to draw on.
+    styles : sequence of RunStyle or None
+        How each run is drawn (None: a colour per label).
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        The axes drawn on.
+    """
     styles = plots.run_styles(labels, [""] * len(labels)) if styles is None else styles
     for result, label, style in zip(results, labels, styles, strict=True):
         t, steer = result.trace["t_s"], result.trace["steer_wheel_rad"]
@@ -506,7 +610,26 @@ def render_report(
     judgement: Judgement,
     traces: Mapping[str, SimulationResult],
 ) -> str:
-    """The report as one HTML document (sections SECTIONS, in order)."""
+    """The report as one HTML document (sections SECTIONS, in order).
+
+    Parameters
+    ----------
+    summary : TournamentSummary
+        What the tournament was: its title, controllers, cases and rules.
+    results : pandas.DataFrame
+        The tournament's runs (every judged controller among them).
+    history : pandas.DataFrame
+        One row per controller and trial: train_ objective means, pareto, chosen, carried.
+    judgement : Judgement
+        `tournament_judging.judge`'s verdict on the results.
+    traces : mapping
+        Controller -> its chosen configuration's run on one test scenario (SimulationResult); may be empty.
+
+    Returns
+    -------
+    str
+        One self-contained HTML page (`report.html_page`).
+    """
     body = [
         _contents(),
         *_leaderboard_section(summary, judgement),
@@ -532,7 +655,34 @@ def write_report(
     """Write DIR/report.html (REPORT_FILE) and return its path. results: the tournament's runs (every judged
     controller must be in it); history: one row per controller and trial (train_ objective means, pareto, chosen,
     carried); judgement: `tournament_judging.judge`'s of the results; traces: controller -> its chosen
-    configuration's run on one test scenario (may be empty)."""
+    configuration's run on one test scenario (may be empty).
+
+    Parameters
+    ----------
+    out_dir : pathlib.Path
+        The tournament's folder (made if missing).
+    summary : TournamentSummary
+        What the tournament was: its title, controllers, cases and rules.
+    results : pandas.DataFrame
+        The tournament's runs (every judged controller among them).
+    history : pandas.DataFrame
+        One row per controller and trial: train_ objective means, pareto, chosen, carried.
+    judgement : Judgement
+        `tournament_judging.judge`'s verdict on the results.
+    traces : mapping
+        Controller -> its chosen configuration's run on one test scenario (SimulationResult); may be empty.
+
+    Returns
+    -------
+    pathlib.Path
+        out_dir/report.html.
+
+    Raises
+    ------
+    WorkbenchInputError
+        The judgement names a controller the results or the history do not hold, the history lacks a column,
+        or a trace is given for a controller not judged.
+    """
     judged = set(judgement.leaderboard["controller"])
     unknown = sorted(judged - set(results["controller"]))
     if unknown:
