@@ -114,7 +114,18 @@ FIG17_COLUMNS = _fig17_columns()
 
 
 def curves_start_m(path: ReferencePath) -> float:
-    """Arc length (m) where the path first curves (|curvature| above CURVING_1PM): the end of its lead-in straight."""
+    """Arc length (m) where the path first curves (|curvature| above CURVING_1PM): the end of its lead-in straight.
+
+    Parameters
+    ----------
+    path : ReferencePath
+        The reference path, resampled at its spacing_m.
+
+    Returns
+    -------
+    float
+        Arc length (m); 0.0 for a path that never curves.
+    """
     curving = np.flatnonzero(np.abs(path.curvature_1pm) > CURVING_1PM)
     return float(curving[0] * path.spacing_m) if curving.size else 0.0
 
@@ -124,7 +135,22 @@ def max_cte_after_convergence_m(progress_m: np.ndarray, cte_m: np.ndarray, from_
     CONVERGED_CTE_M (`converge_distance_m`) and from_m; NaN if it never converged.
 
     from_m (the start of the curves, `curves_start_m`) keeps the measure off the approach's last metres, where |CTE|
-    is still just under the tolerance by definition and would read as CONVERGED_CTE_M for every run."""
+    is still just under the tolerance by definition and would read as CONVERGED_CTE_M for every run.
+
+    Parameters
+    ----------
+    progress_m : numpy.ndarray
+        Distance along the path (m) of each sample, shape (n,).
+    cte_m : numpy.ndarray
+        Cross-track error (m) of each sample, shape (n,).
+    from_m : float
+        Distance (m) from the first sample before which the measure does not look.
+
+    Returns
+    -------
+    float
+        Max |CTE| (m); NaN if the run never converged or has no sample after that distance.
+    """
     converged = converge_distance_m(progress_m, cte_m)
     if math.isnan(converged):
         return math.nan
@@ -133,7 +159,25 @@ def max_cte_after_convergence_m(progress_m: np.ndarray, cte_m: np.ndarray, from_
 
 
 def overshoot_m(cte_m: np.ndarray) -> float:
-    """How far (m) the run crosses to the other side of the path from where it started (0 if it never does)."""
+    """How far (m) the run crosses to the other side of the path from where it started (0 if it never does).
+
+    Parameters
+    ----------
+    cte_m : numpy.ndarray
+        Cross-track error (m) of each sample, shape (n,); its first sample's sign is the side the run starts on.
+
+    Returns
+    -------
+    float
+        The largest |CTE| (m) on the other side; NaN for no samples.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from workbench.apps.fig17 import overshoot_m
+    >>> overshoot_m(np.array([1.0, 0.4, -0.05, 0.01, 0.0]))
+    0.05
+    """
     side = math.copysign(1.0, float(cte_m[0])) if cte_m.size else 1.0
     return float(max(0.0, np.max(-side * cte_m))) if cte_m.size else math.nan
 
@@ -178,7 +222,13 @@ class Fig17Result:
 
     def summary(self) -> pd.DataFrame:
         """The fair set's summary with each run's overshoot_m, max_abs_cte_after_convergence_m and speed_spread_kmh
-        (max - min of the measured speed)."""
+        (max - min of the measured speed).
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row per run of the fair set (`Comparison.summary` and those three columns).
+        """
         table = self.fair.summary()
         start = curves_start_m(self.fair.scenario.path)
         table["overshoot_m"] = [overshoot_m(r.trace["cte_m"]) for r in self.fair.results]
@@ -190,14 +240,26 @@ class Fig17Result:
 
     def published_summary(self) -> pd.DataFrame:
         """The published pairs' rows of `summary()`: their step-time ratios are over the clothoid controller's on the
-        same plant (the published selection alone has no clothoid run on the car)."""
+        same plant (the published selection alone has no clothoid run on the car).
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row per published pair, in the published order.
+        """
         table = self.summary()
         rows = [self.fair.specs.index(spec) for spec in self.published.specs]
         return table.iloc[rows].reset_index(drop=True)
 
     def paper_table(self) -> pd.DataFrame:
         """What section 6.6 of the paper says of Figures 17 and 18 (it gives no values), beside our numbers: the
-        published pairing (clothoid on the truck, NMPC on the car) and both controllers on the truck."""
+        published pairing (clothoid on the truck, NMPC on the car) and both controllers on the truck.
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row per statement of PAPER_STATEMENTS: figure, the paper, what we measure, and our numbers.
+        """
         table = self.summary().set_index(["controller", "vehicle"])
 
         def ours(column: str, unit: str, clothoid_on: str, nmpc_on: str) -> str:
@@ -220,7 +282,18 @@ class Fig17Result:
     def save(self, out_dir: str | Path) -> list[Path]:
         """Write the fair set's runs, summary.csv (with the columns of `summary()`) and figures to out_dir, the
         published set's figures with the prefix "published_", both sets' convergence views, paper_vs_ours.csv
-        (`paper_table`) and report.html with all of it; return the paths (the report last)."""
+        (`paper_table`) and report.html with all of it; return the paths (the report last).
+
+        Parameters
+        ----------
+        out_dir : str or pathlib.Path
+            The folder to write to (made if missing); files there of the same names are replaced.
+
+        Returns
+        -------
+        list of pathlib.Path
+            Every file written, report.html last.
+        """
         out = Path(out_dir)
         written = self.fair.save(out)
         self.summary().to_csv(out / "summary.csv", index=False)  # the fair set's, with the fig17 columns
@@ -284,7 +357,34 @@ def run_fig17(
 ) -> Fig17Result:
     """Simulate the fair set (it contains the published pairs) on the fig17 scenario; progress: a line on stderr
     counting the runs (`compare`; None: when stderr is a terminal, as the CLI shows it); allow_long_run: run even
-    when a run may simulate more than the bounds of `run_size` (`compare`)."""
+    when a run may simulate more than the bounds of `run_size` (`compare`).
+
+    Parameters
+    ----------
+    config : SimulationConfig or None
+        The simulation settings (None: the defaults at SPEED_KMH, 30 km/h).
+    progress : bool or None
+        Show the runs' progress on stderr (None: when stderr is a terminal).
+    allow_long_run : bool
+        Run even a run longer than the bounds of `run_size`.
+
+    Returns
+    -------
+    Fig17Result
+        The fair set and the published pairs selected from it.
+
+    Raises
+    ------
+    WorkbenchInputError
+        A run too long (unless allowed), or a path a vehicle cannot follow at the config's speed.
+
+    Examples
+    --------
+    >>> from workbench.apps.fig17 import run_fig17
+    >>> result = run_fig17()  # doctest: +SKIP
+    >>> result.save("runs/fig17")[-1]  # doctest: +SKIP
+    PosixPath('runs/fig17/report.html')
+    """
     show = sys.stderr.isatty() if progress is None else progress
     config = config or SimulationConfig(speed_kmh=SPEED_KMH)
     fair = compare(

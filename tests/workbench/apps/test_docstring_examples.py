@@ -16,6 +16,7 @@ ROOT = Path(__file__).resolve().parents[3]
 #: The modules whose docstrings carry examples, each run as a doctest.
 MODULES = (
     "workbench.apps.comparison",
+    "workbench.apps.fig17",
     "workbench.apps.report",
     "workbench.apps.studies.backends",
     "workbench.apps.studies.circuit_parameters",
