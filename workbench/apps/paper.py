@@ -304,7 +304,18 @@ TRACKING_FIGURES: tuple[tuple[int, str, Callable[[SimulationResult, plt.Axes | N
 
 
 def speed_at_largest_curvature_rate_mps(result: SimulationResult) -> float:
-    """The vehicle's speed (m/s) where the path's |dκ/ds| is largest (the paper's Figure 12a remark)."""
+    """The vehicle's speed (m/s) where the path's |dκ/ds| is largest (the paper's Figure 12a remark).
+
+    Parameters
+    ----------
+    result : SimulationResult
+        A run, its trace with path_s_m and speed_mps.
+
+    Returns
+    -------
+    float
+        Speed (m/s), interpolated at that arc length.
+    """
     path = result.path
     rate = np.abs(np.gradient(path.curvature_1pm, path.spacing_m))
     s_peak = float(np.argmax(rate) * path.spacing_m)
@@ -351,7 +362,30 @@ def _table(runs: dict[str, SimulationResult]) -> pd.DataFrame:
 
 
 def figure_number(path: Path) -> int:
-    """The paper's figure a written file shows (its name starts "figNN")."""
+    """The paper's figure a written file shows (its name starts "figNN").
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        A figure file written by `reproduce_paper`.
+
+    Returns
+    -------
+    int
+        The figure's number.
+
+    Raises
+    ------
+    ValueError
+        The name does not start with "fig" and a number.
+
+    Examples
+    --------
+    >>> from pathlib import Path
+    >>> from workbench.apps.paper import figure_number
+    >>> figure_number(Path("fig12a_speed_vs_arc_length_figure8.png"))
+    12
+    """
     match = re.match(r"fig(\d+)", path.name)
     if match is None:
         raise ValueError(f"{path.name} is not a figure file (fig<number>...)")
@@ -377,7 +411,20 @@ def _report_figure_section(number: int, pngs: list[Path], table: pd.DataFrame, n
 
 def write_paper_report(path: Path, result: PaperResult) -> Path:
     """report.html: the table, what was skipped, then each figure written (embedded) under the paper's caption with
-    what the paper says of it beside our numbers."""
+    what the paper says of it beside our numbers.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        The HTML file to write (replaced if it exists).
+    result : PaperResult
+        What `reproduce_paper` wrote: its figure files are embedded.
+
+    Returns
+    -------
+    pathlib.Path
+        The file written.
+    """
     from workbench.apps.report import html_page, text_table
 
     by_figure: dict[int, list[Path]] = {}
@@ -406,7 +453,34 @@ def reproduce_paper(
 ) -> PaperResult:
     """Write every figure to out_dir, the comparison table as paper_vs_ours.csv and report.html (every figure with
     the paper's caption, what it says and our numbers); return what was written. progress: a line on stderr counting
-    the steps (None: when stderr is a terminal, as the CLI shows it)."""
+    the steps (None: when stderr is a terminal, as the CLI shows it).
+
+    Parameters
+    ----------
+    out_dir : str or pathlib.Path
+        The folder to write to (made if missing).
+    options : ScenarioOptions or None
+        Options of the scenarios, e.g. the Zandvoort track file (None: the defaults; Zandvoort where the track is
+        found).
+    progress : bool or None
+        Show the steps' progress on stderr (None: when stderr is a terminal).
+
+    Returns
+    -------
+    PaperResult
+        The files written (report.html last), our numbers beside the paper's, and what was skipped and why.
+
+    Raises
+    ------
+    WorkbenchInputError
+        A track file given that cannot be used.
+
+    Examples
+    --------
+    >>> from workbench.apps.paper import reproduce_paper
+    >>> result = reproduce_paper("runs/paper")  # doctest: +SKIP
+    >>> result.table, result.skipped  # doctest: +SKIP
+    """
     out = Path(out_dir)
     options = options or ScenarioOptions()
     show = sys.stderr.isatty() if progress is None else progress
@@ -458,7 +532,23 @@ def zandvoort_skip_reason(options: ScenarioOptions) -> str | None:
     """Why Figures 15-16 and the Zandvoort row cannot be given, or None when they can: the paper's verdict on
     Zandvoort is given for the TUMFTM Zandvoort file only (`scenarios.is_zandvoort_file`), never for another file
     given or found in its place, which is named instead. A track file given must be usable: a broken one is refused
-    (WorkbenchInputError) before any work."""
+    (WorkbenchInputError) before any work.
+
+    Parameters
+    ----------
+    options : ScenarioOptions
+        The scenarios' options, with the track file given (or None to look for it).
+
+    Returns
+    -------
+    str or None
+        Why the Zandvoort figures are skipped, or None when the TUMFTM track is there.
+
+    Raises
+    ------
+    WorkbenchInputError
+        A track file given that cannot be read as a track.
+    """
     if not _track_given(options):
         return (
             "Figures 15-16 and the Zandvoort row: no track file (give --track or $WORKBENCH_ZANDVOORT_CSV, or put "

@@ -37,7 +37,13 @@ class StageProgress:
         )
 
     def stage(self, text: str) -> None:
-        """Start the next stage: name it on the bar, or write its line."""
+        """Start the next stage: name it on the bar, or write its line.
+
+        Parameters
+        ----------
+        text : str
+            The stage in words, e.g. "Figure 6: rollover limits".
+        """
         if self.bar is not None:
             if self.started:
                 self.bar.update(1)
@@ -48,7 +54,13 @@ class StageProgress:
 
     @contextmanager
     def above(self) -> Iterator[None]:
-        """Write messages (warnings) above the bar rather than through it."""
+        """Write messages (warnings) above the bar rather than through it.
+
+        Yields
+        ------
+        None
+            Inside the ``with`` block, writes to the stream go above the bar.
+        """
         if self.bar is None:
             yield
         else:
@@ -56,7 +68,13 @@ class StageProgress:
                 yield
 
     def warn(self, message: str) -> None:
-        """A warning on stderr (`warn_on_stderr`), above the bar."""
+        """A warning on stderr (`warn_on_stderr`), above the bar.
+
+        Parameters
+        ----------
+        message : str
+            The warning, one line.
+        """
         with self.above():
             warn_on_stderr(message)
 

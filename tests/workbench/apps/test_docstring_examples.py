@@ -17,6 +17,7 @@ ROOT = Path(__file__).resolve().parents[3]
 MODULES = (
     "workbench.apps.comparison",
     "workbench.apps.fig17",
+    "workbench.apps.paper",
     "workbench.apps.report",
     "workbench.apps.studies.backends",
     "workbench.apps.studies.circuit_parameters",
