@@ -95,7 +95,31 @@ def _payload_kg(vehicle: str) -> float | None:
 def payload_axis(vehicle: str) -> Axis | None:
     """The payload factor of a vehicle with a payload (None for one without, or with none on board): the plant
     carries PAYLOAD_FRACTIONS of its nominal payload while the controller stays built for the nominal one
-    (controller_payload_kg), so every run of the axis but the base is a payload mismatch."""
+    (controller_payload_kg), so every run of the axis but the base is a payload mismatch.
+
+    Parameters
+    ----------
+    vehicle : str
+        A vehicle preset name or a vehicle TOML file.
+
+    Returns
+    -------
+    Axis or None
+        The payload axis (kg), the nominal payload first, falling; None without a payload.
+
+    Raises
+    ------
+    WorkbenchInputError
+        An unknown vehicle or a vehicle file it cannot read.
+
+    Examples
+    --------
+    >>> from workbench.apps.robustness import payload_axis
+    >>> payload_axis("tractor-semitrailer").values
+    (17000.0, 8500.0, 0.0)
+    >>> payload_axis("dynamic-bicycle") is None
+    True
+    """
     nominal = _payload_kg(vehicle)
     if nominal is None or nominal <= 0:
         return None
@@ -104,19 +128,56 @@ def payload_axis(vehicle: str) -> Axis | None:
 
 
 def robustness_axes(vehicle: str, axes: Sequence[Axis] = AXES) -> tuple[Axis, ...]:
-    """The factors of a study on `vehicle`: `axes`, and the payload factor when the vehicle carries a payload."""
+    """The factors of a study on `vehicle`: `axes`, and the payload factor when the vehicle carries a payload.
+
+    Parameters
+    ----------
+    vehicle : str
+        A vehicle preset name or a vehicle TOML file.
+    axes : sequence of Axis
+        The condition factors (default `AXES`).
+
+    Returns
+    -------
+    tuple of Axis
+        `axes`, then the payload axis when there is one (`payload_axis`).
+    """
     payload = payload_axis(vehicle)
     return (*axes, payload) if payload is not None else tuple(axes)
 
 
 def payload_mismatch(controller: str) -> str:
-    """What a payload mismatch changes for `controller` (PAYLOAD_MISMATCH)."""
+    """What a payload mismatch changes for `controller` (PAYLOAD_MISMATCH).
+
+    Parameters
+    ----------
+    controller : str
+        A controller's name.
+
+    Returns
+    -------
+    str
+        A phrase for the report; a general one for a controller PAYLOAD_MISMATCH does not name.
+    """
     return PAYLOAD_MISMATCH.get(controller, OTHER_CONTROLLER_MISMATCH)
 
 
 def told_options(controller: str, delays: KnownDelays) -> dict[str, Any]:
     """The options `Controller.informed_config` sets for `delays` on the controller's default config, by name (the
-    values that differ from the default); empty for a controller that is told nothing (Stanley, pure pursuit)."""
+    values that differ from the default); empty for a controller that is told nothing (Stanley, pure pursuit).
+
+    Parameters
+    ----------
+    controller : str
+        A registered controller's name.
+    delays : KnownDelays
+        The nominal delays told.
+
+    Returns
+    -------
+    dict
+        Option name -> the value told.
+    """
     cls = CONTROLLERS[controller]
     default = cls.config_type()
     told = cls.informed_config(default, delays)
@@ -149,7 +210,47 @@ def plan_robustness(
     (`--allow-infeasible`): then where it cannot is said through `warn` (None: silent). inform_delays: every
     run's controller is told the base conditions' nominal delays (`told_options`, the module docstring).
     circuit_ranges: a file whose [circuits] table a circuit:SEED scenario is drawn within (the run parameter of
-    that name; relative to base_dir)."""
+    that name; relative to base_dir).
+
+    Parameters
+    ----------
+    scenario : str
+        A scenario name or a waypoint file (relative to base_dir).
+    controllers : sequence of str
+        The registered controllers compared.
+    vehicle : str
+        A vehicle preset name or a vehicle TOML file.
+    speed_kmh : float
+        Target speed (km/h) of every run.
+    conditions : str
+        The base conditions: a preset name or a conditions file.
+    seed : int
+        The conditions' noise seed.
+    track_file : pathlib.Path or None
+        The Zandvoort track file (None: where it is looked for).
+    base_dir : pathlib.Path or None
+        The folder relative paths are taken from (None: the working directory).
+    axes : sequence of Axis or None
+        The factors (None: `robustness_axes(vehicle)`).
+    allow_long_run, allow_infeasible : bool
+        Plan runs that would otherwise be refused as too long, or on a path the vehicle cannot follow.
+    warn : callable or None
+        Called with each place the vehicle cannot follow when allowed (None: silent).
+    inform_delays : bool
+        Tell every controller the base conditions' nominal delays.
+    circuit_ranges : pathlib.Path or None
+        The ranges file a circuit:SEED scenario is drawn within (None: the defaults).
+
+    Returns
+    -------
+    list of PlannedRun
+        Each distinct run once, indexed in order.
+
+    Raises
+    ------
+    WorkbenchInputError
+        An unknown name, a value or file refused, a run too long or a path infeasible (unless allowed).
+    """
     ranges = None
     if circuit_ranges is not None:
         from workbench.simulation.circuit_ranges import read_circuit_ranges
@@ -248,11 +349,33 @@ class RobustnessResult:
     inform_delays: bool = False
 
     def passed(self, row: pd.Series) -> bool:
-        """Completed, no steering limit cycle, max |CTE| within max_cte_m."""
+        """Completed, no steering limit cycle, max |CTE| within max_cte_m.
+
+        Parameters
+        ----------
+        row : pandas.Series
+            A run's row of `rows`.
+
+        Returns
+        -------
+        bool
+            Whether the run passes (`why_failed` is "").
+        """
         return self.why_failed(row) == ""
 
     def why_failed(self, row: pd.Series) -> str:
-        """Why the run does not pass ("" when it does)."""
+        """Why the run does not pass ("" when it does).
+
+        Parameters
+        ----------
+        row : pandas.Series
+            A run's row of `rows`.
+
+        Returns
+        -------
+        str
+            Its status when it did not complete, "limit cycle", "max |CTE| > ... m", or "".
+        """
         if row["status"] != "completed":
             return str(row["status"])
         if bool(row["limit_cycle"]):
@@ -263,7 +386,20 @@ class RobustnessResult:
 
     def axis_rows(self, axis: Axis, controller: str) -> pd.DataFrame:
         """The runs of one axis and controller, the base run included, by the axis's value (the base's value where
-        the column is empty), in the axis's order."""
+        the column is empty), in the axis's order.
+
+        Parameters
+        ----------
+        axis : Axis
+            One of the study's axes.
+        controller : str
+            One of the study's controllers.
+
+        Returns
+        -------
+        pandas.DataFrame
+            The rows with a ``value`` column (the axis's parameter, in its unit), from the base outward.
+        """
         df = self.rows[self.rows["controller"] == controller]
         others = [a.parameter for a in self.axes if a is not axis and a.parameter in df]
         keep = df[df[others].isna().all(axis=1)].copy()
@@ -273,7 +409,13 @@ class RobustnessResult:
 
     def tolerance(self) -> pd.DataFrame:
         """Per controller and axis: the last value, going outward from the base, at which every run so far passed,
-        the first at which one did not (None when all passed) and how it failed (PASSES_ALL when none did)."""
+        the first at which one did not (None when all passed) and how it failed (PASSES_ALL when none did).
+
+        Returns
+        -------
+        pandas.DataFrame
+            controller, factor, unit, tolerated, fails_at (both in the shown unit), how.
+        """
         out = []
         for controller in self.controllers:
             for axis in self.axes:
@@ -300,13 +442,25 @@ class RobustnessResult:
         return pd.DataFrame(out)
 
     def payload_axis(self) -> Axis | None:
-        """The payload factor among the study's axes (None when the vehicle carries no payload)."""
+        """The payload factor among the study's axes (None when the vehicle carries no payload).
+
+        Returns
+        -------
+        Axis or None
+            The axis of payload_kg.
+        """
         return next((a for a in self.axes if a.parameter == "payload_kg"), None)
 
     def mismatch(self) -> pd.DataFrame:
         """The payload axis's runs per controller, the base (matched) run first: the plant's payload, the payload
         the controller was built for, status, max |CTE|, its change from the base run, oscillation, limit cycle,
-        and what the mismatch changes for that controller (`payload_mismatch`). Empty without a payload axis."""
+        and what the mismatch changes for that controller (`payload_mismatch`). Empty without a payload axis.
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row per run of the payload axis, columns headed as the report shows them.
+        """
         axis = self.payload_axis()
         if axis is None:
             return pd.DataFrame()
@@ -333,7 +487,13 @@ class RobustnessResult:
 
     def payload_summary(self) -> list[str]:
         """One line per controller on the payload axis: max |CTE| at each plant payload, from the matched base run
-        outward, and what the mismatch changes for that controller. Empty without a payload axis."""
+        outward, and what the mismatch changes for that controller. Empty without a payload axis.
+
+        Returns
+        -------
+        list of str
+            A heading line, then one indented line per controller.
+        """
         table, axis = self.mismatch(), self.payload_axis()
         if table.empty or axis is None:  # no payload axis (the table is empty then)
             return []
@@ -345,7 +505,18 @@ class RobustnessResult:
         return lines
 
     def figure(self, axis: Axis) -> Figure:
-        """Max |CTE|, steering oscillation and completion against the axis's value, a line per controller."""
+        """Max |CTE|, steering oscillation and completion against the axis's value, a line per controller.
+
+        Parameters
+        ----------
+        axis : Axis
+            One of the study's axes.
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+            A pyplot figure of three panels (the caller closes it).
+        """
         import matplotlib.pyplot as plt
 
         fig, panels = plt.subplots(1, 3, figsize=(13, 3.6), layout="constrained")
@@ -369,7 +540,13 @@ class RobustnessResult:
         return fig
 
     def report_html(self) -> str:
-        """The self-contained report (figures embedded as base64 PNG), a page of `report.html_page`."""
+        """The self-contained report (figures embedded as base64 PNG), a page of `report.html_page`.
+
+        Returns
+        -------
+        str
+            The whole HTML document.
+        """
         from workbench.apps.report import figure_png, html_page, png_figure, text_table
 
         title = f"Robustness: {', '.join(self.controllers)} on {self.vehicle}, {self.scenario}"
@@ -397,7 +574,18 @@ class RobustnessResult:
         return html_page(title, parts, intro)
 
     def save(self, out_dir: str | Path) -> list[Path]:
-        """DIR/report.html and DIR/tolerance.csv (results.parquet is written as the runs finish)."""
+        """DIR/report.html and DIR/tolerance.csv (results.parquet is written as the runs finish).
+
+        Parameters
+        ----------
+        out_dir : str or pathlib.Path
+            The study's folder DIR (it exists: the runs were written there).
+
+        Returns
+        -------
+        list of pathlib.Path
+            report.html and tolerance.csv.
+        """
         out = Path(out_dir)
         report, table = out / "report.html", out / "tolerance.csv"
         report.write_text(self.report_html(), encoding="utf-8")
@@ -419,7 +607,54 @@ def run_robustness(
     inform_delays: bool = False,
 ) -> RobustnessResult:
     """Run (or resume) the planned runs into out_dir (DIR/runs/, DIR/results.parquet) and return the result;
-    inform_delays: whether `plan_robustness` told the controllers the base conditions' delays (for the report)."""
+    inform_delays: whether `plan_robustness` told the controllers the base conditions' delays (for the report).
+
+    Parameters
+    ----------
+    runs : sequence of PlannedRun
+        The study's runs (`plan_robustness`), at least one.
+    out_dir : str or pathlib.Path
+        The study's folder: runs/ (rows already there are not run again) and results.parquet.
+    backend : Backend
+        Where the runs execute (`make_backend`), left running.
+    scenario : str
+        The scenario, for the report.
+    vehicle : str
+        A vehicle preset name or a vehicle TOML file.
+    controllers : sequence of str
+        The controllers planned, in the report's order.
+    conditions : str
+        The base conditions, for the report.
+    speed_kmh : float
+        The target speed (km/h), for the report.
+    progress : bool
+        Show a bar on stderr counting the runs left to do.
+    max_cte_m : float
+        The largest max |CTE| (m) a passing run may have; positive.
+    inform_delays : bool
+        Whether the runs' controllers were told the base conditions' delays.
+
+    Returns
+    -------
+    RobustnessResult
+        The rows and what was asked; `tolerance()` says where each controller stops passing.
+
+    Raises
+    ------
+    WorkbenchInputError
+        No runs, or max_cte_m not positive.
+    BackendError
+        The backend's machinery failed; the rows already written stay.
+
+    Examples
+    --------
+    >>> from workbench.apps.robustness import plan_robustness, run_robustness
+    >>> from workbench.apps.studies import make_backend
+    >>> runs = plan_robustness("dlc", ["clothoid", "stanley"], "dynamic-bicycle")  # doctest: +SKIP
+    >>> with make_backend("local", workers=2) as backend:  # doctest: +SKIP
+    ...     result = run_robustness(runs, "runs/robust", backend, "dlc", "dynamic-bicycle", ["clothoid", "stanley"])
+    >>> result.tolerance()  # doctest: +SKIP
+    """
     require_positive("max_cte_m", max_cte_m)
     if not runs:
         raise WorkbenchInputError("the robustness study plans no runs")

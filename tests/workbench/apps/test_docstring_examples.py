@@ -19,6 +19,7 @@ MODULES = (
     "workbench.apps.fig17",
     "workbench.apps.paper",
     "workbench.apps.report",
+    "workbench.apps.robustness",
     "workbench.apps.studies.backends",
     "workbench.apps.studies.circuit_parameters",
     "workbench.apps.studies.distributions",
