@@ -93,7 +93,18 @@ FILE_OPTIONS: dict[str, FileOption] = {
 
 def option_types(config_type: type) -> dict[str, Any]:
     """The options a config file or `--set` may give for `config_type`, with their types: its fields, with each
-    field that holds an object read from a file named by its file option instead (`filter_file: Path | None`)."""
+    field that holds an object read from a file named by its file option instead (`filter_file: Path | None`).
+
+    Parameters
+    ----------
+    config_type : type
+        A controller's config dataclass (e.g. `StanleyConfig`).
+
+    Returns
+    -------
+    dict
+        Option name -> its type annotation, in the config's field order.
+    """
     by_field = {option.field: name for name, option in FILE_OPTIONS.items()}
     return {
         by_field.get(name, name): (Path | None if name in by_field else t)
@@ -111,7 +122,39 @@ def build_config(
     """An instance of `config_type` from `values` (a TOML table, its values typed as they are) and `key=value`
     overrides (text, parsed as each option's type); its defaults otherwise. File options are read into their
     objects here (`FILE_OPTIONS`; `geometry`: the steered vehicle's, which a limits file without a rate column
-    needs)."""
+    needs).
+
+    Parameters
+    ----------
+    config_type : type
+        A controller's config dataclass (e.g. `StanleyConfig`).
+    values : mapping or None
+        Option -> value, as a TOML table holds them (None: none).
+    overrides : iterable of str
+        ``key=value`` texts over `values`, each parsed as its option's type.
+    base_dir : pathlib.Path or None
+        The folder relative file paths are taken from (None: the working directory).
+    geometry : VehicleGeometry or None
+        The steered vehicle's geometry, which a limits file without a rate column needs (None: none).
+
+    Returns
+    -------
+    object
+        The config, checked by its own validation.
+
+    Raises
+    ------
+    WorkbenchInputError
+        An unknown option, a malformed override, a value of the wrong type or out of its range, or a file that
+        cannot be read.
+
+    Examples
+    --------
+    >>> from controllers.stanley import StanleyConfig
+    >>> from workbench.apps.controller_config import build_config
+    >>> build_config(StanleyConfig, overrides=["gain_per_s=2.5"]).gain_per_s
+    2.5
+    """
     types = option_types(config_type)
     merged: dict[str, Any] = {}
     items = [(key, value, False) for key, value in (values or {}).items()]  # TOML values: typed as they are
@@ -135,7 +178,23 @@ def build_config(
 def read_config_tables(path: str | Path) -> dict[str, dict[str, Any]]:
     """The tables of the controller-config file at `path`, by controller name. Refused (WorkbenchInputError naming
     the file): a key outside any table, and a table whose name is no registered controller (the close one
-    suggested), so that no option in the file goes unread."""
+    suggested), so that no option in the file goes unread.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        A controller-config TOML file.
+
+    Returns
+    -------
+    dict
+        Controller name -> its table.
+
+    Raises
+    ------
+    WorkbenchInputError
+        The file is missing or not TOML, a key is outside any table, or a table names no registered controller.
+    """
     from controllers import CONTROLLERS
 
     what = f"controller config file {str(path)!r}"
@@ -164,7 +223,25 @@ def _suggestion(name: str, names: Iterable[str]) -> str:
 def missing_table_warning(path: str | Path, controller_name: str) -> str | None:
     """A warning when the controller-config file at `path` has no table for `controller_name` (which then runs
     with its defaults), naming the tables it has; None when it has one. The file is read and checked as
-    `read_config_tables` does."""
+    `read_config_tables` does.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        A controller-config TOML file.
+    controller_name : str
+        The controller the file is given for.
+
+    Returns
+    -------
+    str or None
+        The warning, or None when the file has the table.
+
+    Raises
+    ------
+    WorkbenchInputError
+        As `read_config_tables`.
+    """
     return _missing_table_text(path, controller_name, read_config_tables(path))
 
 
@@ -189,7 +266,33 @@ def read_controller_config(
     """The config of `controller_name` from the table of that name in the TOML file at `path` (None: no file),
     with `overrides` applied on top; file options read into objects (`build_config`). The file is checked as
     `read_config_tables` does; `warn` (None: silent) is told when it has no table for the controller
-    (`missing_table_warning`)."""
+    (`missing_table_warning`).
+
+    Parameters
+    ----------
+    path : str or pathlib.Path or None
+        A controller-config TOML file (None: none, the defaults and overrides only).
+    controller_name : str
+        The registered controller whose table is read.
+    config_type : type
+        A controller's config dataclass (e.g. `StanleyConfig`).
+    overrides : iterable of str
+        ``key=value`` texts (`--set`) over the file's table.
+    geometry : VehicleGeometry or None
+        The steered vehicle's geometry, which a limits file without a rate column needs (None: none).
+    warn : callable or None
+        Called with the warning when the file has no table for the controller (None: silent).
+
+    Returns
+    -------
+    object
+        The controller's config.
+
+    Raises
+    ------
+    WorkbenchInputError
+        As `read_config_tables` and `build_config`, the message naming the file and the table.
+    """
     table: Mapping[str, Any] = {}
     base_dir = None
     if path is not None:
@@ -216,7 +319,20 @@ def config_template(controller_name: str, config_type: type) -> str:
     --show NAME`). Above each option, as comments, what it does, its unit, its default and what it allows, from its
     field's metadata (`controllers.config_checks.option`: the rule its config's validation checks); a field without
     that metadata is listed undocumented. Options whose default is an object read from a file are written commented
-    out; the text reads back (`read_controller_config`) to the defaults."""
+    out; the text reads back (`read_controller_config`) to the defaults.
+
+    Parameters
+    ----------
+    controller_name : str
+        The table's name.
+    config_type : type
+        A controller's config dataclass (e.g. `StanleyConfig`).
+
+    Returns
+    -------
+    str
+        The TOML text, lines of at most TEMPLATE_WIDTH characters in its comments.
+    """
     defaults = config_type()
     by_field = {option.field: name for name, option in FILE_OPTIONS.items()}
     lines = [

@@ -16,6 +16,7 @@ ROOT = Path(__file__).resolve().parents[3]
 #: The modules whose docstrings carry examples, each run as a doctest.
 MODULES = (
     "workbench.apps.comparison",
+    "workbench.apps.controller_config",
     "workbench.apps.fig17",
     "workbench.apps.paper",
     "workbench.apps.report",
