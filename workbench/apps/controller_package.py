@@ -207,7 +207,24 @@ def _read_path(file: Path, manifest: dict[str, Any]) -> ReferencePath:
 
 
 def read_manifest(folder: Path) -> dict[str, Any]:
-    """The package's manifest, checked for the keys and format this version reads."""
+    """The package's manifest, checked for the keys and format this version reads.
+
+    Parameters
+    ----------
+    folder : pathlib.Path
+        A package folder (`pack_controller`).
+
+    Returns
+    -------
+    dict
+        The manifest's keys: format, controller, period_s, path_name, path_spacing_m, path_closed and the others
+        written.
+
+    Raises
+    ------
+    WorkbenchInputError
+        The manifest is missing, not JSON, lacks a key, or is of another format.
+    """
     file = folder / MANIFEST_FILE
     label = f"controller package manifest {str(file)!r}"
     manifest = parse_json(read_text(file, label), label, allow_nan=False)
@@ -224,7 +241,24 @@ def read_manifest(folder: Path) -> dict[str, Any]:
 
 def load_packed_controller(folder: Path) -> PackedController:
     """Build the packed controller as `workbench run` would (the vehicle from its file, the options from
-    controller.toml, `tuned_controller`) and reset it on the packed path."""
+    controller.toml, `tuned_controller`) and reset it on the packed path.
+
+    Parameters
+    ----------
+    folder : pathlib.Path
+        A package folder (`pack_controller`).
+
+    Returns
+    -------
+    PackedController
+        The controller, reset on the packed path, with the path, its period (s) and a description.
+
+    Raises
+    ------
+    WorkbenchInputError
+        A manifest refused (`read_manifest`), a controller not installed here, or a packed file that cannot be
+        read.
+    """
     from controllers import CONTROLLERS
     from tuning.own_tuning import tuned_controller
     from workbench.apps.controller_config import read_controller_config

@@ -41,7 +41,24 @@ class {identifier}(ControllerSlave):
 
 def model_identifier(controller: str) -> str:
     """The FMU's model identifier for a controller name: its words capitalised, then "Controller" (a C name:
-    `pure-pursuit` gives PurePursuitController)."""
+    `pure-pursuit` gives PurePursuitController).
+
+    Parameters
+    ----------
+    controller : str
+        A controller's registered name.
+
+    Returns
+    -------
+    str
+        A C identifier.
+
+    Examples
+    --------
+    >>> from workbench.apps.fmu_export import model_identifier
+    >>> model_identifier("pure-pursuit"), model_identifier("nmpc")
+    ('PurePursuitController', 'NmpcController')
+    """
     words = [w for w in re.split(r"[^A-Za-z0-9]+", controller) if w]
     identifier = "".join(w[0].upper() + w[1:] for w in words) + "Controller"
     return identifier if identifier[0].isalpha() else f"X{identifier}"
@@ -49,7 +66,20 @@ def model_identifier(controller: str) -> str:
 
 def check_fmu_target(out: Path, overwrite: bool) -> None:
     """Refuse an --out that is not a writable FILE.fmu: another suffix, a folder, an existing file without
-    --overwrite, a parent that is missing or not a folder."""
+    --overwrite, a parent that is missing or not a folder.
+
+    Parameters
+    ----------
+    out : pathlib.Path
+        The FMU file to write.
+    overwrite : bool
+        Whether an existing file may be replaced.
+
+    Raises
+    ------
+    WorkbenchInputError
+        Any of those, naming --out.
+    """
     if out.is_dir():
         raise WorkbenchInputError(f"--out {str(out)!r} is a folder; name the FMU file to write")
     if out.suffix.lower() != ".fmu":
@@ -66,7 +96,22 @@ def check_fmu_target(out: Path, overwrite: bool) -> None:
 def named_files(config_path: Path | None, controller: str, overrides: Iterable[str]) -> dict[str, Path]:
     """The files the file options (`FILE_OPTIONS`) of the controller's config file table and of the `--set`
     overrides name, resolved as `read_controller_config` resolves them (the last one given wins; "none" drops
-    one). The options are checked by `read_controller_config` first; this only finds their files to pack."""
+    one). The options are checked by `read_controller_config` first; this only finds their files to pack.
+
+    Parameters
+    ----------
+    config_path : pathlib.Path or None
+        The controller-config file (None: none).
+    controller : str
+        The controller whose table is read.
+    overrides : iterable of str
+        The ``key=value`` overrides (`--set`).
+
+    Returns
+    -------
+    dict of str to pathlib.Path
+        File option -> the file or folder it names.
+    """
     from workbench.apps.controller_config import FILE_OPTIONS, read_config_tables
     from workbench.base.typed_tables import typed_value
 
@@ -99,7 +144,25 @@ def build_controller_fmu(
     period_s: float,
 ) -> Path:
     """Pack the controller (`controller_package.pack_controller`, whose arguments these are) and build the FMU at
-    `out` (replaced whole: written beside it, then renamed); returns `out`."""
+    `out` (replaced whole: written beside it, then renamed); returns `out`.
+
+    Parameters
+    ----------
+    out : pathlib.Path
+        The FMU file (`check_fmu_target`).
+    controller, vehicle, options, files, path, period_s
+        As `controller_package.pack_controller` takes them (files: its named_files).
+
+    Returns
+    -------
+    pathlib.Path
+        `out`.
+
+    Raises
+    ------
+    WorkbenchInputError
+        PythonFMU could not build the FMU, or packing refused a value.
+    """
     from pythonfmu import FmuBuilder
 
     from workbench.apps.controller_package import pack_controller

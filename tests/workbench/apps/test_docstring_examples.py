@@ -18,6 +18,7 @@ MODULES = (
     "workbench.apps.comparison",
     "workbench.apps.controller_config",
     "workbench.apps.fig17",
+    "workbench.apps.fmu_export",
     "workbench.apps.paper",
     "workbench.apps.report",
     "workbench.apps.robustness",
