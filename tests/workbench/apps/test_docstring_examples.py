@@ -24,6 +24,7 @@ MODULES = (
     "workbench.apps.robustness",
     "workbench.apps.studies.backends",
     "workbench.apps.studies.circuit_parameters",
+    "workbench.apps.studies.condition_parameters",
     "workbench.apps.studies.distributions",
     "workbench.apps.studies.optimise",
     "workbench.apps.studies.plots",

@@ -39,7 +39,25 @@ CONDITION_PARAMETERS: dict[str, Any] = {"conditions": str, **{k: t for k, (_, _,
 
 def resolve_conditions(value: str, base_dir: Path) -> str:
     """A `conditions` value as a run keeps it: a preset name, or the absolute path of a conditions file (relative to
-    base_dir), read once here so that a file no run can use is refused before any run."""
+    base_dir), read once here so that a file no run can use is refused before any run.
+
+    Parameters
+    ----------
+    value : str
+        A conditions preset's name or a conditions TOML file.
+    base_dir : pathlib.Path
+        The folder a relative file is taken from (the spec's).
+
+    Returns
+    -------
+    str
+        The preset's name, or the file's absolute path.
+
+    Raises
+    ------
+    WorkbenchInputError
+        An unknown preset, a missing file, or a file the conditions refuse.
+    """
     if value in CONDITIONS:
         return value
     path = Path(value)
@@ -52,7 +70,32 @@ def resolve_conditions(value: str, base_dir: Path) -> str:
 
 def run_conditions(name: str | None, fields: Mapping[str, Any]) -> Conditions:
     """The conditions of a run: the preset or file `name` (None: ideal), its fields set from `fields` (names of
-    CONDITION_FIELDS); named "<name>+" when a field changed it, so reports tell them apart."""
+    CONDITION_FIELDS); named "<name>+" when a field changed it, so reports tell them apart.
+
+    Parameters
+    ----------
+    name : str or None
+        A conditions preset or file (None: ideal).
+    fields : mapping
+        `CONDITION_FIELDS` name -> value, set over the named conditions.
+
+    Returns
+    -------
+    Conditions
+        The run's conditions.
+
+    Raises
+    ------
+    WorkbenchInputError
+        An unknown preset, a file it cannot read, or a field value the conditions refuse.
+
+    Examples
+    --------
+    >>> from workbench.apps.studies.condition_parameters import run_conditions
+    >>> conditions = run_conditions("automotive", {"actuation_dead_time_s": 0.2})
+    >>> conditions.name, conditions.actuation.dead_time_s
+    ('automotive+', 0.2)
+    """
     conditions = load_conditions(name or "ideal")
     changes: dict[str, dict[str, Any]] = {}
     for key, value in fields.items():
