@@ -66,23 +66,73 @@ class FrechetVsLookahead:
     s_m: float = math.nan
 
     def to_pandas(self) -> pd.DataFrame:
+        """The curve as a table.
+
+        Returns
+        -------
+        pandas.DataFrame
+            lookahead_m and frechet_m, one row per candidate.
+        """
         return pd.DataFrame({"lookahead_m": self.lookahead_m, "frechet_m": self.frechet_m})
 
     def chosen_lookahead_m(self, threshold_m: float = DEFAULT_FRECHET_THRESHOLD_M) -> float:
         """The largest lookahead (m) whose Fréchet distance stays within threshold_m, as the adaptive search picks
-        it (before the end-point tolerances, the floor and the filter); NaN when none does."""
+        it (before the end-point tolerances, the floor and the filter); NaN when none does.
+
+        Parameters
+        ----------
+        threshold_m : float
+            The Fréchet threshold (m), positive (default: the controller's).
+
+        Returns
+        -------
+        float
+            The lookahead (m), or NaN.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> from workbench.apps.lookahead_study import FrechetVsLookahead
+        >>> curve = FrechetVsLookahead(np.array([5.0, 10.0, 15.0, 20.0]), np.array([0.0, 0.01, 0.04, 0.09]), "bend")
+        >>> curve.chosen_lookahead_m(0.05), curve.crosses(0.05)
+        (15.0, True)
+        """
         within = np.flatnonzero(self.frechet_m <= threshold_m)
         return float(self.lookahead_m[within[-1]]) if within.size else math.nan
 
     def crosses(self, threshold_m: float = DEFAULT_FRECHET_THRESHOLD_M) -> bool:
         """Whether the Fréchet distance starts within threshold_m and ends above it (the threshold then picks a
-        lookahead inside the range)."""
+        lookahead inside the range).
+
+        Parameters
+        ----------
+        threshold_m : float
+            The Fréchet threshold (m), positive (default: the controller's).
+
+        Returns
+        -------
+        bool
+            True when the first candidate is within it and the last is above.
+        """
         return bool(self.frechet_m[0] <= threshold_m < self.frechet_m[-1])
 
     def plot(self, ax: Axes | None = None, threshold_m: float | None = DEFAULT_FRECHET_THRESHOLD_M) -> Axes:
         """The Fréchet distance against the lookahead; with threshold_m (the controller's default unless given; None:
         none), the threshold and the lookahead it picks. The axis runs from 0 to above the larger of the curve and
-        the threshold, so both show."""
+        the threshold, so both show.
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+            The axes to draw on (None: a fresh pyplot figure's).
+        threshold_m : float or None
+            The Fréchet threshold (m) drawn, with the lookahead it picks (None: neither).
+
+        Returns
+        -------
+        matplotlib.axes.Axes
+            The axes drawn on.
+        """
         import matplotlib.pyplot as plt
 
         if ax is None:
@@ -109,7 +159,33 @@ def frechet_vs_lookahead(
     lookaheads_m: np.ndarray = DEFAULT_LOOKAHEADS_M,
     max_curvature_rate_1pm2: float = DEFAULT_MAX_CURVATURE_RATE_1PM2,
 ) -> FrechetVsLookahead:
-    """Score every lookahead for a vehicle at s (offset by cte, turned by heading_error, on the path's curvature)."""
+    """Score every lookahead for a vehicle at s (offset by cte, turned by heading_error, on the path's curvature).
+
+    Parameters
+    ----------
+    path : ReferencePath
+        The reference path.
+    s_m : float
+        Arc length (m) of the vehicle's place on the path.
+    cte_m : float
+        The vehicle's lateral offset (m) from the path, left positive.
+    heading_error_rad : float
+        The vehicle's heading error (rad) from the path's heading.
+    lookaheads_m : numpy.ndarray
+        The candidate lookaheads (m), increasing (default: the controller's).
+    max_curvature_rate_1pm2 : float
+        The clothoid's kappa' saturation (1/m^2; default: the controller's).
+
+    Returns
+    -------
+    FrechetVsLookahead
+        The Fréchet distance (m) of each candidate.
+
+    Raises
+    ------
+    WorkbenchInputError
+        s_m outside the path, or an offset or heading error not finite.
+    """
     evaluator = LookaheadEvaluator(path)
     x, y, heading = _pose(path, s_m, cte_m, heading_error_rad)
     kappa = float(path.curvature(s_m))
@@ -132,7 +208,31 @@ def growing_stretch(
 ) -> FrechetVsLookahead:
     """Figure 4b's stretch: of the places on the path every step_m (a vehicle on the path, at its curvature), the one
     whose Fréchet distance crosses threshold_m among the lookaheads and grows most across them (where the curvature
-    ahead changes most within the lookahead range). Refused for a path without such a place (a straight, a circle)."""
+    ahead changes most within the lookahead range). Refused for a path without such a place (a straight, a circle).
+
+    Parameters
+    ----------
+    path : ReferencePath
+        The reference path.
+    threshold_m : float
+        The Fréchet threshold (m), positive.
+    lookaheads_m : numpy.ndarray
+        The candidate lookaheads (m), increasing.
+    max_curvature_rate_1pm2 : float
+        The clothoid's kappa' saturation (1/m^2).
+    step_m : float
+        Spacing (m) of the places tried, positive.
+
+    Returns
+    -------
+    FrechetVsLookahead
+        The curve at the place found.
+
+    Raises
+    ------
+    WorkbenchInputError
+        threshold_m or step_m not positive, or no place where the curve crosses the threshold.
+    """
     require_positive("threshold_m", threshold_m)
     require_positive("step_m", step_m)
     best: FrechetVsLookahead | None = None
@@ -159,11 +259,30 @@ class MinFrechetVsCte:
     best_lookahead_m: np.ndarray
 
     def to_pandas(self) -> pd.DataFrame:
+        """The curve as a table.
+
+        Returns
+        -------
+        pandas.DataFrame
+            cte_m, min_frechet_m and best_lookahead_m, one row per initial CTE.
+        """
         return pd.DataFrame(
             {"cte_m": self.cte_m, "min_frechet_m": self.min_frechet_m, "best_lookahead_m": self.best_lookahead_m}
         )
 
     def plot(self, ax: Axes | None = None) -> Axes:
+        """Figure 5b: the minimum Fréchet distance against the initial CTE.
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+            The axes to draw on (None: a fresh pyplot figure's).
+
+        Returns
+        -------
+        matplotlib.axes.Axes
+            The axes drawn on.
+        """
         import matplotlib.pyplot as plt
 
         if ax is None:
@@ -185,7 +304,33 @@ def min_frechet_vs_cte(
     lookaheads_m: np.ndarray = DEFAULT_LOOKAHEADS_M,
     max_curvature_rate_1pm2: float = DEFAULT_MAX_CURVATURE_RATE_1PM2,
 ) -> MinFrechetVsCte:
-    """For each initial CTE, the least Fréchet distance over the lookaheads and the lookahead that gives it."""
+    """For each initial CTE, the least Fréchet distance over the lookaheads and the lookahead that gives it.
+
+    Parameters
+    ----------
+    path : ReferencePath
+        The reference path.
+    s_m : float
+        Arc length (m) of the vehicle's place on the path.
+    ctes_m : numpy.ndarray
+        The initial lateral offsets (m), left positive.
+    heading_error_rad : float
+        The vehicle's heading error (rad) from the path's heading.
+    lookaheads_m : numpy.ndarray
+        The candidate lookaheads (m), increasing (default: the controller's).
+    max_curvature_rate_1pm2 : float
+        The clothoid's kappa' saturation (1/m^2; default: the controller's).
+
+    Returns
+    -------
+    MinFrechetVsCte
+        One point per initial CTE.
+
+    Raises
+    ------
+    WorkbenchInputError
+        s_m outside the path, or an offset or heading error not finite.
+    """
     best, where = [], []
     for cte in ctes_m:
         sweep = frechet_vs_lookahead(path, s_m, float(cte), heading_error_rad, lookaheads_m, max_curvature_rate_1pm2)

@@ -19,6 +19,7 @@ MODULES = (
     "workbench.apps.controller_config",
     "workbench.apps.fig17",
     "workbench.apps.fmu_export",
+    "workbench.apps.lookahead_study",
     "workbench.apps.paper",
     "workbench.apps.report",
     "workbench.apps.robustness",
