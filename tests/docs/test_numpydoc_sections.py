@@ -7,6 +7,7 @@ from __future__ import annotations
 import ast
 import importlib
 import inspect
+import itertools
 import textwrap
 from collections.abc import Callable, Iterator
 from typing import Any
@@ -20,7 +21,7 @@ _PROJECT = ("workbench", "controllers", "tuning")
 
 def _section(doc: str, name: str) -> bool:
     lines = doc.splitlines()
-    return any(a.strip() == name and set(b.strip()) == {"-"} for a, b in zip(lines, lines[1:], strict=False))
+    return any(a.strip() == name and set(b.strip()) == {"-"} for a, b in itertools.pairwise(lines))
 
 
 def _public_callables() -> Iterator[tuple[str, Callable[..., Any]]]:
