@@ -56,46 +56,38 @@ METRIC_KEYS: tuple[str, ...] = (
 class Metrics:
     """Summary of one run; None where a quantity does not apply (no samples, no trailer, no roll model).
 
-    distance_m: distance travelled by the reference point; path_length_m: the length the run was asked to cover
-    (the path, times the laps of a closed path); max_abs_cte_on_path_m: the max |CTE| from the first sample within
-    CONVERGED_CTE_M of the path (`approach_end`): max_abs_cte_m itself for a run that starts on the path, and for
-    one started off it (fig17's 1 m) its tracking once it has come onto the path, overshoot included, without the
-    start every controller shares; max_abs_steer_rate_deg_s, rms_steer_rate_deg_s: the largest and the
-    RMS steering-wheel rate (the steering effort), from the measured steering-wheel angle differenced at the
-    controller rate; steer_oscillation_deg: the RMS of the measured steering-wheel angle about its centred 1 s moving
-    average, away from the trace's ends (`limit_cycle.oscillation`; None for a trace under about 2 s);
-    limit_cycle, limit_cycle_hz, limit_cycle_amplitude_deg: whether the steering wheel limit-cycles, at what
-    frequency and steering-wheel amplitude (`limit_cycle.detect_limit_cycle`; None when it does not);
-    max_offtracking_m: the largest lateral distance of the trailer's rear-axle centre from the path;
-    min_track_margin_m: the least distance (m) from the vehicle's outline (the trailer's too) to an edge of the track,
-    negative when it went beyond one (`track_margin.track_margins`); left_track: whether it did; both None when the
-    path has no track widths or the outline is not known.
+    CTE is the signed cross-track error at the reference point (left of the path positive). The steering-wheel
+    rates difference the measured steering-wheel angle at the controller rate; the oscillation is
+    `limit_cycle.oscillation`'s, away from the trace's ends. max_abs_cte_on_path_m is max_abs_cte_m itself for a
+    run that starts on the path; for one started off it (fig17's 1 m) it is the tracking once the run has come onto
+    the path, overshoot included, without the approach every controller shares. The track fields
+    (`track_margin.track_margins`) are None when the path has no track widths or the vehicle's outline is not known.
     """
 
-    scenario: str
-    controller: str
-    vehicle: str
-    completed: bool
-    distance_m: float
-    path_length_m: float
-    max_abs_cte_m: float | None
-    max_abs_cte_on_path_m: float | None
-    rms_cte_m: float | None
-    max_abs_heading_error_deg: float | None
-    max_abs_steer_wheel_deg: float | None
-    max_abs_steer_rate_deg_s: float | None
-    rms_steer_rate_deg_s: float | None
-    steer_oscillation_deg: float | None
-    limit_cycle: bool
-    limit_cycle_hz: float | None
-    limit_cycle_amplitude_deg: float | None
-    max_abs_lat_accel_g: float | None
-    max_ltr: float | None
-    max_offtracking_m: float | None
-    step_time_median_us: float | None
-    step_time_p99_us: float | None
-    min_track_margin_m: float | None = None
-    left_track: bool | None = None
+    scenario: str  # the scenario's name
+    controller: str  # the controller's name
+    vehicle: str  # the vehicle model's name
+    completed: bool  # whether the run completed (`Status.COMPLETED`)
+    distance_m: float  # m, >= 0; distance travelled by the reference point
+    path_length_m: float  # m; length the run was asked to cover: the path's, times the laps of a closed path
+    max_abs_cte_m: float | None  # m; the largest |CTE| over the run
+    max_abs_cte_on_path_m: float | None  # m; the largest |CTE| once on the path (from `approach_end`)
+    rms_cte_m: float | None  # m; the RMS CTE over the run
+    max_abs_heading_error_deg: float | None  # deg; the largest |heading error| to the path
+    max_abs_steer_wheel_deg: float | None  # deg; the largest |measured steering-wheel angle|
+    max_abs_steer_rate_deg_s: float | None  # deg/s; the largest |steering-wheel rate|
+    rms_steer_rate_deg_s: float | None  # deg/s; the RMS steering-wheel rate (the steering effort)
+    steer_oscillation_deg: float | None  # deg; RMS wheel angle about its centred 1 s mean (None: < ~2 s)
+    limit_cycle: bool  # whether the steering wheel limit-cycles (`limit_cycle.detect_limit_cycle`)
+    limit_cycle_hz: float | None  # Hz; the limit cycle's frequency (None when there is none)
+    limit_cycle_amplitude_deg: float | None  # deg; the limit cycle's steering-wheel amplitude (None when none)
+    max_abs_lat_accel_g: float | None  # g; the largest |lateral acceleration|
+    max_ltr: float | None  # 1; the largest |load transfer ratio| (1 is wheel lift-off; None: no roll model)
+    max_offtracking_m: float | None  # m; largest lateral distance of the trailer's rear-axle centre from the path
+    step_time_median_us: float | None  # µs; the median wall time of one controller step
+    step_time_p99_us: float | None  # µs; the 99th percentile of the wall time of one controller step
+    min_track_margin_m: float | None = None  # m; outline's (trailer's too) least distance to a track edge, < 0 beyond
+    left_track: bool | None = None  # whether the outline went beyond a track edge (min_track_margin_m < 0)
 
     def to_dict(self) -> dict[str, object]:
         """The metrics as metrics.json holds them.
