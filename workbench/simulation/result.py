@@ -38,21 +38,23 @@ class Status(StrEnum):
 
 @dataclass(frozen=True, eq=False)
 class SimulationResult:
-    """trace: one array per logged signal (SI units, units in the names), one row per controller step; outline: the
-    vehicle's plan-view outline, for the track margin (None: not known, the track metrics are null);
-    infeasible_curvature: where the vehicle cannot follow the path at its planned speed (`feasibility.check_path`;
-    empty when it can, None when not checked)."""
+    """One closed-loop run: its trace, how and why it ended, what it ran; computes its metrics on first use.
 
-    trace: dict[str, np.ndarray]
-    status: Status
-    message: str
-    scenario: Scenario
-    path: ReferencePath
-    controller: str
-    vehicle: str
-    config: SimulationConfig
-    outline: VehicleOutline | None = None
-    infeasible_curvature: tuple[InfeasibleSpan, ...] | None = None
+    A run that did not complete keeps its partial trace; `status` and `message` say why it stopped. Without an
+    `outline` the track metrics are null. `infeasible_curvature` lists where the vehicle cannot follow the path at
+    its planned speed (`feasibility.check_path`): empty when it can, None when not checked.
+    """
+
+    trace: dict[str, np.ndarray]  # one array per logged signal (SI, unit in the name), one row per controller step
+    status: Status  # how the run ended
+    message: str  # why it ended, in words (what failed and when, for a run that did not complete)
+    scenario: Scenario  # the scenario run
+    path: ReferencePath  # the path the vehicle followed
+    controller: str  # the controller's name
+    vehicle: str  # the vehicle model's name
+    config: SimulationConfig  # how the run was simulated (speed, rates, laps, conditions)
+    outline: VehicleOutline | None = None  # vehicle's plan-view outline, for the track margin (None: not known)
+    infeasible_curvature: tuple[InfeasibleSpan, ...] | None = None  # spans it cannot follow at speed
     _metrics: list[Metrics] = field(default_factory=list, repr=False)
 
     @property
