@@ -25,23 +25,20 @@ COMMAND_REJECTED = "command_rejected"
 class Measurement:
     """What the sensors give at one controller step (SI units).
 
-    x_m, y_m: position of the reference point (the tractor's rear-axle centre, where the paper measures CTE);
-    vx_mps, vy_mps: its velocity in the vehicle frame; yaw_rad, yaw_rate_rad_s: heading and its rate;
-    steer_wheel_rad: measured steering-wheel angle; t_s: time.
-
-    Each field is a real number: a float, an int or a NumPy real scalar. A controller's step (`controllers.base`)
-    holds its last command on a frame with a field that is not (a bool, a complex number, a string, None, an
-    array), as on a non-finite or implausible one, and says which field and value in its `rejection`.
+    The reference point is the tractor's rear-axle centre, where the paper measures CTE. Each field is a real
+    number: a float, an int or a NumPy real scalar. A controller's step (`controllers.base`) holds its last command
+    on a frame with a field that is not (a bool, a complex number, a string, None, an array), as on a non-finite or
+    implausible one, and says which field and value in its `rejection`.
     """
 
-    t_s: float
-    x_m: float
-    y_m: float
-    vx_mps: float
-    vy_mps: float
-    yaw_rad: float
-    yaw_rate_rad_s: float
-    steer_wheel_rad: float
+    t_s: float  # s; time of the measurement
+    x_m: float  # m; x of the reference point
+    y_m: float  # m; y of the reference point
+    vx_mps: float  # m/s; the reference point's longitudinal velocity, in the vehicle frame
+    vy_mps: float  # m/s; the reference point's lateral velocity, in the vehicle frame
+    yaw_rad: float  # rad; heading, counter-clockwise from x
+    yaw_rate_rad_s: float  # rad/s; heading rate, counter-clockwise positive
+    steer_wheel_rad: float  # rad; measured steering-wheel angle, positive left
 
     @property
     def speed_mps(self) -> float:
