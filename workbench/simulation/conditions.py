@@ -65,20 +65,17 @@ def _require_text(name: str, value: object) -> None:
 class Localisation:
     """The pose (x, y, yaw) and the velocity (vx, vy) a GNSS/INS gives.
 
-    position_noise_m: sigma of white noise on x and on y (m); position_drift_m: sigma of a first-order Gauss-Markov
-    drift on x and on y (m), each started from its stationary distribution; position_drift_time_s: its
-    correlation time tau (s); heading_noise_rad: sigma of white noise on the yaw (rad); update_rate_hz: None, the
-    pose refreshed at every controller step; else the pose and the velocity refreshed at the multiples of
-    1 / update_rate_hz of the run's clock and held in between (noise drawn with each refresh); latency_s: the
-    refreshed pose and velocity are those of latency_s earlier (s).
+    The drift on x and on y starts from its stationary distribution. With an update rate, the pose and the velocity
+    are refreshed at the multiples of 1 / update_rate_hz of the run's clock and held in between, the noise drawn
+    with each refresh.
     """
 
-    position_noise_m: float = 0.0
-    position_drift_m: float = 0.0
-    position_drift_time_s: float = 60.0
-    heading_noise_rad: float = 0.0
-    update_rate_hz: float | None = None
-    latency_s: float = 0.0
+    position_noise_m: float = 0.0  # sigma of white noise on x and on y (m), in [0, 100]
+    position_drift_m: float = 0.0  # sigma of a first-order Gauss-Markov drift on x and on y (m), in [0, 100]
+    position_drift_time_s: float = 60.0  # the drift's correlation time tau (s), in [0.001, 1e6]
+    heading_noise_rad: float = 0.0  # sigma of white noise on the yaw (rad), in [0, 0.5]
+    update_rate_hz: float | None = None  # pose and velocity refresh rate (Hz), in [0.001, 10000]; None: every step
+    latency_s: float = 0.0  # the refreshed pose and velocity are those of this much earlier (s), in [0, 2]
 
     def __post_init__(self) -> None:
         require_in_range("localisation.position_noise_m", self.position_noise_m, 0.0, MAX_POSITION_SIGMA_M, "m")
@@ -109,18 +106,16 @@ class Localisation:
 class Inertial:
     """The yaw rate and the speed.
 
-    yaw_rate_noise_rad_s: sigma of white noise on the yaw rate (rad/s), drawn every controller step;
-    yaw_rate_bias_rad_s: a constant bias added to it (rad/s); speed_noise_mps: sigma of white noise on the speed
-    (m/s): the measured velocity (vx, vy) is scaled by (v + n) / v, v its magnitude, so the noise is on the speed
-    and the direction of travel (the side-slip) is kept; it is drawn with each refresh of the velocity, which
-    follows the localisation's update rate and latency; latency_s: the yaw rate seen is that of latency_s earlier
-    (s), its own latency (e.g. a vehicle bus), independent of the localisation's.
+    The speed noise n scales the measured velocity (vx, vy) by (v + n) / v, v its magnitude, so the noise is on the
+    speed and the direction of travel (the side-slip) is kept; it is drawn with each refresh of the velocity, which
+    follows the localisation's update rate and latency. The yaw rate's latency is its own (e.g. a vehicle bus),
+    independent of the localisation's.
     """
 
-    yaw_rate_noise_rad_s: float = 0.0
-    yaw_rate_bias_rad_s: float = 0.0
-    speed_noise_mps: float = 0.0
-    latency_s: float = 0.0
+    yaw_rate_noise_rad_s: float = 0.0  # sigma of white noise on the yaw rate, drawn every step (rad/s), in [0, 1]
+    yaw_rate_bias_rad_s: float = 0.0  # a constant bias added to the yaw rate (rad/s), in [-1, 1]
+    speed_noise_mps: float = 0.0  # sigma of white noise on the speed (m/s), in [0, 10]
+    latency_s: float = 0.0  # the yaw rate seen is that of this much earlier (s), in [0, 2]
 
     def __post_init__(self) -> None:
         require_in_range("inertial.yaw_rate_noise_rad_s", self.yaw_rate_noise_rad_s, 0.0, MAX_RATE_SIGMA_RAD_S, "rad/s")
@@ -142,15 +137,11 @@ class Inertial:
 
 @dataclass(frozen=True)
 class SteeringSensor:
-    """The measured steering-wheel angle.
+    """The measured steering-wheel angle: noisy, then quantised, then late."""
 
-    noise_rad: sigma of white noise on it (rad); quantisation_rad: 0, none; else it is rounded to the nearest
-    multiple of this (rad), after the noise; latency_s: the angle seen is that of latency_s earlier (s).
-    """
-
-    noise_rad: float = 0.0
-    quantisation_rad: float = 0.0
-    latency_s: float = 0.0
+    noise_rad: float = 0.0  # sigma of white noise on the angle (rad), in [0, 0.5]
+    quantisation_rad: float = 0.0  # the angle rounded to a multiple of this after the noise (rad), in [0, 0.2]; 0: none
+    latency_s: float = 0.0  # the angle seen is that of this much earlier (s), in [0, 2]
 
     def __post_init__(self) -> None:
         require_in_range("steering_sensor.noise_rad", self.noise_rad, 0.0, MAX_ANGLE_SIGMA_RAD, "rad")
@@ -169,13 +160,12 @@ class SteeringSensor:
 class Actuation:
     """How the steering-wheel command reaches the plant, before the plant's own steering dynamics.
 
-    dead_time_s: a pure delay (s): the command applied from time t is the one the controller computed at
-    t - dead_time_s (honoured to the plant's step); max_steer_wheel_rate_rad_s: None, only the plant's own rate
-    limit; else the delayed command is also rate-limited to this (steering-wheel rad/s).
+    The dead time is a pure delay honoured to the plant's step: the command applied from time t is the one the
+    controller computed at t - dead_time_s. The rate limit acts on the delayed command.
     """
 
-    dead_time_s: float = 0.0
-    max_steer_wheel_rate_rad_s: float | None = None
+    dead_time_s: float = 0.0  # pure delay of the command (s), in [0, 2]
+    max_steer_wheel_rate_rad_s: float | None = None  # steering-wheel rad/s, in [0.001, 100]; None: the plant's own
 
     def __post_init__(self) -> None:
         require_in_range("actuation.dead_time_s", self.dead_time_s, 0.0, MAX_LATENCY_S, "s")
@@ -198,14 +188,14 @@ class Actuation:
 class Road:
     """The road: the scale of the tyres' peak friction (Pacejka's lambda_mu; 1.0 the road of the tyre data).
 
-    friction_scale: the scale everywhere; friction_profile: None, constant; else (distance_m, scale) pairs,
-    distances increasing from >= 0, interpolated linearly along the path's arc length and held beyond the first
-    and last points, the scale at s being friction_scale x the profile's. Every resulting scale must lie in
-    ROAD_FRICTION_RANGE. The simulator sets it with `vehicle.set_road_friction(road.friction_at(s))`.
+    The friction profile has at least two pairs, distances (m) increasing from 0 or more and scales in
+    ROAD_FRICTION_RANGE; it is interpolated linearly along the path's arc length and held beyond its first and last
+    points. The scale at s is friction_scale x the profile's, and every such product must lie in
+    ROAD_FRICTION_RANGE too. The simulator sets it with `vehicle.set_road_friction(road.friction_at(s))`.
     """
 
-    friction_scale: float = 1.0
-    friction_profile: tuple[tuple[float, float], ...] | None = None
+    friction_scale: float = 1.0  # the scale everywhere (dimensionless), in [0.05, 1.5]
+    friction_profile: tuple[tuple[float, float], ...] | None = None  # (distance m, scale) pairs; None: constant
 
     def __post_init__(self) -> None:
         low, high = ROAD_FRICTION_RANGE
@@ -296,15 +286,15 @@ def _profile_pairs(profile: object) -> tuple[tuple[float, float], ...]:
 @dataclass(frozen=True)
 class Conditions:
     """Everything between the plant and the controller in a run (see the module docstring); the defaults change
-    nothing. name: what reports call it; source: where its values come from, in words."""
+    nothing."""
 
-    name: str = "custom"
-    localisation: Localisation = field(default_factory=Localisation)
-    inertial: Inertial = field(default_factory=Inertial)
-    steering_sensor: SteeringSensor = field(default_factory=SteeringSensor)
-    actuation: Actuation = field(default_factory=Actuation)
-    road: Road = field(default_factory=Road)
-    source: str = ""
+    name: str = "custom"  # what reports call these conditions: non-empty text
+    localisation: Localisation = field(default_factory=Localisation)  # the pose and velocity from a GNSS/INS
+    inertial: Inertial = field(default_factory=Inertial)  # the yaw rate and the speed
+    steering_sensor: SteeringSensor = field(default_factory=SteeringSensor)  # the measured steering-wheel angle
+    actuation: Actuation = field(default_factory=Actuation)  # how the steering command reaches the plant
+    road: Road = field(default_factory=Road)  # the tyres' peak-friction scale along the path
+    source: str = ""  # where the values come from, in words (any text)
 
     def __post_init__(self) -> None:
         _require_text("conditions name", self.name)
