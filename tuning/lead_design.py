@@ -75,20 +75,20 @@ _MAX_CURVATURE_LOOKAHEAD = 1.8
 class LeadDesign:
     """A designed filter and what it achieves. Frequencies in rad/s, phases in degrees (negative: lag)."""
 
-    params: LeadFilterParams
-    lag: SteeringLag
-    method: str
-    max_lead_gain: float
-    max_cascade_peak_db: float
-    lead_peak_gain: float
-    cascade_peak_db: float
-    plant_bandwidth_rad_s: float
-    cascade_bandwidth_rad_s: float
-    plant_tracking_bandwidth_rad_s: float
-    cascade_tracking_bandwidth_rad_s: float
-    phase_frequency_rad_s: float
-    plant_phase_deg: float
-    cascade_phase_deg: float
+    params: LeadFilterParams  # the designed filter of Eq. 6
+    lag: SteeringLag  # the identified lag of Eq. 5 it was designed for (the plant)
+    method: str  # "cancel" (`design_lead`) or "margins" (`design_lead_for_margins`)
+    max_lead_gain: float  # 1 (linear), >= 1; the bound on the filter's peak |G_lead|
+    max_cascade_peak_db: float  # dB, >= 0; the bound on the cascade's peak |G_lead G_lag| (inf: none)
+    lead_peak_gain: float  # 1 (linear); the filter's peak |G_lead(jw)|, its high-frequency gain
+    cascade_peak_db: float  # dB, >= 0; the cascade's peak |G_lead G_lag| (0: no resonance)
+    plant_bandwidth_rad_s: float  # rad/s; the plant's -3 dB bandwidth
+    cascade_bandwidth_rad_s: float  # rad/s; the cascade's -3 dB bandwidth
+    plant_tracking_bandwidth_rad_s: float  # rad/s; where the plant's |G(jw) - 1| first reaches TRACKING_ERROR
+    cascade_tracking_bandwidth_rad_s: float  # rad/s; where the cascade's |T(jw) - 1| first reaches TRACKING_ERROR
+    phase_frequency_rad_s: float  # rad/s; where the phases are stated (default: the plant's -3 dB bandwidth)
+    plant_phase_deg: float  # deg, negative: lag; the plant's phase there, the lag's delay included
+    cascade_phase_deg: float  # deg, negative: lag; the cascade's phase there, the lag's delay included
 
     @property
     def bandwidth_ratio(self) -> float:
@@ -421,18 +421,20 @@ def _report(
 
 @dataclass(frozen=True)
 class ValidationTrace:
-    """Figure 9 for one log: time (s) and curvatures (1/m): kinematic, kinematic with lag (Eq. 5), compensated
-    (Eq. 6 on the steering wheel, then kinematic with lag), and the measured curvature (None if not in the log).
-    The NRMSEs are of the lagged and compensated curvatures against the kinematic one (range of the kinematic)."""
+    """Figure 9 for one log: the kinematic, lagged, compensated and measured curvatures over time.
 
-    name: str
-    t_s: np.ndarray
-    kinematic_1pm: np.ndarray
-    lagged_1pm: np.ndarray
-    compensated_1pm: np.ndarray
-    measured_1pm: np.ndarray | None
-    nrmse_lagged: float
-    nrmse_compensated: float
+    The curvature arrays have one sample per log sample, like `t_s`. The NRMSEs are RMS errors against the kinematic
+    curvature, normalised by its range (peak to peak).
+    """
+
+    name: str  # the log's name
+    t_s: np.ndarray  # s; time from the log's first sample
+    kinematic_1pm: np.ndarray  # 1/m; kinematic curvature of the steering-wheel angle
+    lagged_1pm: np.ndarray  # 1/m; the kinematic curvature through the lag (Eq. 5)
+    compensated_1pm: np.ndarray  # 1/m; Eq. 6 on the steering wheel, then kinematic with lag
+    measured_1pm: np.ndarray | None  # 1/m; the log's measured curvature (None: not in the log)
+    nrmse_lagged: float  # 1, >= 0; NRMSE of the lagged curvature against the kinematic one
+    nrmse_compensated: float  # 1, >= 0; NRMSE of the compensated curvature against the kinematic one
 
 
 def validate(design: LeadDesign, log: VehicleLog, geometry: VehicleGeometry | SteeringGeometry) -> ValidationTrace:
@@ -492,16 +494,16 @@ _REFINE_ROUNDS = 2
 
 @dataclass(frozen=True)
 class MarginsDesign:
-    """The margins design (`design_lead_for_margins`): the chosen design, the lookahead floor it gives (m), the
-    floor without a lead filter (m; nan when no lookahead in the range keeps the margins without one), how many
-    candidates met the gain bound, and margin_score: when no candidate keeps the margins at any lookahead in the
-    range (floor_m nan), the chosen one's score at the longest lookahead (`margin_score`, under 1), else nan."""
+    """The margins design (`design_lead_for_margins`): the chosen filter and the lookahead floors with and without it.
 
-    design: LeadDesign
-    floor_m: float
-    floor_without_lead_m: float
-    candidates: int
-    margin_score: float = math.nan
+    A floor is nan when no lookahead in the searched range keeps the margins; the margin_score is the chosen filter's.
+    """
+
+    design: LeadDesign  # the chosen design (method "margins")
+    floor_m: float  # m; the lookahead floor with the chosen filter (nan: none in the range)
+    floor_without_lead_m: float  # m; the lookahead floor without a lead filter (nan: none in the range)
+    candidates: int  # >= 0; how many candidate filters met the gain bound
+    margin_score: float = math.nan  # the `margin_score` at the longest lookahead (< 1) when floor_m is nan, else nan
 
 
 def margin_score(margins: Margins, phase_margin_deg: float, gain_margin_db: float) -> float:
