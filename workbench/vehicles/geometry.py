@@ -12,18 +12,14 @@ from workbench.base.errors import require_in_range, require_positive
 
 @dataclass(frozen=True)
 class VehicleGeometry:
-    """What a controller may know about the vehicle it steers.
+    """What a controller may know about the vehicle it steers: the wheelbase L of Ackermann's tan(phi) = L kappa,
+    the steering ratio, the steering actuator's limits and the width."""
 
-    wheelbase_m: front axle to rear axle (group centre) of the steered unit, for Ackermann tan(phi) = L kappa;
-    steering_ratio: steering-wheel angle / road-wheel angle; max_road_wheel_angle_rad and
-    max_steer_wheel_rate_rad_s: actuator limits; width_m: overall width (sizes the ISO 3888 lanes).
-    """
-
-    wheelbase_m: float
-    steering_ratio: float
-    max_road_wheel_angle_rad: float
-    max_steer_wheel_rate_rad_s: float
-    width_m: float
+    wheelbase_m: float  # front axle to rear axle (group centre) of the steered unit (m), in [0.5, 15]
+    steering_ratio: float  # steering-wheel angle / road-wheel angle, in [1, 60]
+    max_road_wheel_angle_rad: float  # steering lock at the road wheels (rad), in [0.01, 1.5]
+    max_steer_wheel_rate_rad_s: float  # steering-wheel rate limit of the actuator (rad/s), > 0
+    width_m: float  # overall width, which sizes the ISO 3888 lanes (m), in [0.5, 4]
 
     def __post_init__(self) -> None:
         require_in_range("wheelbase_m", self.wheelbase_m, 0.5, 15.0, "m")

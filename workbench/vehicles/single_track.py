@@ -32,16 +32,16 @@ class SingleTrackParams:
     and B = cornering stiffness / (C D), as in the workbench plants.
     """
 
-    mass_kg: float
-    yaw_inertia_kgm2: float
-    cg_to_front_axle_m: float
-    cg_to_rear_axle_m: float
-    front_cornering_stiffness_n_per_rad: float
-    rear_cornering_stiffness_n_per_rad: float
-    front_peak_force_n: float
-    rear_peak_force_n: float
-    tyre_shape_factor: float = 1.35
-    tyre_curvature_factor: float = 0.0
+    mass_kg: float  # mass m (kg), in [100, 100000]
+    yaw_inertia_kgm2: float  # yaw moment of inertia about the CG (kg m^2), in [10, 5e6]
+    cg_to_front_axle_m: float  # CG to front axle, a (m), in [0.05, 15]
+    cg_to_rear_axle_m: float  # CG to rear axle, b (m), in [0.05, 15]
+    front_cornering_stiffness_n_per_rad: float  # the front axle's cornering stiffness Cf (N/rad), > 0
+    rear_cornering_stiffness_n_per_rad: float  # the rear axle's cornering stiffness Cr (N/rad), > 0
+    front_peak_force_n: float  # the front axle's peak lateral force D (N), > 0
+    rear_peak_force_n: float  # the rear axle's peak lateral force D (N), > 0
+    tyre_shape_factor: float = 1.35  # the magic formula's shape factor C of both axles, in [1, 1.9]
+    tyre_curvature_factor: float = 0.0  # the magic formula's curvature factor E of both axles, in [-5, 0.99]
 
     def __post_init__(self) -> None:
         require_in_range("mass_kg", self.mass_kg, 100.0, 100_000.0, "kg")
@@ -157,22 +157,19 @@ class SteeringActuator(Protocol):
 
 @dataclass(frozen=True)
 class PredictionParams:
-    """The vehicle as the MPC predicts it (SI units).
-
-    wheelbase_m, steering_ratio, max_road_wheel_angle_rad, max_road_wheel_rate_rad_s: as `VehicleGeometry`;
-    steering_time_constant_s: first-order steering actuator (s); single_track: mass, inertia and tyres, or None
-    when unknown (then only the kinematic kinds are available); lag: the identified steering-wheel-to-curvature
-    lag (Eq. 5), or None; source: where the numbers came from, for messages and reports.
+    """The vehicle as the MPC predicts it (SI units): its geometry as `VehicleGeometry` has it, its steering
+    actuator and what is known of its dynamics. Without a single track only the MPC's kinematic kinds are
+    available; with one, its axle positions must add up to wheelbase_m.
     """
 
-    wheelbase_m: float
-    steering_ratio: float
-    max_road_wheel_angle_rad: float
-    max_road_wheel_rate_rad_s: float
-    steering_time_constant_s: float = DEFAULT_STEERING_TIME_CONSTANT_S
-    single_track: SingleTrackParams | None = None
-    lag: SteeringLag | None = None
-    source: str = ""
+    wheelbase_m: float  # front axle to rear axle (group centre) of the steered unit (m), in [0.5, 15]
+    steering_ratio: float  # steering-wheel angle / road-wheel angle, in [1, 60]
+    max_road_wheel_angle_rad: float  # steering lock at the road wheels (rad), in [0.01, 1.5]
+    max_road_wheel_rate_rad_s: float  # steering rate limit at the road wheels (rad/s), > 0
+    steering_time_constant_s: float = DEFAULT_STEERING_TIME_CONSTANT_S  # first-order actuator (s), in [0.001, 2]
+    single_track: SingleTrackParams | None = None  # mass, inertia and tyres; None: unknown
+    lag: SteeringLag | None = None  # the identified steering-wheel-to-curvature lag (Eq. 5); None: not identified
+    source: str = ""  # where the numbers came from, for messages and reports (any text)
 
     def __post_init__(self) -> None:
         require_in_range("wheelbase_m", self.wheelbase_m, 0.5, 15.0, "m")
