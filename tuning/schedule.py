@@ -81,14 +81,13 @@ SPEED_MATCH_KMH = 1e-6
 
 @dataclass(frozen=True)
 class ScheduleEntry:
-    """One speed: the fit of the path lag, the fit of the measured (yaw-rate) lag (None when not identified), the
-    filter designed, and with the margins design its lookahead floors."""
+    """One speed of a schedule: the lags identified there, the filter designed for the path lag, its floors."""
 
-    speed_kmh: float
-    fit: LagFit
-    design: LeadDesign
-    measured_fit: LagFit | None = None
-    margins: MarginsDesign | None = None
+    speed_kmh: float  # km/h; the speed identified at
+    fit: LagFit  # the fit of the path lag
+    design: LeadDesign  # the filter designed for it
+    measured_fit: LagFit | None = None  # the fit of the measured (yaw-rate) lag (None: not identified)
+    margins: MarginsDesign | None = None  # the margins design's lookahead floors (None: the cancel design)
 
     def row(self) -> dict[str, float]:
         """The entry as one row of the lead-filter file's ``design.per_speed`` table and of `ScheduleResult.table`.
@@ -141,13 +140,12 @@ class ScheduleEntry:
 
 @dataclass(frozen=True)
 class DroppedSpeed:
-    """A speed left out of a schedule (`drop_refused`): speed_kmh, why (the refusal of the fit or of the design),
-    and the fitted lag when it was the design that was refused (None when the fit was)."""
+    """A speed left out of a schedule (`drop_refused`), why, and what was fitted there before the refusal."""
 
-    speed_kmh: float
-    reason: str
-    lag: SteeringLag | None = None
-    measured_lag: SteeringLag | None = None
+    speed_kmh: float  # km/h; the speed left out
+    reason: str  # why: the refusal of the fit or of the design, in words
+    lag: SteeringLag | None = None  # the fitted path lag when the design was refused (None: the fit was)
+    measured_lag: SteeringLag | None = None  # the fitted measured (yaw-rate) lag, when there was one
 
     def row(self) -> dict[str, float | str]:
         """The dropped speed as one row of the lead-filter file's ``design.dropped_speeds`` table.
@@ -172,19 +170,16 @@ class DroppedSpeed:
 
 @dataclass(frozen=True)
 class ScheduleResult:
-    """The identified schedule of `vehicle` (its model name): one entry per speed kept; lat_accel_g of the
-    identification maneuvers; fit_delay whether the lags were fitted with a pure delay; dropped the speeds left
-    out (with `drop_refused`); design the lead design ("cancel" or "margins"); controller_rate_hz and
-    prediction_time_s the loop the margins design analysed."""
+    """The identified lead-filter schedule of one vehicle: a lag fit and a filter per speed kept."""
 
-    vehicle: str
-    entries: tuple[ScheduleEntry, ...]
-    lat_accel_g: float
-    fit_delay: bool = False
-    dropped: tuple[DroppedSpeed, ...] = field(default=())
-    design: str = "cancel"
-    controller_rate_hz: float = DEFAULT_CONTROLLER_RATE_HZ
-    prediction_time_s: float = DEFAULT_PREDICTION_TIME_S
+    vehicle: str  # the vehicle's model name
+    entries: tuple[ScheduleEntry, ...]  # one per speed kept, by increasing speed
+    lat_accel_g: float  # g; the kinematic lateral acceleration of the identification maneuvers
+    fit_delay: bool = False  # whether the lags were fitted with a pure delay
+    dropped: tuple[DroppedSpeed, ...] = field(default=())  # the speeds left out (with `drop_refused`)
+    design: str = "cancel"  # the lead design: "cancel" (`design_lead`) or "margins" (`design_lead_for_margins`)
+    controller_rate_hz: float = DEFAULT_CONTROLLER_RATE_HZ  # Hz; the controller rate the margins design analysed
+    prediction_time_s: float = DEFAULT_PREDICTION_TIME_S  # s; the pose prediction the margins design analysed
 
     @property
     def speeds_kmh(self) -> tuple[float, ...]:
