@@ -56,6 +56,7 @@ templates_path: list[str] = []
 html_theme = "furo"
 html_title = project
 html_static_path = ["_static"] if (DOCS / "_static").is_dir() else []
+html_css_files = ["workbench.css"] if (DOCS / "_static" / "workbench.css").is_file() else []
 
 # MyST: pages and notebooks.
 myst_enable_extensions = ["colon_fence", "deflist", "dollarmath", "amsmath"]

@@ -56,15 +56,17 @@ def format_cell(value: object) -> str:
 
 
 def markdown_table(rows: Sequence[Mapping[str, object]]) -> str:
-    """rows as a Markdown table: a column per key (in order of first appearance), columns empty in every row left
-    out."""
+    """rows as a Markdown table: a column per key (in order of first appearance, each underscore of its name
+    followed by a zero-width space, where it may wrap), columns empty in every row left out."""
     columns: list[str] = []
     for row in rows:
         columns += [key for key in row if key not in columns]
     columns = [c for c in columns if any(row.get(c) is not None for row in rows)]
     if not rows or not columns:
         return "(no rows)\n"
-    lines = ["| " + " | ".join(columns) + " |", "|" + "---|" * len(columns)]
+    # A column name is a result's key (median_max_cte_vs_nominal): a zero-width space after each underscore lets a
+    # long one wrap at its words, so that a table of numbers fits the page's column.
+    lines = ["| " + " | ".join(c.replace("_", "_\u200b") for c in columns) + " |", "|" + "---|" * len(columns)]
     lines += ["| " + " | ".join(format_cell(row.get(c)) for c in columns) + " |" for row in rows]
     return "\n".join(lines) + "\n"
 

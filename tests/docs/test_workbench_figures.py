@@ -83,6 +83,8 @@ def test_cells_format_numbers_booleans_and_pipes(figures: ModuleType) -> None:
     assert figures.format_cell("a | b") == "a \\| b"
     table = figures.markdown_table([{"a": 1, "b": None}, {"a": 2.5, "c": "x"}])
     assert table.splitlines()[0] == "| a | c |"  # b is empty in every row: left out
+    # a long column name may wrap after each underscore (a zero-width space), not inside its words
+    assert figures.markdown_table([{"max_abs_cte_m": 1}]).splitlines()[0] == "| max_\u200babs_\u200bcte_\u200bm |"
     assert table.splitlines()[3] == "| 2.5 | x |"
 
 
