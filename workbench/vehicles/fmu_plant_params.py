@@ -61,81 +61,76 @@ OPTIONAL_OUTPUTS: dict[str, str] = {
 class FmuPlantParams:
     """A plant FMU and its mapping (module docstring), SI units unless a field says otherwise.
 
-    fmu_file: the .fmu (a relative path is relative to the vehicle file's folder); communication_step_s: the step
-    of each doStep (a controller period is split into steps of it, the last shortened when the period is not a
-    multiple, which needs an FMU that handles a variable step). Geometry and limits as `VehicleGeometry`, plus the
-    acceleration limits the commands are clipped to. Prediction: steering_time_constant_s, and either the single
-    track (SINGLE_TRACK_FIELDS, all or none; the rear axle is wheelbase_m - cg_to_front_axle_m) or lag_file (an
-    identified steering lag, `tuning fit-lag`), or neither (a kinematic single track). rollover_threshold_g: the
-    static rollover threshold the feasibility check uses (none: not checked). hitch_to_trailer_axle_m: a trailer's
-    hitch to its axle (its outline), needed with trailer outputs. Inputs: steering_input (kind
-    steering_input_is), accel_input or throttle_input and brake_input (kind longitudinal_input_is). Outputs:
-    REQUIRED_OUTPUTS and any of OPTIONAL_OUTPUTS, each with `<field>_scale`. Start values: speed_parameter (the
-    FMU parameter set to the run's initial speed), payload_parameter and payload_kg, friction_parameter and
-    road_friction (its value on the road of the tyre data; a road-friction scale multiplies it, so it must be
-    tunable).
+    A controller period is split into doSteps of communication_step_s, the last shortened when the period is not a
+    multiple, which needs an FMU that handles a variable step. What the MPCs predict with: the steering time
+    constant, and either the single track (SINGLE_TRACK_FIELDS, all or none; the rear axle is wheelbase_m -
+    cg_to_front_axle_m; the ranges of `SingleTrackParams` apply, checked when `FmuPlant.single_track` builds it)
+    or lag_file, or neither (a kinematic single track). Outputs: REQUIRED_OUTPUTS and any of OPTIONAL_OUTPUTS, each
+    at the rear-axle centre with the workbench's signs and with its `<field>_scale` (FMU value = scale x the
+    workbench's value); trailer outputs need hitch_to_trailer_axle_m, which draws the trailer's outline. A start
+    value goes with its parameter: both given or both None.
     """
 
-    fmu_file: Path
-    communication_step_s: float
-    wheelbase_m: float
-    steering_ratio: float
-    max_road_wheel_angle_rad: float
-    max_road_wheel_rate_rad_s: float
-    width_m: float
-    max_accel_mps2: float
-    max_decel_mps2: float
-    steering_time_constant_s: float
-    mass_kg: float | None
-    yaw_inertia_kgm2: float | None
-    cg_to_front_axle_m: float | None
-    front_cornering_stiffness_n_per_rad: float | None
-    rear_cornering_stiffness_n_per_rad: float | None
-    front_peak_force_n: float | None
-    rear_peak_force_n: float | None
-    lag_file: Path | None
-    rollover_threshold_g: float | None
-    hitch_to_trailer_axle_m: float | None
-    steering_input: str
-    steering_input_is: str
-    steering_input_scale: float
-    longitudinal_input_is: str
-    accel_input: str | None
-    accel_input_scale: float
-    throttle_input: str | None
-    throttle_input_scale: float
-    brake_input: str | None
-    brake_input_scale: float
-    x_output: str
-    x_output_scale: float
-    y_output: str
-    y_output_scale: float
-    yaw_output: str
-    yaw_output_scale: float
-    vx_output: str
-    vx_output_scale: float
-    vy_output: str
-    vy_output_scale: float
-    yaw_rate_output: str
-    yaw_rate_output_scale: float
-    steering_output: str
-    steering_output_is: str
-    steering_output_scale: float
-    lat_accel_output: str
-    lat_accel_output_scale: float
-    ltr_output: str | None
-    ltr_output_scale: float
-    trailer_x_output: str | None
-    trailer_x_output_scale: float
-    trailer_y_output: str | None
-    trailer_y_output_scale: float
-    articulation_output: str | None
-    articulation_output_scale: float
-    speed_parameter: str | None
-    payload_parameter: str | None
-    payload_kg: float | None
-    friction_parameter: str | None
-    road_friction: float | None
+    fmu_file: Path  # the plant's .fmu; in a vehicle file, a relative path is from the file's folder
+    communication_step_s: float  # the step of each doStep (s), in [0.0001, 0.1]
+    wheelbase_m: float  # front axle to rear axle (m), in [0.5, 15]
+    steering_ratio: float  # steering-wheel angle / road-wheel angle, in [1, 60]
+    max_road_wheel_angle_rad: float  # steering lock at the road wheels (rad), in [0.01, 1.5]
+    max_road_wheel_rate_rad_s: float  # steering rate limit at the road wheels (rad/s), > 0
+    width_m: float  # overall width (m), in [0.5, 4]
+    max_accel_mps2: float  # the acceleration command is clipped to this (m/s^2), in [0.01, 20]
+    max_decel_mps2: float  # the deceleration command is clipped to this (m/s^2, positive), in [0.01, 20]
+    steering_time_constant_s: float  # the steering actuator's time constant the MPCs use (s), in [0.001, 2]
+    mass_kg: float | None  # single track: mass (kg), in [100, 100000]; None: no single track
+    yaw_inertia_kgm2: float | None  # single track: yaw inertia about the CG (kg m^2), in [10, 5e6]
+    cg_to_front_axle_m: float | None  # single track: CG to front axle (m), in [0.05, wheelbase_m - 0.05]
+    front_cornering_stiffness_n_per_rad: float | None  # single track: front axle's (N/rad), > 0
+    rear_cornering_stiffness_n_per_rad: float | None  # single track: rear axle's (N/rad), > 0
+    front_peak_force_n: float | None  # single track: the front axle's peak lateral force (N), > 0
+    rear_peak_force_n: float | None  # single track: the rear axle's peak lateral force (N), > 0
+    lag_file: Path | None  # an identified steering lag (`tuning fit-lag` writes one); None: none
+    rollover_threshold_g: float | None  # the feasibility check's static rollover threshold (g), in [0.05, 2]; None: off
+    hitch_to_trailer_axle_m: float | None  # hitch to the trailer's axle (m), in [0.5, 20]; needed with trailer outputs
+    steering_input: str  # the FMU input variable of the steering command
+    steering_input_is: str  # what it is: "road_wheel_angle" or "steering_wheel_angle" (rad, left positive)
+    steering_input_scale: float  # FMU value / workbench value, finite and not 0
+    longitudinal_input_is: str  # "acceleration" (accel_input) or "throttle_brake" (throttle_input and brake_input)
+    accel_input: str | None  # the FMU input of the acceleration command (m/s^2); needed with "acceleration"
+    accel_input_scale: float  # FMU value / workbench value, finite and not 0
+    throttle_input: str | None  # the FMU input of the throttle; needed with "throttle_brake"
+    throttle_input_scale: float  # FMU value / (acceleration command / max_accel_mps2), finite and not 0
+    brake_input: str | None  # the FMU input of the brake; needed with "throttle_brake"
+    brake_input_scale: float  # FMU value / (deceleration command / max_decel_mps2), finite and not 0
+    x_output: str  # the FMU output of x, east (m)
+    x_output_scale: float  # FMU value / workbench value, finite and not 0
+    y_output: str  # the FMU output of y, north (m)
+    y_output_scale: float  # FMU value / workbench value, finite and not 0
+    yaw_output: str  # the FMU output of the yaw, counter-clockwise (rad)
+    yaw_output_scale: float  # FMU value / workbench value, finite and not 0
+    vx_output: str  # the FMU output of the body-frame longitudinal speed (m/s)
+    vx_output_scale: float  # FMU value / workbench value, finite and not 0
+    vy_output: str  # the FMU output of the body-frame lateral speed, left positive (m/s)
+    vy_output_scale: float  # FMU value / workbench value, finite and not 0
+    yaw_rate_output: str  # the FMU output of the yaw rate, counter-clockwise (rad/s)
+    yaw_rate_output_scale: float  # FMU value / workbench value, finite and not 0
+    steering_output: str  # the FMU output of the steering angle, left positive (rad)
+    steering_output_is: str  # what it is: "road_wheel_angle" or "steering_wheel_angle"
+    steering_output_scale: float  # FMU value / workbench value, finite and not 0
+    lat_accel_output: str  # the FMU output of the lateral acceleration, left positive (m/s^2)
+    lat_accel_output_scale: float  # FMU value / workbench value, finite and not 0
+    ltr_output: str | None  # load transfer ratio (|LTR| = 1: a wheel lifts); None: no rollover metrics
+    ltr_output_scale: float  # FMU value / workbench value, finite and not 0
+    trailer_x_output: str | None  # x of the trailer's rear-axle centre (m); given with trailer_y_output or neither
+    trailer_x_output_scale: float  # FMU value / workbench value, finite and not 0
+    trailer_y_output: str | None  # y of the trailer's rear-axle centre (m); given with trailer_x_output or neither
+    trailer_y_output_scale: float  # FMU value / workbench value, finite and not 0
+    articulation_output: str | None  # the articulation angle (rad); None: none
+    articulation_output_scale: float  # FMU value / workbench value, finite and not 0
+    speed_parameter: str | None  # the FMU parameter set to the initial speed (vx_output's units); None: the FMU's
+    payload_parameter: str | None  # the FMU parameter set to payload_kg; None: the FMU's own payload
+    payload_kg: float | None  # the payload written to payload_parameter (kg), in [0, 100000]
+    friction_parameter: str | None  # the FMU's tunable tyre-friction parameter; None: only road friction 1.0
+    road_friction: float | None  # friction_parameter's value on the tyre data's road, > 0; a road scale multiplies it
 
     def __post_init__(self) -> None:
         require_in_range("communication_step_s", self.communication_step_s, *COMMUNICATION_STEP_RANGE_S, "s")
