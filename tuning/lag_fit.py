@@ -133,25 +133,27 @@ class SteeringGeometry:
 
 @dataclass(frozen=True)
 class FittedLog:
-    """One log's curves (Figure 8): time (s), kinematic, measured and modelled (kinematic with lag) curvature
-    (1/m), and the log's NRMSE."""
+    """One log's curves (Figure 8): the kinematic, measured and modelled curvature over time, and how well they fit.
 
-    name: str
-    t_s: np.ndarray
-    kinematic_1pm: np.ndarray
-    measured_1pm: np.ndarray
-    modelled_1pm: np.ndarray
-    nrmse: float
-    curvature_from: str
+    The curvature arrays have one sample per log sample, like `t_s`.
+    """
+
+    name: str  # the log's name
+    t_s: np.ndarray  # s; time from the log's first sample
+    kinematic_1pm: np.ndarray  # 1/m; kinematic curvature of the steering-wheel angle
+    measured_1pm: np.ndarray  # 1/m; the measured curvature the lag was fitted to
+    modelled_1pm: np.ndarray  # 1/m; the kinematic curvature through the fitted lag (Eq. 5)
+    nrmse: float  # 1, >= 0; this log's normalised RMS error of the modelled against the measured curvature
+    curvature_from: str  # where the measured curvature came from: "path" (x, y) or "yaw-rate"
 
 
 @dataclass(frozen=True)
 class LagFit:
     """The identified lag (with nrmse and speed range), the steady-state gain K, and the curves of each log."""
 
-    lag: SteeringLag
-    logs: tuple[FittedLog, ...] = field(repr=False)
-    options: LagFitOptions = field(repr=False)
+    lag: SteeringLag  # the identified lag of Eq. 5, with its gain K, NRMSE and the logs' speed range
+    logs: tuple[FittedLog, ...] = field(repr=False)  # each log's curves, in the order given
+    options: LagFitOptions = field(repr=False)  # the options it was fitted with
 
     @property
     def nrmse(self) -> float:
