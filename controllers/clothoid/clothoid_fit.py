@@ -391,13 +391,13 @@ def sample_kernel(
 
 @dataclass(frozen=True, slots=True)
 class ClothoidFit:
-    """One hyper-clothoid: curvature rate (1/m^2), length (m), end point (m) and status (FIT_* code)."""
+    """One hyper-clothoid from a start pose towards a target (`fit_hyper_clothoid`), and how the fit ended."""
 
-    curvature_rate_1pm2: float
-    length_m: float
-    end_x_m: float
-    end_y_m: float
-    status: int
+    curvature_rate_1pm2: float  # 1/m^2; kdot, the curvature's rate along the arc, within +-the bound fitted with
+    length_m: float  # m, >= 0; the arc length
+    end_x_m: float  # m; x of the end point, in the coordinates the start and the target were given in
+    end_y_m: float  # m; y of the end point, in that frame
+    status: int  # FIT_OK (0, on the target), FIT_SATURATED (1, kdot at its bound) or FIT_UNREACHABLE (2)
 
     @property
     def saturated(self) -> bool:
