@@ -36,12 +36,13 @@ DEFAULT_LIMIT_LATERAL_ACCEL_G = 0.4
 
 @dataclass(frozen=True)
 class CurvatureLimits:
-    """Tables of the curvature limit (1/m) and curvature-rate limit (1/(m s)) against speed (km/h)."""
+    """Tables of the curvature limit and the curvature-rate limit against speed, one entry of each per speed,
+    linearly interpolated in speed and clamped beyond the table's ends."""
 
-    speeds_kmh: tuple[float, ...]
-    max_curvature_1pm: tuple[float, ...]
-    max_curvature_rate_1pm_s: tuple[float, ...]
-    source: str = "table"
+    speeds_kmh: tuple[float, ...]  # the table's speeds (km/h), finite, >= 0 and strictly increasing
+    max_curvature_1pm: tuple[float, ...]  # the curvature limit at each speed (1/m), finite and > 0
+    max_curvature_rate_1pm_s: tuple[float, ...]  # the curvature-rate limit at each speed (1/(m s)), finite and > 0
+    source: str = "table"  # where the table comes from, which starts every message (any text)
 
     def __post_init__(self) -> None:
         n = len(self.speeds_kmh)

@@ -28,12 +28,12 @@ DEFAULT_FILTER = LeadFilterParams.from_lag(4.44, 0.80)
 
 @dataclass(frozen=True)
 class FilterSchedule:
-    """Lead filters against speed: speeds_kmh (km/h, strictly increasing; one entry: the same filter at every
-    speed) and one LeadFilterParams per speed; source says where they come from."""
+    """Lead filters against speed, interpolated between the speeds they were designed for; a schedule of one entry
+    gives the same filter at every speed."""
 
-    speeds_kmh: tuple[float, ...]
-    params: tuple[LeadFilterParams, ...]
-    source: str = ""
+    speeds_kmh: tuple[float, ...]  # the design speeds (km/h), each in [0, 300], strictly increasing, at least one
+    params: tuple[LeadFilterParams, ...]  # the lead filter (Eq. 6) at each speed, one per speed
+    source: str = ""  # where the filters come from, in words (any text)
 
     def __post_init__(self) -> None:
         speeds, params = tuple(self.speeds_kmh), tuple(self.params)

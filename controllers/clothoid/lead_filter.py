@@ -40,12 +40,12 @@ POLE_RATIO_RANGE = (1.0, 100.0)
 
 @dataclass(frozen=True)
 class LeadFilterParams:
-    """Parameters of Eq. 6: omega_z_rad_s (wz) and psi (damping) of the zero pair, omega_p_rad_s (wp) of the
-    triple pole. wz, wp in [0.01, 1000] rad/s, psi in (0, 5], wp / wz in [1, 100]."""
+    """Parameters of Eq. 6: a complex zero pair (wz, psi) and a triple real pole (wp), with wp / wz in [1, 100]:
+    the poles at or above the zeros, so that the filter leads, and at most 72 dB of peak gain."""
 
-    omega_z_rad_s: float
-    psi: float
-    omega_p_rad_s: float
+    omega_z_rad_s: float  # wz, the zero pair's natural frequency (rad/s), in [0.01, 1000]
+    psi: float  # the zero pair's damping (dimensionless), in (0, 5]
+    omega_p_rad_s: float  # wp, the triple pole's frequency (rad/s), in [0.01, 1000], with wp / wz in [1, 100]
 
     def __post_init__(self) -> None:
         require_in_range("omega_z_rad_s", self.omega_z_rad_s, *OMEGA_RANGE_RAD_S, "rad/s")
