@@ -72,17 +72,16 @@ FIGURES: tuple[tuple[str, str], ...] = (
 
 @dataclass(frozen=True)
 class RunSpec:
-    """One run of a comparison: a registered controller; a vehicle, a preset name or a vehicle TOML file (as
-    `workbench run --vehicle-file`), with `payload_kg` for one that carries a payload (None: the preset's or the
-    file's); and controller options: a TOML file with a table per controller name (`config_file`, as `workbench
-    run --controller-config`; a controller without a table gets its defaults) and KEY=VALUE overrides on top (as
-    `--set`)."""
+    """One run of a comparison: a controller with its options on a vehicle.
 
-    controller: str
-    vehicle: str
-    overrides: tuple[str, ...] = ()
-    config_file: Path | None = None
-    payload_kg: float | None = None
+    A controller without a table in `config_file` gets its defaults; the overrides apply on top of either.
+    """
+
+    controller: str  # a registered controller's name
+    vehicle: str  # a preset's name or a vehicle TOML file (as `workbench run --vehicle-file`)
+    overrides: tuple[str, ...] = ()  # controller options as KEY=VALUE (as `--set`)
+    config_file: Path | None = None  # TOML, a table per controller name (as `--controller-config`)
+    payload_kg: float | None = None  # kg; the payload of a vehicle that carries one (None: the preset's or file's)
 
     def __post_init__(self) -> None:
         if self.controller not in CONTROLLERS:
@@ -179,14 +178,13 @@ def step_time_ratios(table: pd.DataFrame, reference_controller: str | None) -> l
 
 @dataclass(frozen=True, eq=False)
 class Comparison:
-    """The runs of one scenario, in the order asked. `reference_controller` is the controller whose step time the
-    others are divided by in `summary()` (the clothoid controller when present)."""
+    """The runs of one scenario, in the order asked, with their results."""
 
-    scenario: Scenario
-    specs: tuple[RunSpec, ...]
-    results: tuple[SimulationResult, ...]
-    config: SimulationConfig
-    reference_controller: str | None = None
+    scenario: Scenario  # the scenario every run drove
+    specs: tuple[RunSpec, ...]  # the runs, in the order asked
+    results: tuple[SimulationResult, ...]  # their results, one per spec in the same order
+    config: SimulationConfig  # how every run was simulated
+    reference_controller: str | None = None  # the controller whose step time summary() divides by (None: no ratio)
     _summary: list[pd.DataFrame] = field(default_factory=list, repr=False)
 
     def select(self, specs: Sequence[RunSpec]) -> Comparison:
