@@ -79,36 +79,35 @@ figcaption { font-size: 0.9em; color: #444; }
 
 @dataclass(frozen=True)
 class ReportFigure:
-    """A further figure of a section: its caption (plain) and what draws it (the figure is closed once embedded)."""
+    """A further figure of a section: its caption and what draws it (the figure is closed once embedded)."""
 
-    caption: str
-    draw: Callable[[], Figure]
+    caption: str  # the caption, plain text
+    draw: Callable[[], Figure]  # draws the figure when the report is written
 
 
 @dataclass(frozen=True)
 class ReportTable:
-    """A table of text before the sections: heading, explanatory text (plain) and its rows (every cell as text)."""
+    """A table of text before the sections."""
 
-    heading: str
-    text: str
-    frame: pd.DataFrame
+    heading: str  # the table's heading
+    text: str  # explanatory text before it, plain
+    frame: pd.DataFrame  # its rows, every cell as text
 
 
 @dataclass(frozen=True)
 class ReportSection:
-    """heading, explanatory text (plain), and the comparison it shows.
+    """One section of a report: a comparison's table and figures under a heading.
 
-    summary: the table to show instead of the comparison's own `summary()` (the same rows, e.g. with ratios taken
-    from a larger comparison, or with further columns; the text then says what its step-time ratios divide by);
-    columns: the summary columns shown, with their headings; figures: further figures after the four comparison
-    figures."""
+    A `summary` given has the same rows as the comparison's own `summary()`, e.g. with step-time ratios taken from
+    a larger comparison (the text then says what they divide by), or with further columns.
+    """
 
-    heading: str
-    text: str
-    comparison: Comparison
-    summary: pd.DataFrame | None = None
-    columns: tuple[tuple[str, str], ...] = TABLE_COLUMNS
-    figures: tuple[ReportFigure, ...] = field(default=())
+    heading: str  # the section's heading
+    text: str  # explanatory text, plain
+    comparison: Comparison  # the comparison it shows
+    summary: pd.DataFrame | None = None  # the table shown instead of the comparison's `summary()` (None: that)
+    columns: tuple[tuple[str, str], ...] = TABLE_COLUMNS  # the summary columns shown: (column, heading) pairs
+    figures: tuple[ReportFigure, ...] = field(default=())  # further figures after the four comparison figures
 
 
 #: What a table shows for a missing number (None or NaN), unless the table says otherwise.
