@@ -64,29 +64,21 @@ STARTS = 3
 
 @dataclass(frozen=True)
 class LagFitOptions:
-    """How fit_lag reads and judges the data (defaults in brackets).
-
-    curvature_from: "auto" (path from x, y when the log has them, else yaw rate), "path" or "yaw-rate";
-    smooth_s: window of the Savitzky-Golay derivatives of the path (0.3 s); fit_delay: also fit a pure delay
-    (False); max_zeta: the upper bound of zeta (None: 10 without a delay, DELAY_FIT_MAX_ZETA = 2 with one, where a
-    fit at the bound is accepted: module docstring); unit_gain: fix the steady-state gain K = 1 (False);
-    min_duration_s (5 s), min_samples (50):
-    the shortest usable log; min_steer_std_deg: the least steering-wheel standard deviation (1 deg);
-    min_speed_mps (2 m/s); max_speed_variation: (max - min) / mean speed over all logs (0.15); max_nrmse: the
-    worst fit accepted (0.25).
+    """How fit_lag reads and judges the data (the module docstring says what it refuses and why). With a delay and
+    no max_zeta, the upper bound of zeta is DELAY_FIT_MAX_ZETA, where a fit at the bound is accepted.
     """
 
-    curvature_from: str = "auto"
-    smooth_s: float = 0.3
-    fit_delay: bool = False
-    max_zeta: float | None = None
-    unit_gain: bool = False
-    min_duration_s: float = 5.0
-    min_samples: int = 50
-    min_steer_std_deg: float = 1.0
-    min_speed_mps: float = 2.0
-    max_speed_variation: float = 0.15
-    max_nrmse: float = 0.25
+    curvature_from: str = "auto"  # "auto" (path from x, y when the log has them, else yaw rate), "path" or "yaw-rate"
+    smooth_s: float = 0.3  # window of the Savitzky-Golay derivatives of the path (s), in [0, 10]
+    fit_delay: bool = False  # also fit a pure delay (True or False)
+    max_zeta: float | None = None  # the fit's upper bound of zeta, in [0.1, 10]; None: 10, or 2 with a delay
+    unit_gain: bool = False  # fix the steady-state gain K = 1 instead of fitting it (True or False)
+    min_duration_s: float = 5.0  # the shortest usable log (s), > 0
+    min_samples: int = 50  # the fewest samples of a usable log, a whole number >= 10
+    min_steer_std_deg: float = 1.0  # the least steering-wheel standard deviation of a log (deg), in [0, 360]
+    min_speed_mps: float = 2.0  # the lowest speed a log may reach (m/s), in [0.1, 100]
+    max_speed_variation: float = 0.15  # the most (max - min) / mean speed over all logs, in [0, 2]
+    max_nrmse: float = 0.25  # the worst fit accepted (NRMSE, module docstring), in [0, 10]
 
     def __post_init__(self) -> None:
         if self.curvature_from not in CURVATURE_SOURCES:
@@ -120,11 +112,10 @@ class LagFitOptions:
 
 @dataclass(frozen=True)
 class SteeringGeometry:
-    """What the kinematic curvature needs, for a vehicle without a model here: wheelbase_m (front axle to rear axle,
-    0.5-15 m) and steering_ratio (steering-wheel / road-wheel angle, 1-60). VehicleGeometry has both too."""
+    """What the kinematic curvature needs, for a vehicle without a model here; VehicleGeometry has both too."""
 
-    wheelbase_m: float
-    steering_ratio: float
+    wheelbase_m: float  # front axle to rear axle (m), in [0.5, 15]
+    steering_ratio: float  # steering-wheel angle / road-wheel angle, in [1, 60]
 
     def __post_init__(self) -> None:
         require_in_range("wheelbase_m", self.wheelbase_m, 0.5, 15.0, "m")
