@@ -111,22 +111,14 @@ class DoubleLaneChangeLayout:
 
     Lane widths 1.1 b + 0.25, 1.2 b + 0.25 and 1.3 b + 0.25 m; sections 15, 30, 25, 25 and 15 m. The 3.5 m lateral
     offset is taken between the right-hand cone lines of sections 1 and 3 (the datum varies between sources);
-    the exit lane is centred on the entry lane's centre line.
-
-    Parameters
-    ----------
-    vehicle_width_m : float
-        Overall width b of the vehicle the lanes are sized for (m).
-    run_in_m, run_out_m : float
-        Straights before section 1 and after section 5 (m).
-    lateral_offset_m : float
-        Offset between the right-hand cone lines of sections 1 and 3 (m).
+    the exit lane is centred on the entry lane's centre line. The layout checks no range itself; the `dlc`
+    scenario builds it from `ScenarioOptions.vehicle_width_m`, which is checked there.
     """
 
-    vehicle_width_m: float
-    run_in_m: float = 40.0
-    run_out_m: float = 40.0
-    lateral_offset_m: float = 3.5
+    vehicle_width_m: float  # overall width b of the vehicle the lanes are sized for (m), > 0 (`dlc`: 0.5 to 4)
+    run_in_m: float = 40.0  # the straight before section 1 (m), >= 0
+    run_out_m: float = 40.0  # the straight after section 5 (m), >= 0
+    lateral_offset_m: float = 3.5  # offset between the right-hand cone lines of sections 1 and 3 (m), ISO: 3.5
 
     @property
     def lane_widths_m(self) -> tuple[float, float, float]:
