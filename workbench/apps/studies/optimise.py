@@ -190,19 +190,20 @@ def write_controller_config(
 
 @dataclass(frozen=True, eq=False)
 class OptimisationResult:
-    """history: one row per trial (number, state, value, the options as "<controller>.<option>", runs, failed
-    runs, why it failed, and the mean of each objective metric over its runs); best_trial / best_value /
-    best_params: the best completed trial (None if none completed); config_file: DIR/best.toml; runs: every run of
-    every trial, with its trial number; ran: runs executed in this call."""
+    """An optimisation's trials, the best of them (the least objective) and every run they made.
 
-    history: pd.DataFrame
-    best_trial: int | None
-    best_value: float | None
-    best_params: dict[str, Any]
-    config_file: Path | None
-    runs: SweepResult
-    objective: str
-    ran: int = 0
+    The history has one row per trial: trial, state, value, the options as "<controller>.<option>", runs,
+    failed_runs, reason (why it failed) and mean_<metric> of each objective metric over its runs.
+    """
+
+    history: pd.DataFrame  # one row per trial, in the order proposed
+    best_trial: int | None  # the best completed trial's number (None: no trial completed)
+    best_value: float | None  # its objective value (None: no trial completed)
+    best_params: dict[str, Any]  # its options, option name to value (empty: no trial completed)
+    config_file: Path | None  # DIR/best.toml, the best options as a controller config (None: no trial completed)
+    runs: SweepResult  # every run of every trial, with its trial number
+    objective: str  # the objective in words (`objective_text`)
+    ran: int = 0  # >= 0; runs executed in this call
 
     def to_pandas(self) -> pd.DataFrame:
         """The trial history (a copy).

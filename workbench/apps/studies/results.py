@@ -38,12 +38,11 @@ REPORT_METRICS: tuple[tuple[str, str], ...] = (
 
 @dataclass(frozen=True, eq=False)
 class SweepResult:
-    """table: one row per run, in the study's order; out_dir: where it is stored; ran: how many runs executed in
-    the call that produced it (the others were already stored)."""
+    """The runs of a sweep as one table, and where it is stored."""
 
-    table: pd.DataFrame
-    out_dir: Path | None = None
-    ran: int = 0
+    table: pd.DataFrame  # one row per run, in the study's order
+    out_dir: Path | None = None  # where the sweep is stored (None: nowhere)
+    ran: int = 0  # >= 0; runs executed in the call that produced it (the others were already stored)
 
     @classmethod
     def from_rows(cls, rows: Sequence[Mapping[str, Any]], out_dir: Path | None = None, ran: int = 0) -> SweepResult:
