@@ -33,7 +33,7 @@ def _long_options(parser: argparse.ArgumentParser) -> set[str]:
 def synopses(page: Path, program: str) -> dict[str, str]:
     """Each command's synopsis text in the page's first code block that shows `program COMMAND` lines: from its
     first line to the next command's (continuation lines included)."""
-    blocks = re.findall(r"```\n(.*?)```", page.read_text(encoding="utf-8"), re.DOTALL)
+    blocks = re.findall(r"```(?:text)?\n(.*?)```", page.read_text(encoding="utf-8"), re.DOTALL)
     block = next(b for b in blocks if re.search(rf"^{program} [a-z]", b, re.MULTILINE))
     found: dict[str, str] = {}
     command = None
