@@ -225,18 +225,18 @@ def spread_points(front: Sequence[int], points: Mapping[int, Sequence[float]], c
 
 @dataclass(frozen=True, eq=False)
 class TournamentResult:
-    """results: every run (module docstring); history: one row per controller and trial; chosen: controller ->
-    its chosen trial (None: no trial completed, its tuned configuration is its default); config_files: controller ->
-    its chosen configuration's file (the first vehicle's); ran: runs executed in this call; judgement and report:
-    the verdict and DIR/report.html (None when not asked for)."""
+    """A tournament's runs, trials and chosen configurations, and its verdict when a report was asked for.
 
-    results: pd.DataFrame
-    history: pd.DataFrame
-    chosen: Mapping[str, int | None]
-    config_files: Mapping[str, Path]
-    ran: int
-    judgement: Any = None
-    report: Path | None = None
+    A controller with no completed trial is judged with its default as its tuned configuration.
+    """
+
+    results: pd.DataFrame  # every run, as DIR/results.parquet (module docstring)
+    history: pd.DataFrame  # one row per controller and trial, as DIR/history.parquet
+    chosen: Mapping[str, int | None]  # controller -> its chosen trial (None: no trial completed)
+    config_files: Mapping[str, Path]  # controller -> its chosen configuration's file (the first vehicle's)
+    ran: int  # >= 0; runs executed in this call (the others were already stored)
+    judgement: Any = None  # the verdict, a `tournament_judging.Judgement` (None: no report asked for)
+    report: Path | None = None  # DIR/report.html (None: no report asked for)
 
 
 def run_command(run: PlannedRun, config_file: Path) -> str:
