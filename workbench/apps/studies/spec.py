@@ -253,22 +253,18 @@ def _file_digest(path: Path, cache: dict[Path, str | None]) -> str | None:
 
 @dataclass(frozen=True)
 class PlannedRun:
-    """One run of a study, everything a worker needs: scenario (a name or an absolute waypoint-file path),
-    controller, vehicle (a preset name or an absolute vehicle-file path), values (run parameters given, typed),
-    options (controller parameters given, typed), sample (the random draw's index, None without draws),
-    controller_config (a controller-options TOML), track_file; run_id (hash of the canonical parameters) and
-    index (its place in the study's order)."""
+    """One run of a study, everything a worker needs."""
 
-    run_id: str
-    index: int
-    scenario: str
-    controller: str
-    vehicle: str
-    values: tuple[tuple[str, Any], ...] = ()
-    options: tuple[tuple[str, Any], ...] = ()
-    sample: int | None = None
-    controller_config: Path | None = None
-    track_file: Path | None = None
+    run_id: str  # hash of the run's canonical parameters
+    index: int  # >= 0; its place in the study's order
+    scenario: str  # a scenario's name or an absolute waypoint-file path
+    controller: str  # a registered controller's name
+    vehicle: str  # a preset's name or an absolute vehicle-file path
+    values: tuple[tuple[str, Any], ...] = ()  # the run parameters given, (name, typed value) pairs
+    options: tuple[tuple[str, Any], ...] = ()  # the controller options given, (name, typed value) pairs
+    sample: int | None = None  # the random draw's index (None: the study has no draws)
+    controller_config: Path | None = None  # a controller-options TOML file
+    track_file: Path | None = None  # the Zandvoort track file, for a zandvoort run (None: other scenarios)
 
     def parameters(self) -> dict[str, Any]:
         """The run's columns before its metrics: ids, names, speed_kmh (always) and each given parameter
@@ -391,30 +387,26 @@ class OptimiseSettings:
 
 @dataclass(frozen=True)
 class StudySpec:
-    """A study: see the module docstring. base_dir: the folder relative paths are taken from (the spec file's).
-    grid / random: run-parameter axes / distributions; controller_grid / controller_random: the same per
-    controller; max_runs: the most runs the study may plan (an optimisation: trials x runs per trial);
-    allow_long_runs: let runs longer than the bounds of `run_size` start (`study_size.py`); allow_infeasible: let
-    runs start on a path a vehicle cannot follow at the planned speed (`study_feasibility.py`). Values are
-    checked and typed on construction (paths made absolute, the files they name read)."""
+    """A study: see the module docstring. Values are checked and typed on construction (paths made absolute, the
+    files they name read); the name lists are not empty and name none twice."""
 
-    scenarios: Sequence[str]
-    controllers: Sequence[str]
-    vehicles: Sequence[str]
-    grid: Mapping[str, Any] = field(default_factory=dict)
-    controller_grid: Mapping[str, Mapping[str, Any]] = field(default_factory=dict)
-    random: Mapping[str, Any] = field(default_factory=dict)
-    controller_random: Mapping[str, Mapping[str, Any]] = field(default_factory=dict)
-    seed: int = 0
-    samples: int | None = None
-    controller_config: Path | None = None
-    track_file: Path | None = None
-    description: str = ""
-    base_dir: Path = field(default_factory=Path.cwd)
-    optimise: OptimiseSettings | None = None
-    max_runs: int = DEFAULT_MAX_RUNS
-    allow_long_runs: bool = False
-    allow_infeasible: bool = False
+    scenarios: Sequence[str]  # scenario names, or waypoint files relative to base_dir
+    controllers: Sequence[str]  # registered controller names
+    vehicles: Sequence[str]  # preset names, or vehicle TOML files relative to base_dir
+    grid: Mapping[str, Any] = field(default_factory=dict)  # run parameter -> its axis of values ([grid])
+    controller_grid: Mapping[str, Mapping[str, Any]] = field(default_factory=dict)  # controller -> option -> axis
+    random: Mapping[str, Any] = field(default_factory=dict)  # run parameter -> its distribution ([random])
+    controller_random: Mapping[str, Mapping[str, Any]] = field(default_factory=dict)  # controller -> option -> draw
+    seed: int = 0  # whole, >= 0; the seed of the random draws
+    samples: int | None = None  # whole, >= 1; the number of draws, given exactly when something is drawn
+    controller_config: Path | None = None  # a controller-options TOML file for every run
+    track_file: Path | None = None  # the Zandvoort track (None: from $WORKBENCH_ZANDVOORT_CSV or where it is kept)
+    description: str = ""  # free text
+    base_dir: Path = field(default_factory=Path.cwd)  # the folder relative paths are taken from (the spec file's)
+    optimise: OptimiseSettings | None = None  # the [optimise] table (None: a sweep)
+    max_runs: int = DEFAULT_MAX_RUNS  # whole, >= 1; most runs it may plan (an optimisation: trials x runs per trial)
+    allow_long_runs: bool = False  # let runs longer than the bounds of `run_size` start (`study_size.py`)
+    allow_infeasible: bool = False  # let runs start on a path a vehicle cannot follow at its planned speed
 
     def __post_init__(self) -> None:
         """Check and type the study, in this order: the names (controllers, scenarios, vehicles), the files and
