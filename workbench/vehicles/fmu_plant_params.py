@@ -88,7 +88,7 @@ class FmuPlantParams:
     rear_cornering_stiffness_n_per_rad: float | None  # single track: rear axle's (N/rad), > 0
     front_peak_force_n: float | None  # single track: the front axle's peak lateral force (N), > 0
     rear_peak_force_n: float | None  # single track: the rear axle's peak lateral force (N), > 0
-    lag_file: Path | None  # an identified steering lag (`tuning fit-lag` writes one); None: none
+    lag_file: Path | None  # an identified steering lag (`tuning fit-lag` writes one); None: no identified lag
     rollover_threshold_g: float | None  # the feasibility check's static rollover threshold (g), in [0.05, 2]; None: off
     hitch_to_trailer_axle_m: float | None  # hitch to the trailer's axle (m), in [0.5, 20]; needed with trailer outputs
     steering_input: str  # the FMU input variable of the steering command
@@ -124,9 +124,9 @@ class FmuPlantParams:
     trailer_x_output_scale: float  # FMU value / workbench value, finite and not 0
     trailer_y_output: str | None  # y of the trailer's rear-axle centre (m); given with trailer_x_output or neither
     trailer_y_output_scale: float  # FMU value / workbench value, finite and not 0
-    articulation_output: str | None  # the articulation angle (rad); None: none
+    articulation_output: str | None  # the articulation angle (rad); None: not mapped
     articulation_output_scale: float  # FMU value / workbench value, finite and not 0
-    speed_parameter: str | None  # the FMU parameter set to the initial speed (vx_output's units); None: the FMU's
+    speed_parameter: str | None  # the FMU parameter set to the initial speed (vx_output's units); None: the FMU's own
     payload_parameter: str | None  # the FMU parameter set to payload_kg; None: the FMU's own payload
     payload_kg: float | None  # the payload written to payload_parameter (kg), in [0, 100000]
     friction_parameter: str | None  # the FMU's tunable tyre-friction parameter; None: only road friction 1.0
