@@ -268,39 +268,46 @@ def _contains(dist: Distribution, value: Any) -> bool:
 
 @dataclass(frozen=True)
 class TournamentSpec:
-    """A tournament (module docstring). search: per controller, parameter -> distribution (its own space with the
-    spec's [search.NAME] over it, the fixed options left out); fixed: per controller, option -> value for every
-    run (the MPCs' solve budget included); defaults: per controller, the shipped default of each searched
-    parameter (trial 0); studies: (controller, set) -> StudySpec; source: the spec file, if read from one.
-    selection and ranking: metric -> weight (None: DEFAULT_SELECTION, DEFAULT_RANKING)."""
+    """A tournament (module docstring). Built on construction: search, per controller, parameter -> distribution
+    (its own space with the spec's [search.NAME] over it, the fixed options left out); fixed, per controller,
+    option -> value for every run (the MPCs' solve budget included); defaults, per controller, the shipped default
+    of each searched parameter (trial 0); studies, (controller, set) -> StudySpec."""
 
-    controllers: tuple[str, ...]
-    vehicles: tuple[str, ...]
-    train: CaseSet
-    test: CaseSet
-    trials: int
-    batch_size: int = DEFAULT_BATCH_SIZE
-    seed: int = 0
-    objectives: tuple[str, ...] = DEFAULT_OBJECTIVES
+    controllers: tuple[str, ...]  # registered controller names, not empty, none twice
+    vehicles: tuple[str, ...]  # preset names or vehicle TOML files, not empty
+    train: CaseSet  # the training cases, the CaseSet named "train"
+    test: CaseSet  # the held-out test cases, the CaseSet named "test" (no case in both sets)
+    trials: int  # whole, >= 1; the trial budget of each controller
+    batch_size: int = DEFAULT_BATCH_SIZE  # whole, >= 1; trials asked and run together
+    seed: int = 0  # whole, >= 0; the seed of the trial samplers and of the judging's bootstrap
+    objectives: tuple[str, ...] = DEFAULT_OBJECTIVES  # the metrics a front is drawn over (of OBJECTIVE_METRICS)
     # None gives the default weights; __post_init__ replaces it by the checked weights, so that a constructed spec
     # always holds a mapping (a field's type cannot differ between the constructor and the instance)
-    selection: Mapping[str, float] = None  # type: ignore[assignment]
-    ranking: Mapping[str, float] = None  # type: ignore[assignment]
-    failure_score: float = DEFAULT_FAILURE_SCORE
-    off_path_m: float = DEFAULT_OFF_PATH_M
-    front_points: int = MAX_FRONT_POINTS
-    inform_delays: bool = True
-    search_tables: Mapping[str, Mapping[str, Any]] = field(default_factory=dict)
-    fixed_tables: Mapping[str, Mapping[str, Any]] = field(default_factory=dict)
-    max_runs: int = DEFAULT_MAX_RUNS
-    track_file: str | None = None
-    description: str = ""
-    base_dir: Path = field(default_factory=Path.cwd)
-    source: Path | None = None
-    search: Mapping[str, Mapping[str, Distribution]] = field(init=False)
-    fixed: Mapping[str, Mapping[str, Any]] = field(init=False)
-    defaults: Mapping[str, Mapping[str, Any]] = field(init=False)
-    studies: Mapping[tuple[str, str], StudySpec] = field(init=False)
+    selection: Mapping[str, float] = field(
+        default=None,  # type: ignore[arg-type]
+        metadata={"doc": "objective -> weight (>= 0, not all 0) naming each front's chosen point (None: the "
+                         "default, DEFAULT_SELECTION)"},
+    )
+    ranking: Mapping[str, float] = field(
+        default=None,  # type: ignore[arg-type]
+        metadata={"doc": "metric of OBJECTIVE_METRICS -> weight (>= 0, not all 0) of a test run's ranking scalar "
+                         "(None: the default, DEFAULT_RANKING)"},
+    )
+    failure_score: float = DEFAULT_FAILURE_SCORE  # finite; the ranking scalar of a failed run
+    off_path_m: float = DEFAULT_OFF_PATH_M  # m, > 0; a run whose |CTE| once on the path exceeds this fails
+    front_points: int = MAX_FRONT_POINTS  # whole, 0 to MAX_FRONT_POINTS; front points carried to the test set
+    inform_delays: bool = True  # whether the controllers are told the conditions' nominal delays and pose noise
+    search_tables: Mapping[str, Mapping[str, Any]] = field(default_factory=dict)  # [search.NAME] per controller
+    fixed_tables: Mapping[str, Mapping[str, Any]] = field(default_factory=dict)  # [fixed.NAME] per controller
+    max_runs: int = DEFAULT_MAX_RUNS  # whole, >= 1; the most runs the tournament may plan
+    track_file: str | None = None  # the Zandvoort track file (None: $WORKBENCH_ZANDVOORT_CSV or where it is kept)
+    description: str = ""  # free text
+    base_dir: Path = field(default_factory=Path.cwd)  # the folder relative paths are taken from (the spec file's)
+    source: Path | None = None  # the spec file, if read from one
+    search: Mapping[str, Mapping[str, Distribution]] = field(init=False)  # controller -> parameter -> distribution
+    fixed: Mapping[str, Mapping[str, Any]] = field(init=False)  # controller -> option -> value for every run
+    defaults: Mapping[str, Mapping[str, Any]] = field(init=False)  # controller -> searched parameter -> default
+    studies: Mapping[tuple[str, str], StudySpec] = field(init=False)  # (controller, set) -> StudySpec
 
     def __post_init__(self) -> None:
         """Check the scalars and rules, the controllers and their tables, the tournament's size (at most
