@@ -160,6 +160,8 @@ def _field_lines(cls: type) -> list[str]:
         if field.name.startswith("_") or not field.init:
             continue
         doc = field.metadata.get("doc") or comments.get(field.name, "")
+        if doc and not doc.endswith("."):  # a comment is a phrase; the Allowed and Default sentences follow it
+            doc += "."
         rule = field.metadata.get("rule")
         allowed = rule.allowed() if rule is not None and hasattr(rule, "allowed") else ""
         parts = [p for p in (doc, f"Allowed: {allowed}." if allowed else "", f"Default: ``{_default_text(field)}``.")
