@@ -9,14 +9,10 @@ The build needs no network: no intersphinx, and the third-party types that canno
 from __future__ import annotations
 
 import dataclasses
-import inspect
-import io
 import os
 import re
 import shutil
 import sys
-import textwrap
-import tokenize
 import tomllib
 from pathlib import Path
 from typing import Any
@@ -119,24 +115,10 @@ nitpick_ignore_regex = [
 # A config dataclass documents each field beside the field: an option's unit, range and meaning in its metadata
 # (controllers.config_checks.option), a parameter's in the comment that follows it. The reference lists them.
 def _trailing_comments(cls: type) -> dict[str, str]:
-    """The comment at the end of each ``name: type = value  # comment`` line of the class body."""
-    try:
-        source = textwrap.dedent(inspect.getsource(cls))
-    except (OSError, TypeError):
-        return {}
-    comments: dict[str, str] = {}
-    lines = source.splitlines()
-    for token in tokenize.generate_tokens(io.StringIO(source).readline):
-        if token.type != tokenize.COMMENT:
-            continue
-        line = lines[token.start[0] - 1]
-        head = line[: token.start[1]].strip()
-        if ":" in head and not head.startswith(("def ", "class ", "#")) and line.startswith("    ") and \
-                not line.startswith("        "):
-            name = head.split(":", 1)[0].strip()
-            if name.isidentifier():
-                comments[name] = token.string.lstrip("#:").strip()
-    return comments
+    """The comment at the end of each ``name: type = value  # comment`` line of the class body (_ext/field_comments)."""
+    from field_comments import trailing_comments  # docs/_ext, on the path above
+
+    return trailing_comments(cls)
 
 
 def _rst_text(text: str) -> str:

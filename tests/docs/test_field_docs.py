@@ -1,7 +1,8 @@
 """Every dataclass of the reference documents each field beside it: the doc of a controller's `option(...)` or
 the comment at the end of the field's line (its meaning, unit and allowed range), which the reference lists under
-the class's Fields with the default (docs/conf.py, `_field_lines`). Reads the sources through conf.py's own reader,
-so that the test and the reference cannot disagree about what counts as a field's comment."""
+the class's Fields with the default (docs/conf.py, `_field_lines`). Reads the sources through the reader conf.py
+uses (docs/_ext/field_comments.py), so that the test and the reference cannot disagree about what counts as a
+field's comment; needs no Sphinx."""
 
 from __future__ import annotations
 
@@ -10,7 +11,6 @@ import functools
 import importlib
 import importlib.util
 import inspect
-import os
 import re
 from pathlib import Path
 from types import ModuleType
@@ -27,17 +27,12 @@ _TOOL_PRAGMA = re.compile(r"^(type:|noqa|fmt:|pragma\b)")
 
 
 @functools.cache
-def _conf() -> ModuleType:
-    """docs/conf.py as a module, the environment as it was (conf.py drops MPLBACKEND for the notebooks' kernels)."""
-    backend = os.environ.get("MPLBACKEND")
-    spec = importlib.util.spec_from_file_location("_docs_conf_for_field_docs", ROOT / "docs" / "conf.py")
+def _field_comments() -> ModuleType:
+    """docs/_ext/field_comments.py, the reader docs/conf.py lists the fields with (standard library only)."""
+    spec = importlib.util.spec_from_file_location("_docs_field_comments", ROOT / "docs" / "_ext" / "field_comments.py")
     assert spec is not None and spec.loader is not None
     module = importlib.util.module_from_spec(spec)
-    try:
-        spec.loader.exec_module(module)
-    finally:
-        if backend is not None:
-            os.environ["MPLBACKEND"] = backend
+    spec.loader.exec_module(module)
     return module
 
 
@@ -60,7 +55,7 @@ def undocumented_fields(cls: type) -> list[str]:
     """The fields of `cls` the reference lists without a doc: neither metadata "doc" nor a comment on their line
     (a tool's pragma, such as ``# type: ignore[...]``, is not a doc)."""
     comments = {
-        name: text for name, text in _conf()._trailing_comments(cls).items() if not _TOOL_PRAGMA.match(text)
+        name: text for name, text in _field_comments().trailing_comments(cls).items() if not _TOOL_PRAGMA.match(text)
     }
     return [
         f.name
