@@ -80,8 +80,6 @@ def measured_on(document: Mapping[str, Any]) -> str:
         f"Measured on {document['measured_utc']} with `{document['command']}` on {m.get('platform')}, "
         f"Python {m.get('python')}, {m.get('cpus')} CPUs{load_text}."
     )
-    if document.get("machine_note"):
-        text += f" ({document['machine_note']}.)"
     return text
 
 
