@@ -206,6 +206,35 @@ def fig17_cte_figure(out: Path) -> None:
     fig.savefig(out, dpi=110)
 
 
+def mpc_dlc_figure(out: Path) -> None:
+    """The NMPC, the linear MPC and the clothoid controller on the loaded truck's dlc at 30 km/h: CTE against
+    distance and the steering each took, its step median in the legend; saved to out."""
+    from matplotlib.figure import Figure
+
+    from workbench.apps.comparison import RunSpec, compare
+    from workbench.simulation.simulator import SimulationConfig
+
+    comparison = compare(
+        "dlc",
+        (RunSpec("nmpc", TRUCK), RunSpec("lmpc", TRUCK), RunSpec("clothoid", TRUCK)),
+        SimulationConfig(speed_kmh=LOOP_SPEED_KMH),
+        progress=False,
+    )
+    fig = Figure(figsize=(9, 6.5), layout="constrained")
+    cte_ax, steer_ax = fig.subplots(2, 1)
+    comparison.plot_cte(cte_ax, zoom=False)
+    comparison.plot_steering(steer_ax)
+    steps = comparison.summary().set_index("controller")["step_time_median_us"]
+    for ax in (cte_ax, steer_ax):
+        for line in ax.get_lines():
+            name = line.get_label().split(" ")[0]
+            if name in steps.index:
+                line.set_label(f"{line.get_label()} (step median {float(steps[name]):.0f} us)")
+        ax.legend(fontsize=8)
+    cte_ax.set_title(f"dlc at {LOOP_SPEED_KMH:g} km/h on the loaded truck: the MPCs and the clothoid controller")
+    fig.savefig(out, dpi=110)
+
+
 def cached_figure(out: Path, make: Any, key: str) -> bool:
     """Make the figure at out with make(out) unless out exists with this key beside it (out.key); whether it
     was made."""
@@ -228,6 +257,7 @@ def generate(app: Any = None) -> None:
     key = source_hash()
     cached_figure(GENERATED / "loop_margins_truck.png", loop_margins_figure, key)
     cached_figure(GENERATED / "fig17_cte.png", fig17_cte_figure, key)
+    cached_figure(GENERATED / "mpc_dlc_truck.png", mpc_dlc_figure, key)
 
 
 #: The generated table snippets: read by the pages' include directives, not pages of their own.

@@ -162,3 +162,9 @@ def test_loop_margins_figure_is_drawn(figures: ModuleType, tmp_path: Path) -> No
     out = tmp_path / "loop_margins_truck.png"
     figures.loop_margins_figure(out)
     assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_mpc_dlc_figure_is_drawn(figures: ModuleType, tmp_path: Path) -> None:
+    out = tmp_path / "mpc_dlc_truck.png"
+    figures.mpc_dlc_figure(out)
+    assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
