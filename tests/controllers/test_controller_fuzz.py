@@ -17,6 +17,7 @@ for their 10^5 steps), 47 s with `-n 2`.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -281,12 +282,18 @@ def measurement_sequences(draw, path: ReferencePath, geometry: VehicleGeometry) 
 
 
 _BUILT: dict[str, object] = {}
+#: The MPCs' solve-time budget here (s): with the default (one controller period) a solve that a loaded machine
+#: slows past it is replaced by the shifted plan, and the same measurement would steer differently run to run.
+RELAXED_SOLVE_TIME_S = 0.5
 
 
 def _controller(name: str):
     if name not in _BUILT:
         vehicle = KinematicBicycle()
-        _BUILT[name] = tuned_controller(name, vehicle)
+        config = CONTROLLERS[name].config_type()
+        if any(f.name == "max_solve_time_s" for f in dataclasses.fields(config)):
+            config = dataclasses.replace(config, max_solve_time_s=RELAXED_SOLVE_TIME_S)
+        _BUILT[name] = tuned_controller(name, vehicle, config)
     return _BUILT[name]
 
 

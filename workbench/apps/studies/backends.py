@@ -430,7 +430,9 @@ class DaskBackend(_StartedInWith):
                     n_workers=self.workers,
                     threads_per_worker=1,
                     processes=True,
-                    dashboard_address=None,
+                    # a free port: dashboard_address=None still serves on 8787 and warns when a second
+                    # cluster finds it taken (dask/distributed#8136)
+                    dashboard_address=":0",
                     silence_logs=CLUSTER_LOG_LEVEL,
                 )
             self._client = Client(self._cluster)

@@ -221,6 +221,9 @@ def test_local_workers_ignore_the_stop_signals_and_closing_the_busy_pool_ends_th
         assert worker.is_alive(), "a stop signal ended the worker"
         start = time.monotonic()
     assert not worker.is_alive() and time.monotonic() - start < STOP_BOUND_S / 2
-    assert worker.exitcode == -signal.SIGKILL
+    # killed, as the pool reports it: a forkserver child's status comes through the forkserver, and when that
+    # status is lost multiprocessing reports 255 (multiprocessing/popen_forkserver.py, Popen.poll)
+    killed = (-signal.SIGKILL, 255) if type(worker).__name__ == "ForkServerProcess" else (-signal.SIGKILL,)
+    assert worker.exitcode in killed, worker.exitcode
     loop.join(STOP_BOUND_S)
     assert not loop.is_alive() and len(outcome) == 1 and isinstance(outcome[0], BackendError), outcome
