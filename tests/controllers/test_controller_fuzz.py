@@ -360,12 +360,16 @@ def test_numpy_scalars_of_every_real_dtype_steer_as_their_float_values(name: str
         results = []
         for measurement in (typed, as_floats):
             controller.reset(path, DT_S)
-            results.append((controller.step(measurement, path), controller.diagnostics["measurement_rejected"]))
-        (command, rejected), (command_of_floats, rejected_of_floats) = results
+            command = controller.step(measurement, path)
+            diagnostics = controller.diagnostics
+            results.append((command, diagnostics["measurement_rejected"], diagnostics.get("fallback", 0.0)))
+        (command, rejected, fell_back), (command_of_floats, rejected_of_floats, fell_back_of_floats) = results
         assert rejected == rejected_of_floats, (typed, controller.rejection)
-        if [getattr(as_floats, field) for field in FIELDS] == row:  # the dtype holds the values as they are
+        solved_both = not (fell_back or fell_back_of_floats)
+        if [getattr(as_floats, field) for field in FIELDS] == row and solved_both:  # the dtype holds the values
             # OSQP's adaptive rho depends on timing: the MPCs' solutions agree to the solver's tolerance, not bit
-            # for bit (far off the path, where an unsigned dtype wraps a negative coordinate, not even that)
+            # for bit (far off the path, where an unsigned dtype wraps a negative coordinate, not even that), and
+            # on a loaded machine one of the two solves may miss its budget or iteration limit and fall back
             assert command == pytest.approx(command_of_floats, abs=1e-3), typed
             accepted += rejected == 0.0
     assert accepted >= 6  # the float dtypes at least (float16 holds these whole numbers), and the wide ints
