@@ -82,6 +82,9 @@ for _notebook in sorted(NOTEBOOKS_SOURCE.glob("*.ipynb")):
 autodoc_default_options = {"member-order": "bysource"}
 autodoc_typehints = "description"
 autodoc_typehints_format = "short"
+# Types are added to the parameters and return values a docstring documents; a dataclass lists its fields
+# (`_field_lines`), so its signature is not listed a second time as bare parameters.
+autodoc_typehints_description_target = "documented"
 autodoc_preserve_defaults = True
 autodoc_class_signature = "mixed"
 autosummary_generate = False

@@ -192,3 +192,30 @@ def test_a_dataclass_without_its_own_docstring_counts_as_undocumented() -> None:
 
     assert _own_docstring(Undocumented) == ""
     assert _own_docstring(Documented) == "Says what it is."
+
+
+def _assigns(module: ModuleType, name: str) -> bool:
+    """Whether the module's own top level assigns `name` (not an import of it)."""
+    for node in ast.parse(inspect.getsource(module)).body:
+        targets = node.targets if isinstance(node, ast.Assign) else []
+        targets += [node.target] if isinstance(node, ast.AnnAssign) else []
+        if any(isinstance(t, ast.Name) and t.id == name for t in targets):
+            return True
+    return False
+
+
+def test_a_constant_is_documented_where_it_is_assigned() -> None:
+    """Sphinx reads a constant's `#:` comment from the module the directive names: named through a package that
+    re-exports it, the page shows the docstring of its type (a tuple's, a float's) instead."""
+    elsewhere = []
+    for page in sorted(API_PAGES.glob("*.md")):
+        for kind, path in _DIRECTIVE.findall(page.read_text(encoding="utf-8")):
+            module_name, _, name = path.rpartition(".")
+            if kind == "data" and not _assigns(importlib.import_module(module_name), name):
+                elsewhere.append(f"{page.name}: {path}")
+    assert not elsewhere, f"autodata naming a module that only imports the constant: {elsewhere}"
+
+
+def test_the_assignment_check_tells_an_import_from_an_assignment() -> None:
+    assert _assigns(importlib.import_module("workbench.vehicles.base"), "STANDARD_OUTPUTS")
+    assert not _assigns(importlib.import_module("workbench.vehicles"), "STANDARD_OUTPUTS")
