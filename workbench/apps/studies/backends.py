@@ -307,6 +307,12 @@ class LocalBackend(_StartedInWith):
         deadline = time.monotonic() + KILLED_WORKER_JOIN_S
         for worker in workers:
             worker.join(max(0.0, deadline - time.monotonic()))
+        # The pool's manager thread closes its wake-up pipe as it winds down; Python 3.11's exit handler writes to
+        # that pipe unless it is closed, and a close between its check and its write prints a traceback (OSError:
+        # bad file descriptor) as the interrupted command exits. Waiting for the thread closes the race.
+        manager = getattr(pool, "_executor_manager_thread", None)
+        if manager is not None:
+            manager.join(max(0.0, deadline - time.monotonic()))
 
     def map_runs(self, runs: Sequence[PlannedRun]) -> Iterator[dict[str, Any]]:
         """Run `runs` on the pool's workers, yielding each run's row as it finishes (in completion order, not in
