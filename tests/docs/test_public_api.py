@@ -75,6 +75,12 @@ def _own_docstring(obj: Any) -> str:
     return doc.strip()
 
 
+def _assigns_name(node: ast.stmt, name: str) -> bool:
+    """Whether the statement assigns `name` (plainly or with an annotation)."""
+    targets = node.targets if isinstance(node, ast.Assign) else [node.target] if isinstance(node, ast.AnnAssign) else []
+    return any(isinstance(t, ast.Name) and t.id == name for t in targets)
+
+
 def _assignment_doc(module: ModuleType, name: str, seen: frozenset[str] = frozenset()) -> str | None:
     """The doc of the module-level constant `name`: the string after its assignment or the `#:` comment before it
     (or on its line), followed through `from X import name` to the module that assigns it; None if not found."""
@@ -84,13 +90,7 @@ def _assignment_doc(module: ModuleType, name: str, seen: frozenset[str] = frozen
     lines = source.splitlines()
     body = ast.parse(source).body
     for index, node in enumerate(body):
-        if isinstance(node, ast.Assign):
-            targets = node.targets
-        elif isinstance(node, ast.AnnAssign):
-            targets = [node.target]
-        else:
-            targets = []
-        if any(isinstance(t, ast.Name) and t.id == name for t in targets):
+        if _assigns_name(node, name):
             after = body[index + 1] if index + 1 < len(body) else None
             if isinstance(after, ast.Expr) and isinstance(after.value, ast.Constant) and isinstance(
                 after.value.value, str
@@ -196,12 +196,7 @@ def test_a_dataclass_without_its_own_docstring_counts_as_undocumented() -> None:
 
 def _assigns(module: ModuleType, name: str) -> bool:
     """Whether the module's own top level assigns `name` (not an import of it)."""
-    for node in ast.parse(inspect.getsource(module)).body:
-        targets = node.targets if isinstance(node, ast.Assign) else []
-        targets += [node.target] if isinstance(node, ast.AnnAssign) else []
-        if any(isinstance(t, ast.Name) and t.id == name for t in targets):
-            return True
-    return False
+    return any(_assigns_name(node, name) for node in ast.parse(inspect.getsource(module)).body)
 
 
 def test_a_constant_is_documented_where_it_is_assigned() -> None:
