@@ -6,15 +6,20 @@ from __future__ import annotations
 
 import inspect
 import io
+import re
 import textwrap
 import tokenize
+
+#: A comment that only instructs a tool (a type checker, a linter, a formatter) documents nothing.
+TOOL_PRAGMA = re.compile(r"^(type:|noqa|fmt:|pragma\b)")
 
 
 def trailing_comments(cls: type) -> dict[str, str]:
     """The comment at the end of each ``name: type = value  # comment`` line of the class body, by field name.
 
     Only a line of the class body itself counts (indented once): a comment on a line of its own, on a method's
-    line or on a continuation line documents nothing. Empty when the source cannot be read.
+    line or on a continuation line documents nothing, nor does a tool's pragma (``# type: ignore[...]``). Empty
+    when the source cannot be read.
     """
     try:
         source = textwrap.dedent(inspect.getsource(cls))
@@ -30,6 +35,7 @@ def trailing_comments(cls: type) -> dict[str, str]:
         if ":" in head and not head.startswith(("def ", "class ", "#")) and line.startswith("    ") and \
                 not line.startswith("        "):
             name = head.split(":", 1)[0].strip()
-            if name.isidentifier():
-                comments[name] = token.string.lstrip("#:").strip()
+            text = token.string.lstrip("#:").strip()
+            if name.isidentifier() and not TOOL_PRAGMA.match(text):
+                comments[name] = text
     return comments

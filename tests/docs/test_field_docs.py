@@ -11,7 +11,6 @@ import functools
 import importlib
 import importlib.util
 import inspect
-import re
 from pathlib import Path
 from types import ModuleType
 
@@ -22,8 +21,6 @@ from tests.docs.test_public_api import MODULES
 ROOT = Path(__file__).resolve().parents[2]
 #: The packages of the project: a third-party dataclass a module re-exports is documented by its own project.
 PROJECT_PACKAGES = ("workbench", "controllers", "tuning")
-#: A comment that only instructs a tool (a type checker, a linter, a formatter) documents nothing.
-_TOOL_PRAGMA = re.compile(r"^(type:|noqa|fmt:|pragma\b)")
 
 
 @functools.cache
@@ -54,9 +51,7 @@ def _reference_dataclasses() -> list[type]:
 def undocumented_fields(cls: type) -> list[str]:
     """The fields of `cls` the reference lists without a doc: neither metadata "doc" nor a comment on their line
     (a tool's pragma, such as ``# type: ignore[...]``, is not a doc)."""
-    comments = {
-        name: text for name, text in _field_comments().trailing_comments(cls).items() if not _TOOL_PRAGMA.match(text)
-    }
+    comments = _field_comments().trailing_comments(cls)
     return [
         f.name
         for f in dataclasses.fields(cls)
