@@ -14,7 +14,7 @@ from typing import Any
 
 import pytest
 
-from tests.docs.test_public_api import MODULES
+from tests.docs.test_public_api import _public_names
 
 _PROJECT = ("workbench", "controllers", "tuning")
 
@@ -26,20 +26,18 @@ def _section(doc: str, name: str) -> bool:
 
 def _public_callables() -> Iterator[tuple[str, Callable[..., Any]]]:
     seen: set[int] = set()
-    for module_name in MODULES:
-        module = importlib.import_module(module_name)
-        for name in getattr(module, "__all__", ()):
-            obj = getattr(module, name)
-            if inspect.isfunction(obj) and obj.__module__.startswith(_PROJECT) and id(obj) not in seen:
-                seen.add(id(obj))
-                yield f"{obj.__module__}.{obj.__qualname__}", obj
-            if inspect.isclass(obj) and obj.__module__.startswith(_PROJECT):
-                for member_name, member in vars(obj).items():
-                    function = member.__func__ if isinstance(member, classmethod | staticmethod) else member
-                    if member_name.startswith("_") or not inspect.isfunction(function) or id(function) in seen:
-                        continue
-                    seen.add(id(function))
-                    yield f"{obj.__module__}.{obj.__qualname__}.{member_name}", function
+    for module_name, name in _public_names():
+        obj = getattr(importlib.import_module(module_name), name)
+        if inspect.isfunction(obj) and obj.__module__.startswith(_PROJECT) and id(obj) not in seen:
+            seen.add(id(obj))
+            yield f"{obj.__module__}.{obj.__qualname__}", obj
+        if inspect.isclass(obj) and obj.__module__.startswith(_PROJECT):
+            for member_name, member in vars(obj).items():
+                function = member.__func__ if isinstance(member, classmethod | staticmethod) else member
+                if member_name.startswith("_") or not inspect.isfunction(function) or id(function) in seen:
+                    continue
+                seen.add(id(function))
+                yield f"{obj.__module__}.{obj.__qualname__}.{member_name}", function
 
 
 def _raises_input_error(function: Callable[..., Any]) -> bool:
