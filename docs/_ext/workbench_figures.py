@@ -224,12 +224,12 @@ def mpc_dlc_figure(out: Path) -> None:
     cte_ax, steer_ax = fig.subplots(2, 1)
     comparison.plot_cte(cte_ax, zoom=False)
     comparison.plot_steering(steer_ax)
-    steps = comparison.summary().set_index("controller")["step_time_median_us"]
+    steps = dict(zip(comparison.labels, comparison.summary()["step_time_median_us"], strict=True))
     for ax in (cte_ax, steer_ax):
         for line in ax.get_lines():
-            name = line.get_label().split(" ")[0]
-            if name in steps.index:
-                line.set_label(f"{line.get_label()} (step median {float(steps[name]):.0f} us)")
+            label = line.get_label()
+            if label in steps:
+                line.set_label(f"{label} (step median {float(steps[label]):.0f} us)")
         ax.legend(fontsize=8)
     cte_ax.set_title(f"dlc at {LOOP_SPEED_KMH:g} km/h on the loaded truck: the MPCs and the clothoid controller")
     fig.savefig(out, dpi=110)
