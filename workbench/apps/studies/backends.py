@@ -30,12 +30,13 @@ from __future__ import annotations
 import logging
 import multiprocessing
 import os
+import queue
 import re
 import signal
 import threading
 import time
-from collections.abc import Iterator, Sequence
-from concurrent.futures import Future, ProcessPoolExecutor, as_completed
+from collections.abc import Iterable, Iterator, Sequence
+from concurrent.futures import Future, ProcessPoolExecutor
 from concurrent.futures.process import BrokenProcessPool
 from contextlib import contextmanager
 from types import TracebackType
@@ -60,6 +61,8 @@ class BackendError(RuntimeError):
 ORPHAN_CHECK_S = 1.0
 #: How long (s) closing an interrupted local pool waits for its killed workers to be reaped.
 KILLED_WORKER_JOIN_S = 2.0
+#: How long (s) a study waiting for its runs may take to act on a stop signal that another of its threads received.
+SIGNAL_CHECK_S = 0.5
 #: How long (s) connecting to a dask scheduler may take before it is refused as unreachable.
 SCHEDULER_TIMEOUT_S = 10.0
 #: What a LocalCluster's scheduler, nannies and workers log: critical failures only. Its other errors reach the
@@ -210,6 +213,31 @@ def start_context() -> multiprocessing.context.BaseContext:
     return multiprocessing.get_context("spawn")
 
 
+def _in_completion_order(futures: Iterable[Any]) -> Iterator[Any]:
+    """`futures` (concurrent.futures' or dask's) as each finishes.
+
+    A stop signal's handler raises KeyboardInterrupt in the main thread wherever it is; inside
+    `threading.Condition.wait` (which both libraries' `as_completed` block in) that can land between the
+    condition's release and re-acquire and surface as "RuntimeError: release unlocked lock" instead. Here the main
+    thread blocks only in `queue.SimpleQueue.get`, which is C and leaves its lock consistent when a handler raises,
+    so an interrupted study always sees the KeyboardInterrupt."""
+    finished: queue.SimpleQueue[Any] = queue.SimpleQueue()
+    count = 0
+    for future in futures:
+        future.add_done_callback(finished.put)
+        count += 1
+    for _ in range(count):
+        yield _next_finished(finished)
+
+
+def _next_finished(finished: queue.SimpleQueue[Any]) -> Any:
+    while True:  # with a timeout, so that a signal another thread received is acted on within it
+        try:
+            return finished.get(timeout=SIGNAL_CHECK_S)
+        except queue.Empty:
+            continue
+
+
 @contextmanager
 def _stop_signals_blocked(signals: frozenset[signal.Signals] = _STOP_SIGNALS) -> Iterator[None]:
     """Block `signals` (SIGINT and SIGTERM) in this thread while worker processes may be started: they and the
@@ -342,7 +370,7 @@ class LocalBackend(_StartedInWith):
             futures = {self._pool.submit(execute_run, run): run for run in runs}
         self._futures = list(futures)
         try:
-            for future in as_completed(futures):
+            for future in _in_completion_order(futures):
                 try:
                     row = future.result()  # execute_run returns rows; only the machinery raises here
                 except BrokenProcessPool as exc:
@@ -483,7 +511,6 @@ class DaskBackend(_StartedInWith):
             The cluster could not run a run (e.g. the workbench is missing on a worker); the runs left are
             cancelled.
         """
-        from distributed import as_completed
         from distributed.scheduler import KilledWorker
 
         if self._client is None:
@@ -496,7 +523,7 @@ class DaskBackend(_StartedInWith):
             futures.append(future)
         self._futures = futures
         try:
-            for future in as_completed(futures):
+            for future in _in_completion_order(futures):
                 try:
                     row = future.result()
                 except KilledWorker as exc:
