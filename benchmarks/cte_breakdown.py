@@ -36,6 +36,15 @@ with the nominal lags altered: the measured curvature without the sideslip's lea
 lag), no understeer (K = 1), the speed bands a braking truck passes (20 and 25 km/h), the floor lowered or off.
 The feed-forward does not enter the loop (its term depends on the path only), so it changes nothing there.
 
+The clothoid controller's models of the vehicle, checked along the NMPC's nominal run in ideal conditions (which
+keeps within a few centimetres of the path, so it stands for a vehicle following the path; `model_errors`):
+  - reference: the curvature the feedback's reference pose starts on (`step_kernel.reference_curvature`, the yaw
+    rate / speed that a vehicle following the path measures, from the identified lags) against the yaw rate / speed
+    measured on the run; the feedback reads any difference as an error of the vehicle's;
+  - feedforward: the lag-inverting feed-forward (`path_feedforward.lag_inverse_curvature`) against the steering the
+    NMPC sent, both as kinematic curvature tan(road wheel angle) / wheelbase.
+Each as RMS and max (1/m) and the RMS over the path curvature's RMS on the run.
+
 Prints the tables and writes benchmarks/results/cte_breakdown.json and one figure per vehicle
 (benchmarks/results/cte_breakdown_<vehicle>.png: |CTE| against distance for each switch on the worst case, with the
 path curvature and the longitudinal acceleration beneath). About 4-6 minutes on 2 shared cores, and once about a
@@ -91,6 +100,8 @@ STIFF_RELAXATION_M = 0.05
 CONSTANT_SPEED_LATERAL_G = 2.0
 #: Longitudinal acceleration is smoothed over this many controller samples (0.1 s) before it is read.
 ACCEL_SMOOTHING_SAMPLES = 5
+#: The models are checked where the vehicle moves faster than this (m/s): the yaw rate over speed is defined there.
+MODEL_CHECK_MIN_SPEED_MPS = 1.0
 
 
 def plant_for(vehicle_name: str, switch: str):
@@ -155,7 +166,48 @@ class Run:
     wall_s: float
 
 
-def run_one(job: tuple[str, str, str, str, str]) -> tuple[Run, dict[str, list[float]]]:
+def model_errors(trace: dict, path, tuning, geometry, window_m: float) -> dict[str, float]:
+    """The clothoid controller's reference curvature and feed-forward (module docstring) along a run's `trace`
+    (path_s_m, speed_mps, yaw_rate_rad_s, steer_wheel_cmd_rad, path_curvature_1pm) on `path`, with the vehicle's
+    identified lags (`tuning`, a VehicleTuning), its geometry and the feed-forward's derivative window (m), as the
+    compiled step computes them with no known delay: reference_{rms,max}_1pm, feedforward_{rms,max}_1pm (the
+    differences from the measured and the sent), their RMS relative to path_curvature_rms_1pm, and samples."""
+    from controllers.clothoid.path_feedforward import lag_inverse_curvature
+    from controllers.clothoid.speed_tables import table_row
+    from controllers.clothoid.step_kernel import reference_curvature
+
+    s, speed, yaw_rate, command, curvature = (
+        np.asarray(trace[k], dtype=float)
+        for k in ("path_s_m", "speed_mps", "yaw_rate_rad_s", "steer_wheel_cmd_rad", "path_curvature_1pm")
+    )
+    compiled = path.compiled()
+    speeds, lags, measured_lags = tuning.lag_tables
+    rows, lag = np.empty(8), np.empty(4)
+    moving = np.flatnonzero(speed > MODEL_CHECK_MIN_SPEED_MPS)
+    reference, feedforward = np.empty(moving.size), np.empty(moving.size)
+    for j, i in enumerate(moving):
+        reference[j] = reference_curvature(
+            compiled.table, compiled.record, s[i], speed[i], lags, measured_lags, speeds, window_m, rows
+        )
+        table_row(speeds, lags, speed[i] * 3.6, False, lag)
+        omega_n, zeta, delay, gain = lag
+        feedforward[j] = lag_inverse_curvature(
+            compiled.table, compiled.record, s[i], speed[i], delay, omega_n, zeta, gain, window_m
+        )[0]
+    measured = yaw_rate[moving] / speed[moving]
+    sent = np.tan(command[moving] / geometry.steering_ratio) / geometry.wheelbase_m
+    path_rms = float(np.sqrt(np.mean(curvature[moving] ** 2)))
+    out: dict[str, float] = {"path_curvature_rms_1pm": path_rms, "samples": float(moving.size)}
+    for name, error in (("reference", measured - reference), ("feedforward", sent - feedforward)):
+        rms = float(np.sqrt(np.mean(error**2)))
+        out |= {f"{name}_rms_1pm": rms, f"{name}_max_1pm": float(np.max(np.abs(error))),
+                f"{name}_relative": rms / path_rms if path_rms > 0.0 else math.nan}  # fmt: skip
+    return out
+
+
+def run_one(job: tuple[str, str, str, str, str]) -> tuple[Run, dict[str, list[float]], dict[str, object] | None]:
+    """One run of `jobs_for`: its Run, its trace thinned for the figure and, for the NMPC's nominal run in ideal
+    conditions, the clothoid controller's model errors along it (`model_errors`, with vehicle and scenario)."""
     vehicle_name, scenario_name, switch, controller_name, conditions = job
     plant = plant_for(vehicle_name, switch)
     scenario = make_scenario(scenario_name, ScenarioOptions(plant.geometry.width_m, None))
@@ -195,7 +247,15 @@ def run_one(job: tuple[str, str, str, str, str]) -> tuple[Run, dict[str, list[fl
     )  # fmt: skip
     step = max(1, len(s) // 2000)
     trace = {k: a[::step].tolist() for k, a in (("s", s), ("cte", cte), ("kappa", kappa), ("accel", accel))}
-    return run, trace
+    errors = None
+    if (controller_name, switch, conditions) == ("nmpc", "nominal", "ideal"):
+        from controllers.clothoid.controller import ClothoidConfig
+        from tuning.own_tuning import tuning_for
+
+        window = ClothoidConfig().feedforward_window_m
+        errors = {"vehicle": vehicle_name, "scenario": scenario_name,
+                  **model_errors(tr, scenario.path, tuning_for(plant), plant.geometry, window)}  # fmt: skip
+    return run, trace, errors
 
 
 def jobs_for(vehicles: list[str], scenarios: list[str], automotive: bool) -> list[tuple[str, str, str, str, str]]:
@@ -355,18 +415,19 @@ def main(argv: list[str] | None = None) -> int:
     jobs = jobs_for(vehicles, scenarios, not args.no_automotive)
     with ProcessPoolExecutor(max_workers=args.workers) as pool:
         results = list(pool.map(run_one, jobs, chunksize=2))
-    runs = {(r.vehicle, r.scenario, r.switch, r.controller, r.conditions): r for r, _ in results}
-    traces = {(r.vehicle, r.scenario, r.switch, r.controller, r.conditions): t for r, t in results}
+    runs = {(r.vehicle, r.scenario, r.switch, r.controller, r.conditions): r for r, _, _ in results}
+    traces = {(r.vehicle, r.scenario, r.switch, r.controller, r.conditions): t for r, t, _ in results}
+    models = [errors for _, _, errors in results if errors is not None]
     print(f"{'vehicle':<20} {'scenario':<13} {'cond':<5} {'switch':<21} {'ctrl':<8} {'max|CTE|':>8} {'RMS':>6} "
           f"{'s@max':>7} {'κ@max':>7} {'ax@max':>6} {'osc°':>5} {'rate':>5} LC")  # fmt: skip
-    for r, _ in results:
+    for r, _, _ in results:
         print(
             f"{r.vehicle:<20} {r.scenario:<13} {r.conditions[:5]:<5} {r.switch:<21} {r.controller:<8} "
             f"{r.max_abs_cte_m:8.3f} {r.rms_cte_m:6.3f} {r.s_at_max_m:7.1f} {r.curvature_at_max_1pm:7.3f} "
             f"{r.long_accel_at_max_mps2:6.2f} {r.steer_oscillation_deg:5.1f} {r.rms_steer_rate_deg_s:5.0f} "
             f"{'yes' if r.limit_cycle else 'no'}"
         )
-    table = summary([r for r, _ in results])
+    table = summary([r for r, _, _ in results])
     print(f"\n{'vehicle':<20} {'cond':<10} {'switch':<21} {'max|CTE| x':>10} {'RMS x':>6} {'gap closed':>10} "
           f"{'/ NMPC':>7} LC")  # fmt: skip
     for row in table:
@@ -374,6 +435,14 @@ def main(argv: list[str] | None = None) -> int:
             f"{row['vehicle']:<20} {row['conditions']:<10} {row['switch']:<21} "
             f"{row['median_max_cte_vs_nominal']:10.2f} {row['median_rms_cte_vs_nominal']:6.2f} "
             f"{row['median_gap_closed']:10.0%} {row['median_ratio_to_nmpc_same_run']:7.2f} {row['limit_cycles']}"
+        )
+    print(f"\n{'models along the NMPC run':<34} {'reference RMS':>13} {'max':>8} {'rel.':>5} {'feed-fwd RMS':>12} "
+          f"{'max':>8} {'rel.':>5}")  # fmt: skip
+    for row in models:
+        print(
+            f"{row['vehicle'] + ' ' + row['scenario']:<34} {row['reference_rms_1pm']:13.2e} "
+            f"{row['reference_max_1pm']:8.1e} {row['reference_relative']:5.1%} {row['feedforward_rms_1pm']:12.2e} "
+            f"{row['feedforward_max_1pm']:8.1e} {row['feedforward_relative']:5.1%}"
         )
     loops = [row for v in vehicles for row in loop_rows(v)]
     print(f"\n{'vehicle':<20} {'loop (30 km/h unless said)':<40} {'floor':>6} {'PM°':>5} {'GM dB':>6} {'GRM dB':>7} "
@@ -393,18 +462,19 @@ def main(argv: list[str] | None = None) -> int:
             path = folder / f"cte_breakdown_{v}.png"
             figure(v, worst, traces, runs, path)
             figures.append(str(path))
-    write_results(args.out, result_document([r for r, _ in results], table, loops, figures),
+    write_results(args.out, result_document([r for r, _, _ in results], table, loops, figures, models),
                   f" and {', '.join(figures)}")  # fmt: skip
     return 0
 
 
 def result_document(runs: list[Run], table: list[dict[str, object]], loops: list[dict[str, object]],
-                    figures: list[str]) -> dict[str, object]:  # fmt: skip
+                    figures: list[str], models: list[dict[str, object]]) -> dict[str, object]:  # fmt: skip
     """What the benchmark writes: the machine it ran on, when, the speed, every run, the summary table, the loop
-    analysis rows and the figures' paths."""
+    analysis rows, the figures' paths and the model errors along the NMPC's runs."""
     return {
         "machine": machine(), "created_unix_s": time.time(), "speed_kmh": SPEED_KMH,
         "runs": [asdict(r) for r in runs], "summary": table, "loop_analysis": loops, "figures": figures,
+        "model_error": models,
     }  # fmt: skip
 
 

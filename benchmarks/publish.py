@@ -64,6 +64,8 @@ _BREAKDOWN = ("vehicle", "conditions", "switch", "median_max_cte_vs_nominal", "m
               "median_gap_closed", "median_ratio_to_nmpc_same_run", "limit_cycles", "scenarios")  # fmt: skip
 _LOOPS = ("vehicle", "case", "speed_kmh", "floor_m", "phase_margin_deg", "gain_margin_db", "gain_reduction_margin_db",
           "crossover_hz", "bandwidth_hz", "stable")  # fmt: skip
+_MODELS = ("vehicle", "scenario", "reference_rms_1pm", "reference_max_1pm", "reference_relative", "feedforward_rms_1pm",
+           "feedforward_max_1pm", "feedforward_relative", "path_curvature_rms_1pm")  # fmt: skip
 _STARTUP = ("name", "median_s", "min_s", "overhead_s", "goal", "goal_met")
 
 BENCHMARKS: dict[str, Benchmark] = {
@@ -77,7 +79,10 @@ BENCHMARKS: dict[str, Benchmark] = {
         "cte_breakdown.json",
         "python benchmarks/cte_breakdown.py",
         Table("Summary", "summary", _BREAKDOWN),
-        (Table("Loop analysis", "loop_analysis", _LOOPS),),
+        (
+            Table("Loop analysis", "loop_analysis", _LOOPS),
+            Table("The clothoid controller's models along the NMPC's runs", "model_error", _MODELS),
+        ),
     ),
     "fmu_plant": Benchmark(
         "fmu_plant.json", "python benchmarks/fmu_plant.py --check", Table("Summary", "entries", _TIMED_ENTRIES)

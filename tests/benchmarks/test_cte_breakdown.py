@@ -6,6 +6,7 @@ from __future__ import annotations
 import dataclasses
 import time
 
+import numpy as np
 import pytest
 
 from workbench.vehicles import make_vehicle
@@ -120,8 +121,50 @@ def test_the_result_records_the_machine_and_the_date(breakdown) -> None:
     from benchmark_report import machine
 
     before = time.time()
-    document = breakdown.result_document([], [{"vehicle": "v"}], [], ["f.png"])
+    document = breakdown.result_document([], [{"vehicle": "v"}], [], ["f.png"], [{"vehicle": "v", "scenario": "s"}])
     assert document["machine"]["platform"] == machine()["platform"]
     assert document["machine"]["cpus"] == machine()["cpus"]
     assert before <= document["created_unix_s"] <= time.time()
     assert (document["summary"], document["figures"], document["runs"]) == ([{"vehicle": "v"}], ["f.png"], [])
+    assert document["model_error"] == [{"vehicle": "v", "scenario": "s"}]
+
+
+def _steady_turn(curvature_1pm: float, speed_mps: float, yaw_rate_scale: float, gain: float, geometry) -> dict:
+    """A trace of a vehicle driving a long arc at a held speed: yaw rate speed x curvature (times yaw_rate_scale),
+    steering whose kinematic curvature is the arc's over `gain`."""
+    s = np.linspace(60.0, 140.0, 201)
+    steer = np.arctan(geometry.wheelbase_m * curvature_1pm / gain) * geometry.steering_ratio
+    return {
+        "path_s_m": s,
+        "speed_mps": np.full_like(s, speed_mps),
+        "yaw_rate_rad_s": np.full_like(s, speed_mps * curvature_1pm * yaw_rate_scale),
+        "steer_wheel_cmd_rad": np.full_like(s, steer),
+        "path_curvature_1pm": np.full_like(s, curvature_1pm),
+    }
+
+
+def test_the_model_errors_in_a_steady_turn(breakdown) -> None:
+    """On an arc the reference is the arc's curvature (rigid-body kinematics: yaw rate / speed) and the feed-forward
+    the arc's curvature over the lag's K: a vehicle that measures and steers exactly that has no model error, one
+    whose yaw rate is 1 % high a reference error of 1 % of the curvature, and the feed-forward's error is the
+    steering's own."""
+    from tuning.own_tuning import tuning_for
+    from workbench.base.clothoid_chain import ClothoidChain
+
+    truck = make_vehicle("tractor-semitrailer")
+    tuning, curvature, speed = tuning_for(truck), 1 / 40, 30 / 3.6
+    gain = tuning.lag_at(30.0).steady_state_gain
+    path = ClothoidChain(curvature_1pm=curvature).arc(200.0).to_path("arc")
+    exact = breakdown.model_errors(_steady_turn(curvature, speed, 1.0, gain, truck.geometry), path, tuning,
+                                   truck.geometry, 2.0)  # fmt: skip
+    assert exact["samples"] == 201
+    assert exact["path_curvature_rms_1pm"] == pytest.approx(curvature)
+    for name in ("reference", "feedforward"):
+        assert exact[f"{name}_rms_1pm"] == pytest.approx(0.0, abs=1e-9)
+        assert exact[f"{name}_max_1pm"] == pytest.approx(0.0, abs=1e-9)
+    high = breakdown.model_errors(_steady_turn(curvature, speed, 1.01, 1.0, truck.geometry), path, tuning,
+                                  truck.geometry, 2.0)  # fmt: skip
+    assert high["reference_rms_1pm"] == pytest.approx(0.01 * curvature, rel=1e-6)
+    assert high["reference_relative"] == pytest.approx(0.01, rel=1e-6)
+    # steering for K = 1 where the lag has K: the feed-forward sends curvature / K, the vehicle curvature
+    assert high["feedforward_rms_1pm"] == pytest.approx(abs(curvature - curvature / gain), rel=1e-6)
