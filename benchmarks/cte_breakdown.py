@@ -16,8 +16,12 @@ Switches (each against `nominal`, the shipped defaults on the preset vehicle):
   - feedforward_rate: the feed-forward's other form, the path's curvature rate (averaged over 6 m) at the lags'
     low-frequency delay ahead, integrated through the lead filter, and the reference pose a first-order lead ahead
     (`feedforward_inversion=false`, `feedforward_window_m=6`);
-  - reference_lead: the lag inverted as by default, the feedback's reference pose the first-order lead ahead
-    instead of on the curvature the lags give (`lag_model_reference=false`);
+  - reference_lead: the lag inverted, the feedback's reference pose the first-order lead ahead instead of on the
+    curvature the lags give (`lag_model_reference=false`; with the preview responses, which the truck uses by
+    default, it changes nothing);
+  - lag_model, preview_model: the feed-forward and the reference curvature from the lags of Eq. 5
+    (`feedforward_model='lag'`) or from the preview responses identified from the same logs ('preview'); by default
+    ('auto') the truck uses the preview responses and the car the lags, so on each one of the two is nominal;
   - nmpc_identified_lag: the clothoid controller as by default against the NMPC predicting with the identified lag
     of Eq. 5 the clothoid controller is designed on (its `kinematic-lag` model, the lag at 30 km/h) instead of the
     vehicle's single-track equivalent: how much of the gap is the model each is given, not the control law.
@@ -37,7 +41,8 @@ lag), no understeer (K = 1), the speed bands a braking truck passes (20 and 25 k
 The feed-forward does not enter the loop (its term depends on the path only), so it changes nothing there.
 
 The clothoid controller's models of the vehicle, checked along the NMPC's nominal run in ideal conditions (which
-keeps within a few centimetres of the path, so it stands for a vehicle following the path; `model_errors`):
+keeps within a few centimetres of the path, so it stands for a vehicle following the path; `model_errors`), each
+from the lags of Eq. 5 and (prefixed preview_) from the preview responses (`preview_model.preview_curvature`):
   - reference: the curvature the feedback's reference pose starts on (`step_kernel.reference_curvature`, the yaw
     rate / speed that a vehicle following the path measures, from the identified lags) against the yaw rate / speed
     measured on the run; the feedback reads any difference as an error of the vehicle's;
@@ -85,7 +90,10 @@ HELD_OUT_FIRST_SEED = 9000
 SPEED_KMH = 30.0
 #: switch -> (plant changes, run-config changes, clothoid config changes).
 PLANT_SWITCHES = ("no_actuator_lag", "stiff_tyres", "constant_speed", "ideal_plant")
-CONTROLLER_SWITCHES = ("floor_lowered", "floor_off", "feedforward_off", "feedforward_rate", "reference_lead")
+CONTROLLER_SWITCHES = (
+    "floor_lowered", "floor_off", "feedforward_off", "feedforward_rate", "reference_lead", "lag_model",
+    "preview_model",
+)  # fmt: skip
 #: The feed-forward's curvature-rate window (m) in its rate form (the feedforward_rate switch).
 RATE_FEEDFORWARD_WINDOW_M = 6.0
 #: Switches of the NMPC's model (the clothoid controller runs as nominal).
@@ -131,6 +139,8 @@ def clothoid_config_for(switch: str, config):
         return dataclasses.replace(config, feedforward_inversion=False, feedforward_window_m=RATE_FEEDFORWARD_WINDOW_M)
     if switch == "reference_lead":
         return dataclasses.replace(config, lag_model_reference=False)
+    if switch in ("lag_model", "preview_model"):
+        return dataclasses.replace(config, feedforward_model=switch.removesuffix("_model"))
     return config
 
 
@@ -173,6 +183,7 @@ def model_errors(trace: dict, path, tuning, geometry, window_m: float) -> dict[s
     compiled step computes them with no known delay: reference_{rms,max}_1pm, feedforward_{rms,max}_1pm (the
     differences from the measured and the sent), their RMS relative to path_curvature_rms_1pm, and samples."""
     from controllers.clothoid.path_feedforward import lag_inverse_curvature
+    from controllers.clothoid.preview_model import preview_curvature
     from controllers.clothoid.speed_tables import table_row
     from controllers.clothoid.step_kernel import reference_curvature
 
@@ -185,7 +196,13 @@ def model_errors(trace: dict, path, tuning, geometry, window_m: float) -> dict[s
     rows, lag = np.empty(8), np.empty(4)
     moving = np.flatnonzero(speed > MODEL_CHECK_MIN_SPEED_MPS)
     reference, feedforward = np.empty(moving.size), np.empty(moving.size)
+    preview_reference, preview_feedforward = np.full(moving.size, np.nan), np.full(moving.size, np.nan)
+    first, spacing, steering_taps, measured_taps = tuning.preview_tables
     for j, i in enumerate(moving):
+        if steering_taps.shape[0] > 0:
+            args = (compiled.table, compiled.record, s[i], speed[i], 0.0, first, spacing, speeds)
+            preview_reference[j] = preview_curvature(*args, measured_taps)
+            preview_feedforward[j] = preview_curvature(*args, steering_taps)
         reference[j] = reference_curvature(
             compiled.table, compiled.record, s[i], speed[i], lags, measured_lags, speeds, window_m, rows
         )
@@ -198,7 +215,10 @@ def model_errors(trace: dict, path, tuning, geometry, window_m: float) -> dict[s
     sent = np.tan(command[moving] / geometry.steering_ratio) / geometry.wheelbase_m
     path_rms = float(np.sqrt(np.mean(curvature[moving] ** 2)))
     out: dict[str, float] = {"path_curvature_rms_1pm": path_rms, "samples": float(moving.size)}
-    for name, error in (("reference", measured - reference), ("feedforward", sent - feedforward)):
+    for name, error in (
+        ("reference", measured - reference), ("feedforward", sent - feedforward),
+        ("preview_reference", measured - preview_reference), ("preview_feedforward", sent - preview_feedforward),
+    ):  # fmt: skip
         rms = float(np.sqrt(np.mean(error**2)))
         out |= {f"{name}_rms_1pm": rms, f"{name}_max_1pm": float(np.max(np.abs(error))),
                 f"{name}_relative": rms / path_rms if path_rms > 0.0 else math.nan}  # fmt: skip
@@ -437,12 +457,13 @@ def main(argv: list[str] | None = None) -> int:
             f"{row['median_gap_closed']:10.0%} {row['median_ratio_to_nmpc_same_run']:7.2f} {row['limit_cycles']}"
         )
     print(f"\n{'models along the NMPC run':<34} {'reference RMS':>13} {'max':>8} {'rel.':>5} {'feed-fwd RMS':>12} "
-          f"{'max':>8} {'rel.':>5}")  # fmt: skip
+          f"{'max':>8} {'rel.':>5} {'preview: ref. rel.':>18} {'feed-fwd rel.':>13}")  # fmt: skip
     for row in models:
         print(
             f"{row['vehicle'] + ' ' + row['scenario']:<34} {row['reference_rms_1pm']:13.2e} "
             f"{row['reference_max_1pm']:8.1e} {row['reference_relative']:5.1%} {row['feedforward_rms_1pm']:12.2e} "
-            f"{row['feedforward_max_1pm']:8.1e} {row['feedforward_relative']:5.1%}"
+            f"{row['feedforward_max_1pm']:8.1e} {row['feedforward_relative']:5.1%} "
+            f"{row['preview_reference_relative']:18.1%} {row['preview_feedforward_relative']:13.1%}"
         )
     loops = [row for v in vehicles for row in loop_rows(v)]
     print(f"\n{'vehicle':<20} {'loop (30 km/h unless said)':<40} {'floor':>6} {'PM°':>5} {'GM dB':>6} {'GRM dB':>7} "

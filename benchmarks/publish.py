@@ -65,7 +65,8 @@ _BREAKDOWN = ("vehicle", "conditions", "switch", "median_max_cte_vs_nominal", "m
 _LOOPS = ("vehicle", "case", "speed_kmh", "floor_m", "phase_margin_deg", "gain_margin_db", "gain_reduction_margin_db",
           "crossover_hz", "bandwidth_hz", "stable")  # fmt: skip
 _MODELS = ("vehicle", "scenario", "reference_rms_1pm", "reference_max_1pm", "reference_relative", "feedforward_rms_1pm",
-           "feedforward_max_1pm", "feedforward_relative", "path_curvature_rms_1pm")  # fmt: skip
+           "feedforward_max_1pm", "feedforward_relative", "preview_reference_relative",
+           "preview_feedforward_relative", "path_curvature_rms_1pm")  # fmt: skip
 _STARTUP = ("name", "median_s", "min_s", "overhead_s", "goal", "goal_met")
 
 BENCHMARKS: dict[str, Benchmark] = {

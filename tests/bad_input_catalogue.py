@@ -424,6 +424,8 @@ NUMBER_OPTIONS: tuple[tuple[str, tuple[str, ...], str, frozenset[str]], ...] = (
     ("tuning", ("schedule", "margins"), "--controller-rate-hz", frozenset()),
     ("tuning", ("schedule", "margins"), "--prediction-time-s", frozenset({"0"})),
     ("tuning", ("schedule",), "--nominal-speed", frozenset()),
+    ("tuning", ("schedule",), "--preview-past-s", frozenset({"0"})),
+    ("tuning", ("schedule",), "--preview-future-s", frozenset({"0"})),
     ("tuning", ("margins",), "--phase-margin-deg", frozenset()),
     ("tuning", ("margins",), "--gain-margin-db", frozenset()),
 )
@@ -459,6 +461,8 @@ MEANINGFUL = {
     "tuning-margins---phase-margin-deg=1e-300": "as 0 deg",
     "tuning-margins---prediction-time-s=1e-300": "no prediction, as 0 s",
     "tuning-schedule---prediction-time-s=1e-300": "no prediction, as 0 s",
+    "tuning-schedule---preview-past-s=1e-300": "no past taps, as 0 s",
+    "tuning-schedule---preview-future-s=1e-300": "no future taps, as 0 s",
     "tuning-rollover-limits---payload-kg=1e-300": "an empty trailer",
     "tuning-fit-lag---max-speed-variation=0": "a log held at exactly one speed (this one is)",
     "tuning-fit-lag---max-speed-variation=1e-300": "as 0",

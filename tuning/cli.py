@@ -226,6 +226,7 @@ def _parser(command: str | None = None) -> argparse.ArgumentParser:
 
     sched = sub.add_parser("schedule", help="lag and lead filter at each speed; write a scheduled lead-filter file")
     if _builds(command, "schedule"):
+        from tuning.preview_fit import PreviewFitOptions
         from tuning.schedule import DEFAULT_CONTROLLER_RATE_HZ, DEFAULT_LAT_ACCEL_G, DEFAULT_PREDICTION_TIME_S, DESIGNS
 
         _vehicle_options(sched)
@@ -257,6 +258,19 @@ def _parser(command: str | None = None) -> argparse.ArgumentParser:
             type=float,
             default=DEFAULT_PREDICTION_TIME_S,
             help=f"its pose prediction for --design margins (default {DEFAULT_PREDICTION_TIME_S:g} s)",
+        )
+        sched.add_argument(
+            "--preview-past-s",
+            type=float,
+            default=PreviewFitOptions.past_s,
+            help="how far before the present the preview responses reach (default "
+            f"{PreviewFitOptions.past_s:g} s; the slow responses' settling, tuning/preview_fit.py)",
+        )
+        sched.add_argument(
+            "--preview-future-s",
+            type=float,
+            default=PreviewFitOptions.future_s,
+            help=f"how far after the present they reach (default {PreviewFitOptions.future_s:g} s; the lag's preview)",
         )
         sched.add_argument(
             "--drop-refused",
@@ -525,8 +539,10 @@ def _steering_limits(args: argparse.Namespace) -> int:
 def _schedule(args: argparse.Namespace) -> int:
     from tuning.filter_comparison import compare_closed_loop, fixed_and_scheduled_filters, scheduled_against_fixed
     from tuning.lag_fit import LagFitOptions
+    from tuning.preview_fit import PreviewFitOptions
     from tuning.schedule import PAPER_SPEED_KMH, SPEED_MATCH_KMH, identify_schedule
     from tuning.speeds import parse_speeds
+    from workbench.base.errors import require_in_range
 
     out = _filter_path(args)
     vehicle = _vehicle(args)
@@ -546,6 +562,9 @@ def _schedule(args: argparse.Namespace) -> int:
             "km/h); the nominal (top-level) filter is the one designed at one of the speeds identified: give one "
             "of them, or add it to --speeds"
         )
+    require_in_range("--preview-past-s", args.preview_past_s, 0.0, 30.0, "s")
+    require_in_range("--preview-future-s", args.preview_future_s, 0.0, 10.0, "s")
+    preview = PreviewFitOptions(past_s=args.preview_past_s, future_s=args.preview_future_s)
     with _progress_bar(len(speeds), "speed", "tuning schedule") as bar:
         bar.set_postfix_str(f"{speeds[0]:g} km/h")
 
@@ -568,6 +587,7 @@ def _schedule(args: argparse.Namespace) -> int:
             design=args.design,
             controller_rate_hz=args.controller_rate_hz,
             prediction_time_s=args.prediction_time_s,
+            preview_options=preview,
         )
     if nominal is not None:
         result.entry_at(nominal, "--nominal-speed")  # dropped by --drop-refused: refused, saying why

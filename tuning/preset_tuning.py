@@ -37,6 +37,7 @@ from typing import Any
 
 from tuning.lag_fit import LagFitOptions
 from tuning.limits_file import write_limits_file
+from tuning.preview_fit import PreviewFitOptions
 from tuning.rollover import LTR_OUTPUT, rollover_limits
 from tuning.rollover import to_curvature_limits as rollover_curvature_limits
 from tuning.schedule import (
@@ -69,6 +70,10 @@ EXIT_STALE = 1
 EXIT_INPUT_ERROR = 2
 
 
+#: The preview fit's defaults (`tuning/preview_fit.py`), the tuning options' too.
+PREVIEW_DEFAULTS = PreviewFitOptions()
+
+
 @dataclass(frozen=True)
 class SpeedOverride:
     """Schedule speeds (km/h) for one model type instead of the common ones, and why."""
@@ -93,6 +98,8 @@ class VehicleTuningOptions:
     design: str = "cancel"
     controller_rate_hz: float = DEFAULT_CONTROLLER_RATE_HZ
     prediction_time_s: float = DEFAULT_PREDICTION_TIME_S
+    preview_past_s: float = PREVIEW_DEFAULTS.past_s
+    preview_future_s: float = PREVIEW_DEFAULTS.future_s
 
     def to_dict(self) -> dict[str, Any]:
         out = asdict(self)
@@ -118,7 +125,9 @@ class PresetTuningOptions:
     design: the lead design at each speed (`--design`: "cancel", zeros on the path lag's poles, or "margins", the
     shortest lookahead floor of the clothoid loop with 45 deg / 6 dB margins, from the path and measured lags);
     controller_rate_hz, prediction_time_s: the clothoid controller's rate and pose prediction the margins design
-    analyses (`--controller-rate-hz`, `--prediction-time-s`; its defaults, 50 Hz and 0.2 s).
+    analyses (`--controller-rate-hz`, `--prediction-time-s`; its defaults, 50 Hz and 0.2 s); preview_past_s,
+    preview_future_s: how far before and after the present the preview responses reach (`--preview-past-s`,
+    `--preview-future-s`, `tuning/preview_fit.py`; 8 s holds the truck's trailer settling, 2 s its lag's preview).
     """
 
     schedule_speeds_kmh: tuple[float, ...]
@@ -132,6 +141,8 @@ class PresetTuningOptions:
     design: str = "cancel"
     controller_rate_hz: float = DEFAULT_CONTROLLER_RATE_HZ
     prediction_time_s: float = DEFAULT_PREDICTION_TIME_S
+    preview_past_s: float = PREVIEW_DEFAULTS.past_s
+    preview_future_s: float = PREVIEW_DEFAULTS.future_s
 
     def __post_init__(self) -> None:
         for name in ("schedule_speeds_kmh", "limits_speeds_kmh"):
@@ -148,6 +159,8 @@ class PresetTuningOptions:
             raise WorkbenchInputError(f"design must be one of {', '.join(DESIGNS)}; got {self.design!r}")
         require_in_range("controller_rate_hz", self.controller_rate_hz, 1.0, 1000.0, "Hz")
         require_in_range("prediction_time_s", self.prediction_time_s, 0.0, 2.0, "s")
+        require_in_range("preview_past_s", self.preview_past_s, 0.0, 30.0, "s")  # PreviewFitOptions' ranges
+        require_in_range("preview_future_s", self.preview_future_s, 0.0, 10.0, "s")
 
     def for_model(self, model_type: str) -> VehicleTuningOptions:
         override = next((o for o in self.speed_overrides if o.model == model_type), None)
@@ -163,6 +176,8 @@ class PresetTuningOptions:
             design=self.design,
             controller_rate_hz=float(self.controller_rate_hz),
             prediction_time_s=float(self.prediction_time_s),
+            preview_past_s=float(self.preview_past_s),
+            preview_future_s=float(self.preview_future_s),
         )
 
 
@@ -179,6 +194,8 @@ PRESET_TUNING_OPTIONS = PresetTuningOptions(
     design="margins",
     controller_rate_hz=50.0,
     prediction_time_s=0.2,
+    preview_past_s=8.0,
+    preview_future_s=2.0,
 )
 
 
@@ -224,6 +241,8 @@ def tuning_commands(
     if options.design == "margins":
         schedule += ["--controller-rate-hz", _number(options.controller_rate_hz)]
         schedule += ["--prediction-time-s", _number(options.prediction_time_s)]
+    schedule += ["--preview-past-s", _number(options.preview_past_s)]
+    schedule += ["--preview-future-s", _number(options.preview_future_s)]
     schedule += ["--drop-refused", "--out", LEAD_FILE]
     if has_roll_model(vehicle):
         limits = ["tuning", "rollover-limits", *vehicle_args, "--speeds", _speeds(options.limits_speeds_kmh)]
@@ -312,6 +331,7 @@ def write_tuning_files(
         design=resolved.design,
         controller_rate_hz=resolved.controller_rate_hz,
         prediction_time_s=resolved.prediction_time_s,
+        preview_options=PreviewFitOptions(past_s=resolved.preview_past_s, future_s=resolved.preview_future_s),
     )
     result.write(directory / LEAD_FILE)
     middle = time.perf_counter()

@@ -29,6 +29,7 @@ import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 from scipy.constants import g as G_MPS2  # standard gravity, 9.80665 m/s^2
 
@@ -49,6 +50,7 @@ from tuning.lead_design import (
 )
 from tuning.log_file import VehicleLog
 from tuning.maneuvers import Maneuver
+from tuning.preview_fit import PreviewFit, PreviewFitOptions, fit_preview
 from tuning.speeds import check_speeds
 from workbench.base.errors import WorkbenchInputError, require_in_range, value_text
 from workbench.vehicles.base import VehicleModel
@@ -88,8 +90,9 @@ class ScheduleEntry:
     design: LeadDesign  # the filter designed for it
     measured_fit: LagFit | None = None  # the fit of the measured (yaw-rate) lag (None: not identified)
     margins: MarginsDesign | None = None  # the margins design's lookahead floors (None: the cancel design)
+    preview: PreviewFit | None = None  # the preview responses fitted to the same logs (None: not identified)
 
-    def row(self) -> dict[str, float]:
+    def row(self) -> dict[str, Any]:
         """The entry as one row of the lead-filter file's ``design.per_speed`` table and of `ScheduleResult.table`.
 
         Returns
@@ -99,10 +102,11 @@ class ScheduleEntry:
             under the same keys prefixed ``measured_`` when it was identified; the filter (omega_z_rad_s, psi,
             omega_p_rad_s), its lead_peak_gain and the plant's and cascade's bandwidths (rad/s); with the margins
             design, lookahead_floor_m (or margin_score when no lookahead keeps the margins) and
-            floor_without_lead_m when finite.
+            floor_without_lead_m when finite; with the preview responses, their first tap and spacing (s), NRMSE and
+            taps (lists of float), under keys prefixed ``preview_``.
         """
         lag, d = self.fit.lag, self.design
-        out = {
+        out: dict[str, Any] = {
             "speed_kmh": self.speed_kmh,
             "omega_n_rad_s": lag.omega_n_rad_s,
             "zeta": lag.zeta,
@@ -135,6 +139,16 @@ class ScheduleEntry:
                 out["margin_score"] = margins.margin_score
             if math.isfinite(margins.floor_without_lead_m):
                 out["floor_without_lead_m"] = margins.floor_without_lead_m
+        if self.preview is not None:
+            response = self.preview.response
+            out.update(
+                preview_first_tap_s=response.first_tap_s,
+                preview_tap_spacing_s=response.tap_spacing_s,
+                preview_steering_nrmse=self.preview.steering_nrmse,
+                preview_measured_nrmse=self.preview.measured_nrmse,
+                preview_steering_taps=[float(f"{v:.7g}") for v in response.steering_taps],
+                preview_measured_taps=list(response.measured_taps),
+            )
         return out
 
 
@@ -180,6 +194,7 @@ class ScheduleResult:
     design: str = "cancel"  # the lead design: "cancel" (`design_lead`) or "margins" (`design_lead_for_margins`)
     controller_rate_hz: float = DEFAULT_CONTROLLER_RATE_HZ  # Hz; the controller rate the margins design analysed
     prediction_time_s: float = DEFAULT_PREDICTION_TIME_S  # s; the pose prediction the margins design analysed
+    preview_options: PreviewFitOptions | None = None  # how the preview responses were fitted (None: they were not)
 
     @property
     def speeds_kmh(self) -> tuple[float, ...]:
@@ -286,6 +301,8 @@ class ScheduleResult:
             fit_delay=self.fit_delay,
             per_speed=[e.row() for e in self.entries],
         )
+        if self.preview_options is not None:
+            design["preview_fit"] = dataclasses.asdict(self.preview_options)
         if self.dropped:
             design["dropped_speeds"] = [d.row() for d in self.dropped]
         lag = nominal.fit.lag
@@ -464,6 +481,7 @@ def identify_schedule(
     design: str = "cancel",
     controller_rate_hz: float = DEFAULT_CONTROLLER_RATE_HZ,
     prediction_time_s: float = DEFAULT_PREDICTION_TIME_S,
+    preview_options: PreviewFitOptions | None = None,
 ) -> ScheduleResult:
     """Identify the lags and design the filter at each speed (km/h, strictly increasing). fit_options: how the
     lags are fitted (LagFitOptions; fit_delay adds a pure delay); the path lag with its curvature_from (default: the
@@ -472,7 +490,8 @@ def identify_schedule(
     both lags, the loop at controller_rate_hz with prediction_time_s, about a straight and the arc of
     margins_arc_curvature_1pm; bounded by max_lead_gain). A speed whose fit or design is refused makes the whole
     schedule refused, naming the speed; with drop_refused=True it is left out and recorded in `dropped` instead
-    (refused only when no speed is left). progress, if given, is called with one line per speed.
+    (refused only when no speed is left). progress, if given, is called with one line per speed. The preview
+    responses (`tuning.preview_fit`) are fitted to the same logs at each speed.
 
     Parameters
     ----------
@@ -498,6 +517,8 @@ def identify_schedule(
         The clothoid controller's rate the margins design analyses the loop at, 1-1000 Hz.
     prediction_time_s : float, s
         The controller's pose prediction the margins design analyses the loop with, 0-2 s.
+    preview_options : PreviewFitOptions or None
+        How the preview responses are fitted (None: the defaults).
 
     Returns
     -------
@@ -545,6 +566,7 @@ def identify_schedule(
                 measured = fit_lag(logs, vehicle.geometry, measured_options)
             except WorkbenchInputError as exc:
                 raise WorkbenchInputError(f"the measured (yaw-rate) lag: {exc}") from None
+            preview = fit_preview(logs, vehicle.geometry, preview_options)
             margins = None
             if design == "cancel":
                 lead = design_lead(fit.lag, max_lead_gain=max_lead_gain, max_cascade_peak_db=max_cascade_peak_db)
@@ -567,7 +589,7 @@ def identify_schedule(
             if progress is not None:
                 progress(f"{speed:g} km/h: dropped: {exc}")
             continue
-        entries.append(ScheduleEntry(speed, fit, lead, measured, margins))
+        entries.append(ScheduleEntry(speed, fit, lead, measured, margins, preview))
         if progress is not None:
             floors = ""
             if margins is not None:
@@ -575,7 +597,10 @@ def identify_schedule(
                     f"; lookahead floor {_floor_text(margins.floor_m)} with the lead, "
                     f"{_floor_text(margins.floor_without_lead_m)} without"
                 )
-            progress(f"{speed:g} km/h: path {fit.summary()}; measured {measured.summary()}; {lead.summary()}{floors}")
+            progress(
+                f"{speed:g} km/h: path {fit.summary()}; measured {measured.summary()}; {preview.summary()}; "
+                f"{lead.summary()}{floors}"
+            )
     if not entries:
         reasons = "; ".join(f"at {d.speed_kmh:g} km/h: {d.reason}" for d in dropped)
         raise WorkbenchInputError(f"no speed of {speeds} gave a lag and a lead filter: {reasons}")
@@ -588,6 +613,7 @@ def identify_schedule(
         design,
         float(controller_rate_hz),
         float(prediction_time_s),
+        preview_options or PreviewFitOptions(),
     )
 
 

@@ -17,6 +17,7 @@ from typing import Any
 
 from controllers.clothoid.filter_schedule import FilterSchedule
 from controllers.clothoid.loop_requirements import REQUIRED_GAIN_MARGIN_DB, REQUIRED_PHASE_MARGIN_DEG
+from controllers.clothoid.preview_model import PreviewResponse
 from controllers.clothoid.vehicle_tuning import FloorDesign, VehicleTuning
 from tuning.filter_file import read_filter_file
 from tuning.limits_file import read_limits_file
@@ -56,6 +57,8 @@ LAG_KEYS = ("speed_kmh", "omega_n_rad_s", "zeta")
 #: The per_speed keys of the measured lag (prefix + the path lag's key); the first two are required for it.
 MEASURED_PREFIX = "measured_"
 MEASURED_LAG_KEYS = ("measured_omega_n_rad_s", "measured_zeta")
+#: The per_speed keys of the preview responses (`tuning.schedule.ScheduleEntry.row`); all of them or none.
+PREVIEW_KEYS = ("preview_first_tap_s", "preview_tap_spacing_s", "preview_steering_taps", "preview_measured_taps")
 
 
 # ---- the vehicle's identity -------------------------------------------------------------------------------------
@@ -230,6 +233,28 @@ def _lags(
 FLOOR_DESIGN_KEYS = ("controller_rate_hz", "prediction_time_s", "arc_lateral_accel_g", "lookahead_range_m")
 
 
+def _previews(path: Path, design: Mapping[str, Any]) -> tuple[tuple[float, PreviewResponse], ...]:
+    """(speed_kmh, the preview responses) of design.per_speed (PREVIEW_KEYS); empty when no row has them (files made
+    before they were recorded), refused when only some rows have them or a row's are not a valid response."""
+    rows = design["per_speed"]  # checked by _lags
+    with_keys = [any(k in row for k in PREVIEW_KEYS) for row in rows]
+    if not any(with_keys):
+        return ()
+    out = []
+    for i, row in enumerate(rows):
+        if any(k not in row for k in PREVIEW_KEYS):
+            raise WorkbenchInputError(
+                f"{path}: design.per_speed[{i}] must hold all of {list(PREVIEW_KEYS)}, as every other row does, or "
+                "no row any"
+            )
+        try:
+            response = PreviewResponse(*(row[k] for k in PREVIEW_KEYS))
+        except (WorkbenchInputError, TypeError, ValueError) as exc:
+            raise WorkbenchInputError(f"{path}: design.per_speed[{i}] (preview responses): {exc}") from None
+        out.append((float(row["speed_kmh"]), response))
+    return tuple(out)
+
+
 def _floors(path: Path, design: Mapping[str, Any]) -> tuple[tuple[tuple[float, float], ...], FloorDesign | None]:
     """((speed_kmh, lookahead_floor_m) of the rows of design.per_speed that have one, what they were computed for):
     ((), None) unless the design is "margins" with its loop (FLOOR_DESIGN_KEYS). The margins kept are the design's
@@ -302,8 +327,9 @@ def _read(directory: str, _stamp: tuple[int, ...]) -> VehicleTuning:
     design = _design(lead)
     lags, measured = _lags(lead, design, schedule)
     floors, floor_design = _floors(lead, design)
+    previews = _previews(lead, design)
     try:
-        return VehicleTuning(schedule, limits, lags, source, measured, floors, floor_design)
+        return VehicleTuning(schedule, limits, lags, source, measured, floors, floor_design, previews)
     except WorkbenchInputError as exc:
         raise WorkbenchInputError(f"{lead}: {exc}") from None
 

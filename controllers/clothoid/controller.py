@@ -21,7 +21,9 @@ Added to the paper so that the loop keeps its margins on the vehicle it steers:
     ceiling keeps the target within max_target_turn_deg of the path's turn (ClothoidConfig), never below the floor;
   - two degrees of freedom (`path_feedforward.py`): feedback on Eq. 3's kappa' less the path's own clothoid's,
     and the steering that inverts the identified lag of Eq. 5 along the path fed forward (added after the lead
-    filter), so tracking needs no short lookaheads where the loop has no margin;
+    filter), so tracking needs no short lookaheads where the loop has no margin; where that lag does not explain
+    the vehicle's logs (the loaded truck's trailer), the vehicle's preview responses identified from the same logs
+    give the feed-forward and the reference instead (`preview_model.py`);
   - the steered vehicle's own lead filter, curvature limits and lags (`vehicle_tuning.py`, made by `tuning
     schedule --design margins`; the config holds them); without them, no lead filter and no floor.
 
@@ -67,6 +69,8 @@ INITIAL_CURVATURE = ("yaw-rate", "command", "steering")
 HEADINGS = ("course", "yaw")
 THRESHOLD_MODES = ("excess", "absolute")
 SEARCH_STARTS = ("last", "ends")
+#: The models of the vehicle along the path the feed-forward and the reference can use (`feedforward_model`).
+FEEDFORWARD_MODELS = ("auto", "lag", "preview")
 #: Below this speed (m/s) yaw rate / speed and the course angle are too noisy to use.
 MIN_SPEED_MPS = 0.5
 #: The lookahead floor is computed per band of this many km/h (and at least at the band's lower speed, 5 km/h).
@@ -306,8 +310,17 @@ class ClothoidConfig:
         "delay only) on the curvature a vehicle following the path exactly would measure, the measured (yaw-rate) "
         "lag driven by the inverted path lag (`step_kernel.reference_curvature`), instead of the path's pose and "
         "curvature reference_lead_s ahead (reference_lead_s is then unused; false: that); no effect without "
-        "feedforward_inversion or a tuning",
+        "feedforward_inversion or a tuning, or with the preview responses (feedforward_model)",
         Flag(),
+    )
+    feedforward_model: str = option(
+        "auto",
+        "with feedforward_inversion: the model of the vehicle along the path that gives the feed-forward's steering "
+        "and the reference pose's curvature: 'lag' (the lags of Eq. 5, as above), 'preview' (the preview responses "
+        "identified from the same logs, `preview_model.py`; the tuning must have them) or 'auto' (the preview "
+        "responses where the lag does not explain the vehicle's logs, `VehicleTuning.lag_explains_logs`, else the "
+        "lags); either way the loop and its margins are the same",
+        Choice(FEEDFORWARD_MODELS),
     )
     tuning: VehicleTuning | None = option(  # noqa: RUF009  (option is a dataclasses.field)
         None,
@@ -395,8 +408,9 @@ class ClothoidController(Controller[ClothoidConfig]):
     Raises
     ------
     WorkbenchInputError
-        A vehicle given with a config without tuning, or delay_compensation "model" with a known delay and no
-        tuning (the prediction needs the identified lags).
+        A vehicle given with a config without tuning, delay_compensation "model" with a known delay and no
+        tuning (the prediction needs the identified lags), or feedforward_model "preview" with a tuning without
+        preview responses.
     """
 
     name: ClassVar[str] = "clothoid"
@@ -459,6 +473,11 @@ class ClothoidController(Controller[ClothoidConfig]):
                 "vehicle's identified lags, and this controller has no tuning: give ClothoidConfig(tuning=...) "
                 "(tuning.own_tuning.tuning_for) or set delay_compensation = 'arc'"
             )
+        if cfg.feedforward_model == "preview" and (self.tuning is None or not self.tuning.previews):
+            raise WorkbenchInputError(
+                "feedforward_model 'preview' needs a tuning with the vehicle's preview responses (made by `tuning "
+                "schedule`); this controller's tuning has none: use 'auto' or 'lag', or make the tuning again"
+            )
         if cfg.curvature_limits is not None:
             self.limits = cfg.curvature_limits
         elif self.tuning is not None:
@@ -497,8 +516,9 @@ class ClothoidController(Controller[ClothoidConfig]):
         compiled = path.compiled()
         self._step_arguments = sk.StepArguments(
             self._measured, self._params, self._state, compiled.table, compiled.record, self._limits,
-            self._limit_speeds, self._lags, self._measured_lags, self._lag_speeds, self._schedule,
-            self._schedule_speeds, self._scores, self._results, self._diag, self._history,
+            self._limit_speeds, self._lags, self._measured_lags, self._lag_speeds, self._preview_steering,
+            self._preview_measured, self._schedule, self._schedule_speeds, self._scores, self._results, self._diag,
+            self._history,
         )  # fmt: skip
         # The planned speeds' floors at reset, not in a step (~0.04 s a band, with the delay model 0.5 s).
         for band in self._planned_bands(path):
@@ -506,11 +526,16 @@ class ClothoidController(Controller[ClothoidConfig]):
 
     def _tables(self) -> None:
         """The tables the compiled step reads (step_kernel.py): the limits, the identified lags and the lead
-        filter's schedule (no rows: untuned, no lead filter), each against speed; built once, with the controller
+        filter's schedule (no rows: untuned, no lead filter), each against speed, and the preview responses' taps at
+        the lags' speeds when the feed-forward uses them (no rows: it uses the lags); built once, with the controller
         (they depend on its config alone, not on the path or the period)."""
         self._limit_speeds, self._limits = self.limits.table
+        self._preview_steering = self._preview_measured = np.zeros((0, 0))
         if self.tuning is not None:
             self._lag_speeds, self._lags, self._measured_lags = self.tuning.lag_tables
+            if self.uses_preview:
+                first, spacing, self._preview_steering, self._preview_measured = self.tuning.preview_tables
+                self._params["preview_first_tap"], self._params["preview_spacing"] = first, spacing
         else:
             self._lag_speeds, self._lags, self._measured_lags = np.zeros(0), np.zeros((0, 4)), np.zeros((0, 4))
         if self.filter_schedule is not None:
@@ -559,7 +584,20 @@ class ClothoidController(Controller[ClothoidConfig]):
             delay_model=cfg.predicts_with_model,
             feedforward_inversion=cfg.feedforward_inversion,
             lag_model_reference=cfg.lag_model_reference,
+            preview_first_tap=0.0,
+            preview_spacing=1.0,
         )
+
+    @property
+    def uses_preview(self) -> bool:
+        """Whether the feed-forward and the reference curvature come from the tuning's preview responses
+        (`ClothoidConfig.feedforward_model`) rather than from its lags."""
+        cfg, tuning = self.config, self.tuning
+        if tuning is None or not (cfg.path_feedforward and cfg.feedforward_inversion):
+            return False
+        if cfg.feedforward_model == "preview":
+            return True
+        return cfg.feedforward_model == "auto" and bool(tuning.previews) and not tuning.lag_explains_logs
 
     def plant_lags(self, speed_kmh: float) -> PlantLags | None:
         """The vehicle's identified lags at this speed (None without a tuning).

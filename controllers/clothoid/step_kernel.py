@@ -33,6 +33,7 @@ from controllers.clothoid.lookahead import (
 from controllers.clothoid.lookahead_filter import filtered_lookahead
 from controllers.clothoid.path_feedforward import lag_inverse_curvature, previewed_curvature, two_degree_of_freedom_rate
 from controllers.clothoid.pose_prediction import along_arc
+from controllers.clothoid.preview_model import preview_curvature
 from controllers.clothoid.speed_tables import table_row
 from workbench.base.path_search import TRACK_OUT_SIZE, TRACK_PROGRESS, TRACK_S, TRACK_STATE_SIZE, track
 
@@ -51,6 +52,7 @@ PARAMS = np.dtype(
         "lookahead_step", "min_preview", "fixed_lookahead", "lookahead_gain", "max_turn", "frechet_threshold",
         "point_spacing", "tolerance_x", "tolerance_y", "kdot_max", "feedforward_window", "feedforward_time",
         "reference_lead", "hysteresis", "max_growth", "max_shrink", "min_speed", "band_kmh", "band_hysteresis_kmh",
+        "preview_first_tap", "preview_spacing",
     )]
     + [(name, np.int64) for name in ("lookahead_mode", "initial_curvature")]
     + [(name, np.bool_) for name in (
@@ -219,6 +221,8 @@ class StepArguments(NamedTuple):
     lags: np.ndarray
     measured_lags: np.ndarray
     lag_speeds: np.ndarray
+    preview_steering: np.ndarray
+    preview_measured: np.ndarray
     schedule: np.ndarray
     schedule_speeds: np.ndarray
     scores: np.ndarray
@@ -239,6 +243,8 @@ def clothoid_step(
     lags: np.ndarray,
     measured_lags: np.ndarray,
     lag_speeds: np.ndarray,
+    preview_steering: np.ndarray,
+    preview_measured: np.ndarray,
     schedule: np.ndarray,
     schedule_speeds: np.ndarray,
     scores: np.ndarray,
@@ -250,7 +256,9 @@ def clothoid_step(
     (MEASUREMENT), with the parameters (PARAMS) and the state (STATE, advanced) on the compiled path
     (`path_search.CompiledPath`'s table and record); diagnostics (16) in the order of controller.DIAGNOSTIC_KEYS.
     scores, results: the search's work arrays (`lookahead.py`); history: the delay predictor's commands sent
-    (`delay_predictor.history_length` slots; any size without it)."""
+    (`delay_predictor.history_length` slots; any size without it); preview_steering, preview_measured: the preview
+    responses' taps at the lags' speeds (`preview_model.py`; no rows: the feed-forward and the reference curvature
+    come from the lags)."""
     m, p, st = measurement[0], params[0], state[0]
     t_s, x_m, y_m, vx_mps, vy_mps = m.t, m.x, m.y, m.vx, m.vy
     yaw_rad, yaw_rate_rad_s, steer_wheel_rad = m.yaw, m.yaw_rate, m.steer_wheel
@@ -361,11 +369,19 @@ def clothoid_step(
         ff_time, reference_lead, gain = feedforward_timing(
             speed, params, lags, measured_lags, lag_speeds, schedule, schedule_speeds, scratch[:4]
         )
-        if inverting and p.lag_model_reference and lags.shape[0] > 0:
-            reference_kappa = reference_curvature(
-                path, record, foot[0] + speed * (p.horizon - horizon), speed, lags, measured_lags, lag_speeds,
-                p.feedforward_window, scratch[LAG_ROWS : LAG_ROWS + 8],
-            )  # fmt: skip
+        previewing = inverting and preview_steering.shape[0] > 0
+        if previewing or (inverting and p.lag_model_reference and lags.shape[0] > 0):
+            s_ref = foot[0] + speed * (p.horizon - horizon)
+            if previewing:  # the measured curvature of a vehicle that drives the path, from its preview response
+                reference_kappa = preview_curvature(
+                    path, record, s_ref, speed, 0.0, p.preview_first_tap, p.preview_spacing, lag_speeds,
+                    preview_measured,
+                )  # fmt: skip
+            else:
+                reference_kappa = reference_curvature(
+                    path, record, s_ref, speed, lags, measured_lags, lag_speeds, p.feedforward_window,
+                    scratch[LAG_ROWS : LAG_ROWS + 8],
+                )  # fmt: skip
             kdot, reference_kdot, feedforward_kdot = two_degree_of_freedom_rate(
                 kdot, path, record, foot, tx, ty, speed,
                 horizon, ff_time, 0.0, gain, p.feedforward_window, p.horizon - horizon, reference_kappa,
@@ -381,9 +397,16 @@ def clothoid_step(
             if lags.shape[0] > 0:
                 table_row(lag_speeds, lags, speed * 3.6, False, scratch[:4])
                 omega_n, zeta, dead_time, gain = scratch[0], scratch[1], scratch[2], scratch[3]
-            feedforward_kappa, feedforward_kdot = lag_inverse_curvature(
-                path, record, foot[0], speed, dead_time + p.known_delay, omega_n, zeta, gain, p.feedforward_window
-            )
+            if previewing:  # the steering that drives the path, from the preview response, the known delay ahead
+                feedforward_kappa = preview_curvature(
+                    path, record, foot[0], speed, p.known_delay, p.preview_first_tap, p.preview_spacing, lag_speeds,
+                    preview_steering,
+                )  # fmt: skip
+            else:
+                feedforward_kappa, feedforward_kdot = lag_inverse_curvature(
+                    path, record, foot[0], speed, dead_time + p.known_delay, omega_n, zeta, gain,
+                    p.feedforward_window,
+                )  # fmt: skip
             feedforward_kappa = min(max(feedforward_kappa, -kappa_max), kappa_max)
             st.feedforward_kappa = feedforward_kappa
             if first:  # the feedback's share of the steering now (bumpless)

@@ -1,9 +1,10 @@
 """The clothoid controller's tuning of one vehicle (`VehicleTuning`): its lead filter against speed, its curvature
-limits, the Eq. 5 lags identified at each speed, interpolated in speed, and the lookahead floors the tuning's margins
+limits, the Eq. 5 lags identified at each speed, interpolated in speed, the lookahead floors the tuning's margins
 design computed (`FloorDesign`: what they were computed for, so that the controller uses them only where it would
-compute the same). The steered vehicle's own tuning is made by the project's tuning chain and found by
-`tuning/tuning_dirs.py` (shipped for the presets, cached for any other vehicle); a controller config holds it
-(`ClothoidConfig.tuning`), so the controller reads no file."""
+compute the same) and the preview responses identified at the lags' speeds (`preview_model.py`). The steered
+vehicle's own tuning is made by the project's tuning chain and found by `tuning/tuning_dirs.py` (shipped for the
+presets, cached for any other vehicle); a controller config holds it (`ClothoidConfig.tuning`), so the controller
+reads no file."""
 
 from __future__ import annotations
 
@@ -20,12 +21,18 @@ from controllers.clothoid.curvature_limits import CurvatureLimits
 from controllers.clothoid.filter_schedule import FilterSchedule
 from controllers.clothoid.lead_filter import LeadFilterParams
 from controllers.clothoid.loop_requirements import REQUIRED_GAIN_MARGIN_DB, REQUIRED_PHASE_MARGIN_DEG
+from controllers.clothoid.preview_model import PreviewResponse
 from controllers.clothoid.speed_tables import table_row
 from workbench.base.errors import WorkbenchInputError, shown_all, value_text
 from workbench.vehicles.steering_lag import SteeringLag
 
 #: The parameters of a lag the tables hold, in their order (`VehicleTuning.lag_tables`).
 LAG_COLUMNS = ("omega_n_rad_s", "zeta", "delay_s", "steady_state_gain")
+#: The median NRMSE (-) over the speeds within which the lag of Eq. 5 explains the vehicle's logs
+#: (`VehicleTuning.lag_explains_logs`): a second-order lag explains a single-track car's to about 0.1 % and the
+#: kinematic bicycle's to less; the loaded tractor-semitrailer's (0.6-2 %, zeta at its bound) and the multi-body
+#: car's (1-3 %) it does not, and there the identified preview responses stand in for it.
+LAG_EXPLAINS_NRMSE = 0.005
 #: Relative tolerance (-) within which two inputs of a lookahead floor are one (`FloorInputs.matches`): a rounding
 #: apart, far below any difference that moves a floor by a step of its grid.
 FLOOR_INPUT_REL_TOL = 1e-9
@@ -111,7 +118,9 @@ class VehicleTuning:
     identified there), speeds increasing, the same speeds as the schedule), source (which files, made for which
     vehicle), measured_lags (the same for the lag to the measured curvature, yaw rate / speed, at the same speeds;
     empty when not identified), floors ((speed_kmh, the lookahead floor the margins design computed there, m), at
-    some of the lags' speeds) and floor_design (what they were computed for; None: no floors)."""
+    some of the lags' speeds), floor_design (what they were computed for; None: no floors) and previews ((speed_kmh,
+    the preview responses identified there) at the lags' speeds, all on one grid of taps; empty when not
+    identified)."""
 
     filter_schedule: FilterSchedule
     limits: CurvatureLimits
@@ -120,6 +129,7 @@ class VehicleTuning:
     measured_lags: tuple[tuple[float, SteeringLag], ...] = ()
     floors: tuple[tuple[float, float], ...] = ()
     floor_design: FloorDesign | None = None
+    previews: tuple[tuple[float, PreviewResponse], ...] = ()
 
     def __post_init__(self) -> None:
         if not isinstance(self.filter_schedule, FilterSchedule):
@@ -147,6 +157,35 @@ class VehicleTuning:
         if floors and self.floor_design is None:
             raise WorkbenchInputError("floors need their floor_design (what they were computed for)")
         object.__setattr__(self, "floors", floors)
+        previews = tuple((float(speed), response) for speed, response in self.previews)
+        if previews:
+            if tuple(s for s, _ in previews) != self.lag_speeds_kmh or not all(
+                isinstance(r, PreviewResponse) and r.same_taps(previews[0][1]) for _, r in previews
+            ):
+                raise WorkbenchInputError(
+                    "previews must be (speed_kmh, PreviewResponse) at the lags' speeds "
+                    f"{shown_all(self.lag_speeds_kmh)}, all on one grid of taps; got speeds "
+                    f"{shown_all(s for s, _ in previews)}"
+                )
+        object.__setattr__(self, "previews", previews)
+
+    @property
+    def lag_explains_logs(self) -> bool:
+        """Whether the lag of Eq. 5 explains the vehicle's logs: the median of its fits' NRMSE over the speeds at
+        most LAG_EXPLAINS_NRMSE (True when the fits recorded none)."""
+        errors = [lag.nrmse for _, lag in self.lags if math.isfinite(lag.nrmse)]
+        return not errors or float(np.median(errors)) <= LAG_EXPLAINS_NRMSE
+
+    @functools.cached_property
+    def preview_tables(self) -> tuple[float, float, np.ndarray, np.ndarray]:
+        """(first tap s, tap spacing s, steering taps (n, m), measured taps (n, m)) at the lags' speeds, as
+        `preview_model.preview_curvature` reads them; (0, 1, (0, 0), (0, 0)) without previews."""
+        if not self.previews:
+            return 0.0, 1.0, np.zeros((0, 0)), np.zeros((0, 0))
+        first = self.previews[0][1]
+        steering = np.array([r.steering_taps for _, r in self.previews], dtype=float)
+        measured = np.array([r.measured_taps for _, r in self.previews], dtype=float)
+        return first.first_tap_s, first.tap_spacing_s, steering, measured
 
     def recorded_floor_m(
         self, inputs: FloorInputs, lock_curvature_1pm: float, curvature_limit_1pm: float = math.inf

@@ -50,6 +50,7 @@ MODULES = (
     "workbench.apps.studies.tournament",
     "tuning.lag_fit",
     "tuning.lead_design",
+    "tuning.preview_fit",
     "tuning.schedule",
     "tuning.own_tuning",
 )

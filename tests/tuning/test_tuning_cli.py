@@ -133,12 +133,15 @@ def test_schedule_designs_for_the_margins_from_both_lags(tmp_path: Path, capsys)
     a 0.05 s first-order actuator, the same lag to both curvatures; floors 3 m with the lead, 5.5 m without.)"""
     out = tmp_path / "lead.json"
     argv = ["schedule", "--vehicle", "kinematic-bicycle", "--speeds", "40", "--delay", "--design", "margins"]
-    argv += ["--controller-rate-hz", "50", "--prediction-time-s", "0.2", "--out", str(out)]
+    argv += ["--controller-rate-hz", "50", "--prediction-time-s", "0.2", "--preview-past-s", "3", "--out", str(out)]
     assert main(argv) == 0
     design = json.loads(out.read_text())["design"]
+    assert design["preview_fit"]["past_s"] == 3.0 and design["preview_fit"]["future_s"] == 2.0
     assert design["method"] == "margins" and design["fit_delay"] is True
     assert (design["controller_rate_hz"], design["prediction_time_s"]) == (50.0, 0.2)
     (row,) = design["per_speed"]
+    assert row["preview_first_tap_s"] == -3.0 and len(row["preview_steering_taps"]) == 101  # -3 s to 2 s by 0.05 s
+    assert sum(row["preview_steering_taps"]) == pytest.approx(1.0, abs=0.01)  # a kinematic bicycle: no understeer
     assert row["measured_omega_n_rad_s"] == pytest.approx(row["omega_n_rad_s"], rel=0.02)
     assert row["lookahead_floor_m"] == pytest.approx(3.0) and row["floor_without_lead_m"] == pytest.approx(5.5)
     captured = capsys.readouterr()
@@ -147,6 +150,8 @@ def test_schedule_designs_for_the_margins_from_both_lags(tmp_path: Path, capsys)
     with pytest.raises(SystemExit) as info:  # argparse: invalid choice
         main([*argv[:-2], "--design", "loop", "--out", str(out)])
     assert info.value.code == 2
+    assert main([*argv[:-2], "--preview-past-s", "31", "--out", str(out), "--overwrite"]) == 2
+    assert "--preview-past-s must be a finite number in [0, 30] s; got 31" in capsys.readouterr().err
 
 
 # --- bad input ------------------------------------------------------------------------------------------------

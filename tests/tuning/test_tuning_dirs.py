@@ -66,6 +66,7 @@ def test_the_shipped_tuning_is_made_for_the_current_preset_and_options(name: str
         tuning_parser().parse_args(argv[1:])
     assert manifest["commands"][0].startswith("tuning schedule") and " --delay" in manifest["commands"][0]
     assert " --design margins --controller-rate-hz 50 --prediction-time-s 0.2 " in manifest["commands"][0]
+    assert " --preview-past-s 8 --preview-future-s 2 " in manifest["commands"][0]
     limits = "rollover-limits" if name == "tractor-semitrailer" else "steering-limits"
     assert manifest["commands"][1].startswith(f"tuning {limits}")
     assert manifest["package_version"] and manifest["date"]
@@ -252,6 +253,45 @@ def test_the_shipped_measured_lags_are_read() -> None:
     assert tuning.lag_at(60.0).omega_n_rad_s == at_60["omega_n_rad_s"]
 
 
+def test_the_shipped_preview_responses_are_read_and_chosen_where_the_lag_misfits() -> None:
+    """Every preset ships its preview responses at its lags' speeds; the controller's 'auto' takes them where the
+    lag of Eq. 5 does not explain the vehicle's logs (the truck and the multi-body car), not where it does."""
+    for name in PRESETS:
+        tuning = read_vehicle_tuning(shipped_tuning_root() / name)
+        assert tuple(s for s, _ in tuning.previews) == tuning.lag_speeds_kmh
+        rows = json.loads((shipped_tuning_root() / name / LEAD_FILE).read_text())["design"]["per_speed"]
+        assert tuning.previews[2][1].measured_taps == tuple(rows[2]["preview_measured_taps"])
+        first, spacing, steering, measured = tuning.preview_tables
+        assert steering.shape == measured.shape == (len(rows), len(rows[0]["preview_steering_taps"]))
+        assert (first, spacing) == (rows[0]["preview_first_tap_s"], rows[0]["preview_tap_spacing_s"])
+    explained = {name: read_vehicle_tuning(shipped_tuning_root() / name).lag_explains_logs for name in PRESETS}
+    assert explained == {
+        "tractor-semitrailer": False, "dynamic-bicycle": True, "kinematic-bicycle": True, "commonroad-mb": False,
+    }  # fmt: skip
+
+
+def test_a_lead_file_with_preview_responses_at_some_speeds_only_is_refused(tmp_path: Path) -> None:
+    directory = _copy_shipped("tractor-semitrailer", tmp_path / "partial")
+    doc = json.loads((directory / LEAD_FILE).read_text())
+    del doc["design"]["per_speed"][4]["preview_measured_taps"]
+    _write_lead(directory, doc)
+    with pytest.raises(WorkbenchInputError, match=r"per_speed\[4\] must hold all of \['preview_first_tap_s'"):
+        read_vehicle_tuning(directory)
+    doc["design"]["per_speed"][4]["preview_measured_taps"] = [0.5] * len(
+        doc["design"]["per_speed"][4]["preview_steering_taps"]
+    )
+    _write_lead(directory, doc)
+    with pytest.raises(
+        WorkbenchInputError, match=r"per_speed\[4\] \(preview responses\): measured_taps must sum to one"
+    ):
+        read_vehicle_tuning(directory)
+    for row in doc["design"]["per_speed"]:
+        for key in [k for k in row if k.startswith("preview_")]:
+            del row[key]
+    _write_lead(directory, doc)
+    assert read_vehicle_tuning(directory).previews == ()  # files made before they were recorded
+
+
 def _longer_car(tmp_path: Path) -> Path:
     """A user's vehicle file (`workbench vehicles --show kinematic-bicycle`, edited): a longer wheelbase."""
     path = tmp_path / "longer.toml"
@@ -261,9 +301,7 @@ def _longer_car(tmp_path: Path) -> Path:
     return path
 
 
-def test_another_vehicle_is_tuned_once_into_the_cache(
-    tmp_path: Path, private_cache: Path, monkeypatch, capsys
-) -> None:
+def test_another_vehicle_is_tuned_once_into_the_cache(tmp_path: Path, private_cache: Path, monkeypatch, capsys) -> None:
     car = make_vehicle(vehicle_file=_longer_car(tmp_path))
     first = tuning_for(car, QUICK)
     directory = private_cache / cache_key(car, QUICK)
@@ -334,6 +372,10 @@ def test_options_are_validated() -> None:
         dataclasses.replace(PRESET_TUNING_OPTIONS, controller_rate_hz=0.0)
     with pytest.raises(WorkbenchInputError, match="prediction_time_s must be a finite number in"):
         dataclasses.replace(PRESET_TUNING_OPTIONS, prediction_time_s=-0.1)
+    with pytest.raises(WorkbenchInputError, match="preview_past_s must be a finite number in"):
+        dataclasses.replace(PRESET_TUNING_OPTIONS, preview_past_s=40.0)
+    with pytest.raises(WorkbenchInputError, match="preview_future_s must be a finite number in"):
+        dataclasses.replace(PRESET_TUNING_OPTIONS, preview_future_s=math.nan)
 
 
 def test_the_preset_options_are_the_margins_design_with_a_delay() -> None:

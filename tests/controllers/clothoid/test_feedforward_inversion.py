@@ -93,7 +93,9 @@ def test_the_step_sends_the_inverted_lag_of_the_vehicles_own_tuning() -> None:
     speed, s0 = 8.0, 80.0
     i = round(s0 / path.spacing_m)
     known = 0.1
-    config = ClothoidConfig(tuning=TRUCK_TUNING, feedforward_inversion=True, known_delay_s=known)
+    config = ClothoidConfig(
+        tuning=TRUCK_TUNING, feedforward_inversion=True, known_delay_s=known, feedforward_model="lag"
+    )
     controller = ClothoidController(TRUCK.geometry, config, vehicle=TRUCK)
     controller.reset(path, 0.02)
     g = TRUCK.geometry
@@ -131,7 +133,8 @@ def test_the_feedback_loop_and_its_floor_are_unchanged() -> None:
 def _one_step(**options: object) -> float:
     """The steering command of one step on a clothoid ramp, the truck on the path at 8 m/s."""
     path = ClothoidChain().straight(20.0).clothoid_to(RATE_1PM2 * 150.0, 150.0).to_path("ramp")
-    controller = ClothoidController(TRUCK.geometry, ClothoidConfig(tuning=TRUCK_TUNING, **options), vehicle=TRUCK)
+    config = ClothoidConfig(tuning=TRUCK_TUNING, **{"feedforward_model": "lag", **options})
+    controller = ClothoidController(TRUCK.geometry, config, vehicle=TRUCK)
     controller.reset(path, 0.02)
     i, speed, g = round(80.0 / path.spacing_m), 8.0, TRUCK.geometry
     kappa = float(path.curvature_1pm[i])
@@ -140,11 +143,11 @@ def _one_step(**options: object) -> float:
     return controller.step(Measurement(0.0, x, y, speed, 0.0, heading, speed * kappa, steer), path)
 
 
-def test_the_lag_model_reference_is_on_by_default_and_acts_only_with_the_inversion() -> None:
+def test_the_lag_model_reference_is_on_by_default_and_acts_only_with_the_inversion_and_the_lags() -> None:
     assert ClothoidConfig().lag_model_reference is True
     assert _one_step(lag_model_reference=True) != _one_step(lag_model_reference=False)
-    without = {"feedforward_inversion": False}
-    assert _one_step(lag_model_reference=True, **without) == _one_step(lag_model_reference=False, **without)
+    for without in ({"feedforward_inversion": False}, {"feedforward_model": "preview"}):
+        assert _one_step(lag_model_reference=True, **without) == _one_step(lag_model_reference=False, **without)
 
 
 def _reference(curvature: np.ndarray, s_m: float, measured: np.ndarray) -> float:

@@ -1,0 +1,129 @@
+"""The preview responses along the path (`preview_model.py`): the response's checks, `preview_curvature` against
+the taps summed by hand on paths whose curvature is constant and linear in arc length (and, as a property, on any
+taps), interpolated in speed like the lags; the controller's choice of model (`ClothoidConfig.feedforward_model`)
+and the step's feed-forward and reference from the truck's own responses, with the loop and its floor unchanged."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from controllers.base import Measurement
+from controllers.clothoid import ClothoidConfig, ClothoidController
+from controllers.clothoid.preview_model import PreviewResponse, preview_curvature
+from tuning.own_tuning import tuning_for
+from workbench.base.clothoid_chain import ClothoidChain
+from workbench.base.errors import WorkbenchInputError
+from workbench.base.path_search import CompiledPath
+from workbench.vehicles import make_vehicle
+
+TRUCK, CAR = make_vehicle("tractor-semitrailer"), make_vehicle("dynamic-bicycle")
+TRUCK_TUNING = tuning_for(TRUCK)
+SPACING_M = 0.25
+S_GRID = np.arange(0.0, 300.0 + SPACING_M / 2, SPACING_M)
+RATE_1PM2 = 4e-4
+FIRST_S, TAP_S = -1.0, 0.05
+
+
+def _sum(curvature: np.ndarray, s_m: float, speed_mps: float, taps: np.ndarray, speeds=(30.0,), shift_s=0.0) -> float:
+    zeros = np.zeros_like(curvature)
+    compiled = CompiledPath.of((zeros, zeros, zeros, curvature, None), SPACING_M, float(S_GRID[-1]), False, 0.0, 5.0)
+    return preview_curvature(
+        compiled.table, compiled.record, s_m, speed_mps, shift_s, FIRST_S, TAP_S, np.array(speeds, dtype=float),
+        np.atleast_2d(taps),
+    )  # fmt: skip
+
+
+def test_a_response_is_checked() -> None:
+    with pytest.raises(WorkbenchInputError, match="first_tap_s must be in"):
+        PreviewResponse(0.5, 0.05, (1.0,), (1.0,))
+    with pytest.raises(WorkbenchInputError, match="tap_spacing_s must be in"):
+        PreviewResponse(-1.0, 0.0, (1.0,), (1.0,))
+    with pytest.raises(WorkbenchInputError, match="as many"):
+        PreviewResponse(-1.0, 0.05, (1.0, 0.0), (1.0,))
+    with pytest.raises(WorkbenchInputError, match="finite"):
+        PreviewResponse(-1.0, 0.05, (math.nan,), (1.0,))
+    with pytest.raises(WorkbenchInputError, match="sum to one"):
+        PreviewResponse(-1.0, 0.05, (1.0, 0.0), (0.6, 0.6))
+
+
+def test_on_an_arc_it_is_the_curvature_times_the_taps_sum() -> None:
+    taps = np.linspace(-0.1, 0.3, 41)
+    assert _sum(np.full(S_GRID.size, 0.02), 100.0, 8.0, taps) == pytest.approx(0.02 * taps.sum(), rel=1e-12)
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    taps=st.lists(st.floats(-2.0, 2.0), min_size=1, max_size=60),
+    speed=st.floats(1.0, 30.0),
+    shift=st.floats(0.0, 0.5),
+)
+def test_on_a_clothoid_it_is_the_taps_on_the_curvature_at_each_taps_distance(taps, speed, shift) -> None:
+    """kappa = c s, linear interpolation exact: sum_k h_k c (s + V (tau_k + shift))."""
+    h = np.array(taps)
+    s0 = 150.0
+    tau = FIRST_S + TAP_S * np.arange(h.size)
+    expected = float((h * RATE_1PM2 * (s0 + speed * (tau + shift))).sum())
+    got = _sum(RATE_1PM2 * S_GRID, s0, speed, h, shift_s=shift)
+    assert got == pytest.approx(expected, rel=1e-9, abs=1e-12)
+
+
+def test_the_taps_are_interpolated_in_speed_and_clamped_beyond() -> None:
+    arc = np.full(S_GRID.size, 0.01)
+    rows = np.array([[1.0, 0.0], [0.0, 3.0]])  # sums 1 at 20 km/h, 3 at 40 km/h
+    speeds = (20.0, 40.0)
+    assert _sum(arc, 50.0, 30.0 / 3.6, rows, speeds) == pytest.approx(0.01 * 2.0, rel=1e-12)
+    assert _sum(arc, 50.0, 10.0 / 3.6, rows, speeds) == pytest.approx(0.01, rel=1e-12)
+    assert _sum(arc, 50.0, 60.0 / 3.6, rows, speeds) == pytest.approx(0.03, rel=1e-12)
+    assert _sum(arc, 50.0, 40.0 / 3.6, rows, speeds) == pytest.approx(0.03, rel=1e-12)
+
+
+def test_the_model_is_chosen_by_how_well_the_lag_explains_the_logs() -> None:
+    assert ClothoidConfig().feedforward_model == "auto"
+    with pytest.raises(WorkbenchInputError, match="feedforward_model"):
+        ClothoidConfig(feedforward_model="fir")
+    truck = ClothoidController(TRUCK.geometry, ClothoidConfig(tuning=TRUCK_TUNING), vehicle=TRUCK)
+    car = ClothoidController(CAR.geometry, ClothoidConfig(tuning=tuning_for(CAR)), vehicle=CAR)
+    assert truck.uses_preview and not car.uses_preview
+    lag = ClothoidController(TRUCK.geometry, ClothoidConfig(tuning=TRUCK_TUNING, feedforward_model="lag"))
+    assert not lag.uses_preview
+    forced = ClothoidController(CAR.geometry, ClothoidConfig(tuning=tuning_for(CAR), feedforward_model="preview"))
+    assert forced.uses_preview
+    off = ClothoidController(TRUCK.geometry, ClothoidConfig(tuning=TRUCK_TUNING, feedforward_inversion=False))
+    assert not off.uses_preview
+    with pytest.raises(WorkbenchInputError, match="'preview' needs a tuning with the vehicle's preview responses"):
+        ClothoidController(TRUCK.geometry, ClothoidConfig(feedforward_model="preview"))
+
+
+def test_the_step_sends_the_trucks_preview_response_and_keeps_its_loop() -> None:
+    """On a clothoid, the feed-forward the step keeps is the truck's steering response at its speed summed by hand
+    over the path, the known delay ahead; the loop the floor is computed on is the lags' either way."""
+    path = ClothoidChain().straight(20.0).clothoid_to(RATE_1PM2 * 150.0, 150.0).to_path("ramp")
+    speed, known = 8.0, 0.1
+    i = round(90.0 / path.spacing_m)
+    config = ClothoidConfig(tuning=TRUCK_TUNING, known_delay_s=known)
+    controller = ClothoidController(TRUCK.geometry, config, vehicle=TRUCK)
+    controller.reset(path, 0.02)
+    g = TRUCK.geometry
+    kappa = float(path.curvature_1pm[i])
+    steer = math.atan(g.wheelbase_m * kappa) * g.steering_ratio
+    m = Measurement(
+        0.0, float(path.x_m[i]), float(path.y_m[i]), speed, 0.0, float(path.heading_rad[i]), speed * kappa, steer
+    )
+    controller.step(m, path)
+    first, spacing, steering, _ = TRUCK_TUNING.preview_tables
+    speeds = np.array(TRUCK_TUNING.lag_speeds_kmh)
+    row = np.array([np.interp(speed * 3.6, speeds, steering[:, k]) for k in range(steering.shape[1])])
+    s_taps = float(path.s_m[i]) + speed * (first + spacing * np.arange(row.size) + known)
+    expected = float(row @ np.interp(s_taps, path.s_m, path.curvature_1pm))
+    assert controller._state[0]["feedforward_kappa"] == pytest.approx(expected, rel=1e-3)
+    lags = ClothoidController(
+        TRUCK.geometry, ClothoidConfig(tuning=TRUCK_TUNING, known_delay_s=known, feedforward_model="lag")
+    )
+    lags.reset(path, 0.02)
+    assert controller.loop_settings(30.0) == lags.loop_settings(30.0)
+    assert controller.lookahead_floor_m(30.0 / 3.6) == lags.lookahead_floor_m(30.0 / 3.6)
