@@ -106,7 +106,8 @@ def fit_preview(
     ------
     WorkbenchInputError
         No log; a log without positions or yaw rate, stopped, sampled at other than a whole fraction of the tap
-        spacing, or not longer than the future window.
+        spacing, or not longer than the future window; logs that do not turn the vehicle, or whose yaw rate over
+        speed is not the path's curvature in a steady turn (its steady-state gain outside 0.5-2).
     """
     options = options or PreviewFitOptions()
     if not logs:
@@ -116,11 +117,22 @@ def fit_preview(
     x = np.vstack([b[0] for b in blocks])
     taps = last - first + 1
     gram = x.T @ x
+    if not np.trace(gram) > 0.0:
+        raise WorkbenchInputError(
+            "the logs' path curvature is zero throughout: they do not excite the vehicle, and the preview responses "
+            "need steering that turns it"
+        )
     second = np.diff(np.eye(taps), 2, axis=0)
     penalty = options.ridge * np.trace(gram) / taps * (np.eye(taps) + options.smoothness * second.T @ second)
     targets = np.column_stack([np.concatenate([b[column] for b in blocks]) for column in (1, 2)])
     solved = np.linalg.solve(gram + penalty, x.T @ targets)
     steering, measured = solved[:, 0], solved[:, 1]
+    if not 0.5 <= measured.sum() <= 2.0:  # a steady turn's is one; far off it, the yaw rate is not this vehicle's
+        raise WorkbenchInputError(
+            f"the measured response's steady-state gain is {measured.sum():.3g}, where a steady turn gives 1 (yaw rate "
+            "/ speed = the path's curvature); allowed 0.5-2: check the logs' yaw rate (rad/s, positive turning left) "
+            "and positions"
+        )
     measured = measured / measured.sum()
     response = PreviewResponse(first * options.tap_spacing_s, options.tap_spacing_s, tuple(steering), tuple(measured))
 

@@ -237,15 +237,14 @@ def _previews(path: Path, design: Mapping[str, Any]) -> tuple[tuple[float, Previ
     """(speed_kmh, the preview responses) of design.per_speed (PREVIEW_KEYS); empty when no row has them (files made
     before they were recorded), refused when only some rows have them or a row's are not a valid response."""
     rows = design["per_speed"]  # checked by _lags
-    with_keys = [any(k in row for k in PREVIEW_KEYS) for row in rows]
-    if not any(with_keys):
+    if not any(k in row for row in rows for k in PREVIEW_KEYS):
         return ()
     out = []
     for i, row in enumerate(rows):
         if any(k not in row for k in PREVIEW_KEYS):
             raise WorkbenchInputError(
-                f"{path}: design.per_speed[{i}] must hold all of {list(PREVIEW_KEYS)}, as every other row does, or "
-                "no row any"
+                f"{path}: design.per_speed[{i}] lacks some of {list(PREVIEW_KEYS)}, which other speeds give; give "
+                "the preview responses at every speed or at none"
             )
         try:
             response = PreviewResponse(*(row[k] for k in PREVIEW_KEYS))

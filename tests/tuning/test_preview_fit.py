@@ -86,6 +86,9 @@ def test_bad_logs_are_refused() -> None:
         fit_preview(_logs(KINDS[:1]), GEOMETRY, PreviewFitOptions(tap_spacing_s=0.015))
     with pytest.raises(WorkbenchInputError, match="too short"):
         fit_preview(_logs(KINDS[:1], duration_s=2.0), GEOMETRY, PreviewFitOptions(future_s=3.0))
+    flipped = synthetic_frame("dlc", OMEGA_N, ZETA).assign(yaw_rate_rad_s=lambda f: -f["yaw_rate_rad_s"])
+    with pytest.raises(WorkbenchInputError, match=r"steady-state gain is -0.99\d, where a steady turn gives 1"):
+        fit_preview([VehicleLog.from_frame(flipped, "dlc")], GEOMETRY)
     no_yaw = synthetic_frame("dlc", OMEGA_N, ZETA).drop(columns=["yaw_rate_rad_s"])
     with pytest.raises(WorkbenchInputError, match="yaw_rate_rad_s"):
         fit_preview([VehicleLog.from_frame(no_yaw, "dlc")], GEOMETRY)
