@@ -70,11 +70,18 @@ class PreviewFit:
     """The fitted responses and how well they explain the logs: steering_nrmse and measured_nrmse, the RMS over the
     logs of RMS(error) / range(signal) of the steering's kinematic curvature and of yaw rate / speed (-)."""
 
-    response: PreviewResponse
-    steering_nrmse: float
-    measured_nrmse: float
+    response: PreviewResponse  # the fitted taps (the measured ones summing to one)
+    steering_nrmse: float  # -, >= 0: the steering's NRMSE over the logs
+    measured_nrmse: float  # -, >= 0: yaw rate / speed's NRMSE over the logs
 
     def summary(self) -> str:
+        """One line for the tuning's progress.
+
+        Returns
+        -------
+        str
+            The taps' number and start, each response's NRMSE and the steering taps' sum (its steady-state gain).
+        """
         r = self.response
         return (
             f"preview {len(r.steering_taps)} taps from {r.first_tap_s:g} s, steering NRMSE {self.steering_nrmse:.4f} "

@@ -516,9 +516,8 @@ class ClothoidController(Controller[ClothoidConfig]):
         compiled = path.compiled()
         self._step_arguments = sk.StepArguments(
             self._measured, self._params, self._state, compiled.table, compiled.record, self._limits,
-            self._limit_speeds, self._lags, self._measured_lags, self._lag_speeds, self._preview_steering,
-            self._preview_measured, self._schedule, self._schedule_speeds, self._scores, self._results, self._diag,
-            self._history,
+            self._limit_speeds, self._lags, self._measured_lags, self._lag_speeds, self._schedule,
+            self._schedule_speeds, self._scores, self._results, self._diag, self._history,
         )  # fmt: skip
         # The planned speeds' floors at reset, not in a step (~0.04 s a band, with the delay model 0.5 s).
         for band in self._planned_bands(path):
@@ -526,15 +525,16 @@ class ClothoidController(Controller[ClothoidConfig]):
 
     def _tables(self) -> None:
         """The tables the compiled step reads (step_kernel.py): the limits, the identified lags and the lead
-        filter's schedule (no rows: untuned, no lead filter), each against speed, and the preview responses' taps at
-        the lags' speeds when the feed-forward uses them (no rows: it uses the lags); built once, with the controller
-        (they depend on its config alone, not on the path or the period)."""
+        filter's schedule (no rows: untuned, no lead filter), each against speed, the lags' rows followed by the
+        preview responses' steering and measured taps when the feed-forward uses them (`step_kernel.LAG_COLUMNS`);
+        built once, with the controller (they depend on its config alone, not on the path or the period)."""
         self._limit_speeds, self._limits = self.limits.table
-        self._preview_steering = self._preview_measured = np.zeros((0, 0))
         if self.tuning is not None:
             self._lag_speeds, self._lags, self._measured_lags = self.tuning.lag_tables
             if self.uses_preview:
-                first, spacing, self._preview_steering, self._preview_measured = self.tuning.preview_tables
+                first, spacing, steering, measured = self.tuning.preview_tables
+                self._lags = np.hstack([self._lags, steering])
+                self._measured_lags = np.hstack([self._measured_lags, measured])
                 self._params["preview_first_tap"], self._params["preview_spacing"] = first, spacing
         else:
             self._lag_speeds, self._lags, self._measured_lags = np.zeros(0), np.zeros((0, 4)), np.zeros((0, 4))

@@ -40,6 +40,9 @@ from workbench.base.path_search import TRACK_OUT_SIZE, TRACK_PROGRESS, TRACK_S, 
 # Option codes (ClothoidConfig's strings).
 MODE_ADAPTIVE, MODE_FIXED, MODE_SPEED = 0, 1, 2
 KAPPA0_YAW_RATE, KAPPA0_COMMAND, KAPPA0_STEERING = 0, 1, 2
+#: The lag's columns of a row of the lag tables (`vehicle_tuning.LAG_COLUMNS`: wn, zeta, delay, K); the preview
+#: response's taps follow them when the feed-forward uses them.
+LAG_COLUMNS = 4
 
 #: The step's parameters (`params`, one record, made by `parameters`): the vehicle's geometry (wheelbase m,
 #: steering ratio, steering-wheel limit rad), the period (s) and ClothoidConfig's numbers; NaN stands for an option's
@@ -221,8 +224,6 @@ class StepArguments(NamedTuple):
     lags: np.ndarray
     measured_lags: np.ndarray
     lag_speeds: np.ndarray
-    preview_steering: np.ndarray
-    preview_measured: np.ndarray
     schedule: np.ndarray
     schedule_speeds: np.ndarray
     scores: np.ndarray
@@ -243,8 +244,6 @@ def clothoid_step(
     lags: np.ndarray,
     measured_lags: np.ndarray,
     lag_speeds: np.ndarray,
-    preview_steering: np.ndarray,
-    preview_measured: np.ndarray,
     schedule: np.ndarray,
     schedule_speeds: np.ndarray,
     scores: np.ndarray,
@@ -256,9 +255,10 @@ def clothoid_step(
     (MEASUREMENT), with the parameters (PARAMS) and the state (STATE, advanced) on the compiled path
     (`path_search.CompiledPath`'s table and record); diagnostics (16) in the order of controller.DIAGNOSTIC_KEYS.
     scores, results: the search's work arrays (`lookahead.py`); history: the delay predictor's commands sent
-    (`delay_predictor.history_length` slots; any size without it); preview_steering, preview_measured: the preview
-    responses' taps at the lags' speeds (`preview_model.py`; no rows: the feed-forward and the reference curvature
-    come from the lags)."""
+    (`delay_predictor.history_length` slots; any size without it). lags and measured_lags hold each speed's lag in
+    their first LAG_COLUMNS columns and, when the feed-forward and the reference curvature come from the preview
+    responses (`preview_model.py`), its steering and its measured taps after them; with four columns they come from
+    the lags."""
     m, p, st = measurement[0], params[0], state[0]
     t_s, x_m, y_m, vx_mps, vy_mps = m.t, m.x, m.y, m.vx, m.vy
     yaw_rad, yaw_rate_rad_s, steer_wheel_rad = m.yaw, m.yaw_rate, m.steer_wheel
@@ -369,13 +369,13 @@ def clothoid_step(
         ff_time, reference_lead, gain = feedforward_timing(
             speed, params, lags, measured_lags, lag_speeds, schedule, schedule_speeds, scratch[:4]
         )
-        previewing = inverting and preview_steering.shape[0] > 0
+        previewing = inverting and lags.shape[1] > LAG_COLUMNS
         if previewing or (inverting and p.lag_model_reference and lags.shape[0] > 0):
             s_ref = foot[0] + speed * (p.horizon - horizon)
             if previewing:  # the measured curvature of a vehicle that drives the path, from its preview response
                 reference_kappa = preview_curvature(
                     path, record, s_ref, speed, 0.0, p.preview_first_tap, p.preview_spacing, lag_speeds,
-                    preview_measured,
+                    measured_lags[:, LAG_COLUMNS:],
                 )  # fmt: skip
             else:
                 reference_kappa = reference_curvature(
@@ -400,7 +400,7 @@ def clothoid_step(
             if previewing:  # the steering that drives the path, from the preview response, the known delay ahead
                 feedforward_kappa = preview_curvature(
                     path, record, foot[0], speed, p.known_delay, p.preview_first_tap, p.preview_spacing, lag_speeds,
-                    preview_steering,
+                    lags[:, LAG_COLUMNS:],
                 )  # fmt: skip
             else:
                 feedforward_kappa, feedforward_kdot = lag_inverse_curvature(

@@ -158,6 +158,8 @@ class VehicleTuning:
             raise WorkbenchInputError("floors need their floor_design (what they were computed for)")
         object.__setattr__(self, "floors", floors)
         previews = tuple((float(speed), response) for speed, response in self.previews)
+        if previews and not measured:
+            raise WorkbenchInputError("previews need the measured lags (identified from the same logs); got none")
         if previews:
             if tuple(s for s, _ in previews) != self.lag_speeds_kmh or not all(
                 isinstance(r, PreviewResponse) and r.same_taps(previews[0][1]) for _, r in previews
