@@ -532,9 +532,8 @@ class ClothoidController(Controller[ClothoidConfig]):
         if self.tuning is not None:
             self._lag_speeds, self._lags, self._measured_lags = self.tuning.lag_tables
             if self.uses_preview:
-                first, spacing, steering, measured = self.tuning.preview_tables
-                self._lags = np.hstack([self._lags, steering])
-                self._measured_lags = np.hstack([self._measured_lags, measured])
+                self._lag_speeds, self._lags, self._measured_lags = self.tuning.preview_lag_tables
+                first, spacing, _, _ = self.tuning.preview_tables
                 self._params["preview_first_tap"], self._params["preview_spacing"] = first, spacing
         else:
             self._lag_speeds, self._lags, self._measured_lags = np.zeros(0), np.zeros((0, 4)), np.zeros((0, 4))

@@ -189,6 +189,17 @@ class VehicleTuning:
         measured = np.array([r.measured_taps for _, r in self.previews], dtype=float)
         return first.first_tap_s, first.tap_spacing_s, steering, measured
 
+    @functools.cached_property
+    def preview_lag_tables(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """`lag_tables` with each speed's preview taps after its lag's columns (the path lag's row the steering
+        taps, the measured lag's the measured taps), as the compiled step reads them when the feed-forward uses the
+        preview responses (`step_kernel.LAG_COLUMNS`); `lag_tables` itself without previews."""
+        speeds, lags, measured = self.lag_tables
+        if not self.previews:
+            return speeds, lags, measured
+        _, _, steering, measured_taps = self.preview_tables
+        return speeds, np.hstack([lags, steering]), np.hstack([measured, measured_taps])
+
     def recorded_floor_m(
         self, inputs: FloorInputs, lock_curvature_1pm: float, curvature_limit_1pm: float = math.inf
     ) -> float | None:

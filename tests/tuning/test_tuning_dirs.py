@@ -214,11 +214,18 @@ def _write_lead(directory: Path, doc: dict) -> None:
 
 
 def test_a_lead_file_without_measured_lags_still_reads(tmp_path: Path) -> None:
-    """Files made before the measured lag was recorded: no measured_* keys in per_speed."""
+    """Files made before the measured lag was recorded: no measured_* keys in per_speed (nor the preview responses,
+    recorded later still)."""
     directory = _copy_shipped("tractor-semitrailer", tmp_path / "old")
     doc = json.loads((directory / LEAD_FILE).read_text())
     for row in doc["design"]["per_speed"]:
         for key in [k for k in row if k.startswith("measured_")]:
+            del row[key]
+    _write_lead(directory, doc)
+    with pytest.raises(WorkbenchInputError, match="previews need the measured lags"):
+        read_vehicle_tuning(directory)
+    for row in doc["design"]["per_speed"]:
+        for key in [k for k in row if k.startswith("preview_")]:
             del row[key]
     _write_lead(directory, doc)
     tuning = read_vehicle_tuning(directory)

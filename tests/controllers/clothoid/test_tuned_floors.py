@@ -169,7 +169,9 @@ def test_the_step_tables_are_built_once(monkeypatch: pytest.MonkeyPatch) -> None
     controller = _controller("tractor-semitrailer")
     controller.reset(STRAIGHT, 0.01)
     assert len(built) == 1
-    assert controller._lags is controller.tuning.lag_tables[1]
+    assert controller.uses_preview and controller._lags is controller.tuning.preview_lag_tables[1]
+    lags = _controller("dynamic-bicycle")
+    assert not lags.uses_preview and lags._lags is lags.tuning.lag_tables[1]
 
 
 def test_a_design_with_other_margins_has_floors_the_controller_computes_with_its_own(
