@@ -17,6 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
+from controllers.clothoid.speed_tables import bracket
 from workbench.base.errors import WorkbenchInputError, value_text
 from workbench.base.path_search import PATH_CURVATURE, value_at
 
@@ -72,19 +73,12 @@ def preview_curvature(
     taps: np.ndarray,
 ) -> float:  # pragma: no cover - compiled
     """sum_k h_k kappa_p(s_m + V (tau_k + shift_s)) (1/m): the taps (n speeds, m taps; rows at speeds_kmh,
-    interpolated linearly in speed and clamped beyond the ends, as `speed_tables.table_row`) on the path's curvature
+    interpolated linearly in speed and clamped beyond the ends, `speed_tables.bracket`) on the path's curvature
     around s_m, each tap's time taken to distance at the speed now (`path_search.CompiledPath`'s table and record)."""
     shape = record[0]
     spacing, length, closed = shape.spacing, shape.length, shape.closed
     curvature = table[PATH_CURVATURE]
-    kmh, n = speed_mps * 3.6, speeds_kmh.size
-    i = 0  # the first speed >= kmh, as table_row
-    while i < n and speeds_kmh[i] < kmh:
-        i += 1
-    low, t = min(i, n - 1), 0.0
-    if 0 < i < n and speeds_kmh[i] != kmh:
-        low, t = i - 1, (kmh - speeds_kmh[i - 1]) / (speeds_kmh[i] - speeds_kmh[i - 1])
-    high = min(low + 1, n - 1)
+    low, high, t = bracket(speeds_kmh, speed_mps * 3.6)
     total = 0.0
     for k in range(taps.shape[1]):
         tap = taps[low, k] + t * (taps[high, k] - taps[low, k])
