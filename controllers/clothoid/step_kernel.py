@@ -35,14 +35,15 @@ from controllers.clothoid.path_feedforward import lag_inverse_curvature, preview
 from controllers.clothoid.pose_prediction import along_arc
 from controllers.clothoid.preview_model import preview_curvature
 from controllers.clothoid.speed_tables import table_row
+from controllers.clothoid.vehicle_tuning import LAG_COLUMNS as LAG_PARAMETERS
 from workbench.base.path_search import TRACK_OUT_SIZE, TRACK_PROGRESS, TRACK_S, TRACK_STATE_SIZE, track
 
 # Option codes (ClothoidConfig's strings).
 MODE_ADAPTIVE, MODE_FIXED, MODE_SPEED = 0, 1, 2
 KAPPA0_YAW_RATE, KAPPA0_COMMAND, KAPPA0_STEERING = 0, 1, 2
-#: The lag's columns of a row of the lag tables (`vehicle_tuning.LAG_COLUMNS`: wn, zeta, delay, K); the preview
-#: response's taps follow them when the feed-forward uses them.
-LAG_COLUMNS = 4
+#: How many columns of a row of the lag tables hold the lag (`vehicle_tuning.LAG_COLUMNS`: wn, zeta, delay, K); the
+#: preview response's taps follow them when the feed-forward uses them.
+LAG_COLUMNS = len(LAG_PARAMETERS)
 
 #: The step's parameters (`params`, one record, made by `parameters`): the vehicle's geometry (wheelbase m,
 #: steering ratio, steering-wheel limit rad), the period (s) and ClothoidConfig's numbers; NaN stands for an option's
@@ -393,16 +394,16 @@ def clothoid_step(
             )  # fmt: skip
         if inverting:  # the lag inverted, added after the lead filter; the integrator holds the feedback alone
             kdot = clothoid_kdot - reference_kdot
-            omega_n, zeta, dead_time = math.nan, 1.0, 0.0
-            if lags.shape[0] > 0:
-                table_row(lag_speeds, lags, speed * 3.6, False, scratch[:4])
-                omega_n, zeta, dead_time, gain = scratch[0], scratch[1], scratch[2], scratch[3]
             if previewing:  # the steering that drives the path, from the preview response, the known delay ahead
                 feedforward_kappa = preview_curvature(
                     path, record, foot[0], speed, p.known_delay, p.preview_first_tap, p.preview_spacing, lag_speeds,
                     lags[:, LAG_COLUMNS:],
                 )  # fmt: skip
             else:
+                omega_n, zeta, dead_time = math.nan, 1.0, 0.0
+                if lags.shape[0] > 0:
+                    table_row(lag_speeds, lags, speed * 3.6, False, scratch[:4])
+                    omega_n, zeta, dead_time, gain = scratch[0], scratch[1], scratch[2], scratch[3]
                 feedforward_kappa, feedforward_kdot = lag_inverse_curvature(
                     path, record, foot[0], speed, dead_time + p.known_delay, omega_n, zeta, gain,
                     p.feedforward_window,
