@@ -19,7 +19,7 @@ from numba import njit
 
 from controllers.clothoid.speed_tables import bracket
 from workbench.base.errors import WorkbenchInputError, value_text
-from workbench.base.path_search import PATH_CURVATURE, value_at
+from workbench.base.path_search import PATH_CURVATURE, PATH_SPEED, value_at
 
 
 @dataclass(frozen=True)
@@ -60,6 +60,11 @@ class PreviewResponse:
         )  # fmt: skip
 
 
+#: m/s: below this planned speed where the vehicle is, the plan's shape is not scaled to the measured speed (a plan
+#: that stops there says nothing of the speed's level).
+MIN_PLANNED_SPEED_MPS = 0.5
+
+
 @njit(cache=True)
 def preview_curvature(
     table: np.ndarray,
@@ -72,16 +77,50 @@ def preview_curvature(
     speeds_kmh: np.ndarray,
     taps: np.ndarray,
 ) -> float:  # pragma: no cover - compiled
-    """sum_k h_k kappa_p(s_m + V (tau_k + shift_s)) (1/m): the taps (n speeds, m taps; rows at speeds_kmh,
-    interpolated linearly in speed and clamped beyond the ends, `speed_tables.bracket`) on the path's curvature
-    around s_m, each tap's time taken to distance at the speed now (`path_search.CompiledPath`'s table and record)."""
+    """sum_k h_k kappa_p(s_k) (1/m): the taps (n speeds, m taps; rows at speeds_kmh, interpolated linearly in speed
+    and clamped beyond the ends, `speed_tables.bracket`) on the path's curvature where the vehicle is at each tap's
+    time tau_k + shift_s from now, s_m being where it is now (`path_search.CompiledPath`'s table and record).
+
+    The taps are times, the path's curvature a function of distance: s_k is reached from s_m tap by tap at the
+    path's planned speed (PATH_SPEED), scaled by the measured speed over the planned speed at s_m (the plan's shape,
+    the speed's level now), so that a corner braked into or accelerated out of is read where the vehicle is at each
+    tap's time, not at speed_mps x tau_k. Where the path carries no planned speed (NaN), or plans less than
+    MIN_PLANNED_SPEED_MPS at s_m, the measured speed stands in for the plan, or the plan for the scaled plan."""
     shape = record[0]
     spacing, length, closed = shape.spacing, shape.length, shape.closed
-    curvature = table[PATH_CURVATURE]
+    curvature, planned = table[PATH_CURVATURE], table[PATH_SPEED]
     low, high, t = bracket(speeds_kmh, speed_mps * 3.6)
+    here = value_at(planned, s_m, spacing, length, closed)
+    scale = speed_mps / here if here > MIN_PLANNED_SPEED_MPS else 1.0  # False for NaN
+    n = taps.shape[1]
+    last_past = math.floor(-(first_tap_s + shift_s) / tap_spacing_s)  # the last tap at or before now
+    s_last_past = s_m + speed_mps * (first_tap_s + last_past * tap_spacing_s + shift_s)  # within one spacing
     total = 0.0
-    for k in range(taps.shape[1]):
-        tap = taps[low, k] + t * (taps[high, k] - taps[low, k])
-        s = s_m + speed_mps * (first_tap_s + k * tap_spacing_s + shift_s)
-        total += tap * value_at(curvature, s, spacing, length, closed)
+    s = s_last_past
+    for k in range(last_past, n):  # now and ahead, forward along the plan
+        if k > last_past:
+            s += tap_spacing_s * _speed_at(planned, s, spacing, length, closed, scale, speed_mps)
+        if k >= 0:
+            total += _tap(taps, low, high, t, k) * value_at(curvature, s, spacing, length, closed)
+    s = s_last_past
+    for k in range(last_past - 1, -1, -1):  # the path already driven, backward along the plan
+        s -= tap_spacing_s * _speed_at(planned, s, spacing, length, closed, scale, speed_mps)
+        if k < n:
+            total += _tap(taps, low, high, t, k) * value_at(curvature, s, spacing, length, closed)
     return total
+
+
+@njit(cache=True)
+def _speed_at(
+    planned: np.ndarray, s: float, spacing: float, length: float, closed: bool, scale: float, measured_mps: float
+) -> float:  # pragma: no cover - compiled
+    """The speed (m/s, >= 0) the vehicle drives at arc length s: the planned speed times scale, or the measured speed
+    where the plan is NaN."""
+    v = value_at(planned, s, spacing, length, closed)
+    return measured_mps if math.isnan(v) else max(v * scale, 0.0)
+
+
+@njit(cache=True)
+def _tap(taps: np.ndarray, low: int, high: int, t: float, k: int) -> float:  # pragma: no cover - compiled
+    """Tap k interpolated between the rows low and high (weight t on high)."""
+    return taps[low, k] + t * (taps[high, k] - taps[low, k])

@@ -29,9 +29,12 @@ RATE_1PM2 = 4e-4
 FIRST_S, TAP_S = -1.0, 0.05
 
 
-def _sum(curvature: np.ndarray, s_m: float, speed_mps: float, taps: np.ndarray, speeds=(30.0,), shift_s=0.0) -> float:
+def _sum(
+    curvature: np.ndarray, s_m: float, speed_mps: float, taps: np.ndarray, speeds=(30.0,), shift_s=0.0, planned=None
+) -> float:
     zeros = np.zeros_like(curvature)
-    compiled = CompiledPath.of((zeros, zeros, zeros, curvature, None), SPACING_M, float(S_GRID[-1]), False, 0.0, 5.0)
+    samples = (zeros, zeros, zeros, curvature, planned)
+    compiled = CompiledPath.of(samples, SPACING_M, float(S_GRID[-1]), False, 0.0, 5.0)
     return preview_curvature(
         compiled.table, compiled.record, s_m, speed_mps, shift_s, FIRST_S, TAP_S, np.array(speeds, dtype=float),
         np.atleast_2d(taps),
@@ -70,6 +73,41 @@ def test_on_a_clothoid_it_is_the_taps_on_the_curvature_at_each_taps_distance(tap
     expected = float((h * RATE_1PM2 * (s0 + speed * (tau + shift))).sum())
     got = _sum(RATE_1PM2 * S_GRID, s0, speed, h, shift_s=shift)
     assert got == pytest.approx(expected, rel=1e-9, abs=1e-12)
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    taps=st.lists(st.floats(-2.0, 2.0), min_size=1, max_size=60),
+    speed=st.floats(1.0, 30.0),
+    planned=st.floats(1.0, 30.0),
+    shift=st.floats(0.0, 0.5),
+)
+def test_a_held_planned_speed_gives_the_taps_at_the_measured_speed(taps, speed, planned, shift) -> None:
+    """The plan's shape scaled to the measured speed: a held plan, whatever its level, reads the path as the measured
+    speed held would."""
+    h = np.array(taps)
+    curvature = RATE_1PM2 * S_GRID
+    held = _sum(curvature, 150.0, speed, h, shift_s=shift, planned=np.full(S_GRID.size, planned))
+    assert held == pytest.approx(_sum(curvature, 150.0, speed, h, shift_s=shift), rel=1e-9, abs=1e-12)
+
+
+@pytest.mark.parametrize("accel_mps2", [-1.5, 1.0])
+@pytest.mark.parametrize("tau_s", [-1.0, -0.55, 0.0, 0.35, 2.0])
+def test_braking_or_accelerating_the_taps_are_where_the_vehicle_is_at_their_time(accel_mps2, tau_s) -> None:
+    """A plan of constant acceleration a (v^2 = v0^2 + 2 a (s - s0)) and one unit tap at tau on kappa = c s: the sum
+    is c s(tau), s(tau) = s0 + v0 tau + a tau^2 / 2, within the tap-by-tap stepping's first-order error a |tau| dt
+    (explicit steps of dt at the speed where each starts: a |tau| dt / 2 plus the speed read where the position
+    lags) and 1 mm of the plan's sampling; held at v0 it would be off by a tau^2 / 2 (up to 2 m here)."""
+    s0, v0 = 150.0, 8.0
+    planned = np.sqrt(np.maximum(v0**2 + 2.0 * accel_mps2 * (S_GRID - s0), 0.0))
+    h = np.zeros(round((tau_s - FIRST_S) / TAP_S) + 1)
+    h[-1] = 1.0
+    got = _sum(RATE_1PM2 * S_GRID, s0, v0, h, planned=planned) / RATE_1PM2
+    expected = s0 + v0 * tau_s + 0.5 * accel_mps2 * tau_s**2
+    tolerance = abs(accel_mps2 * tau_s) * TAP_S + 1e-3
+    assert got == pytest.approx(expected, abs=tolerance)
+    if tau_s != 0.0:
+        assert abs((s0 + v0 * tau_s) - expected) > tolerance
 
 
 def test_the_taps_are_interpolated_in_speed_and_clamped_beyond() -> None:
