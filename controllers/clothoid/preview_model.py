@@ -63,6 +63,10 @@ class PreviewResponse:
 #: m/s: below this planned speed where the vehicle is, the plan's shape is not scaled to the measured speed (a plan
 #: that stops there says nothing of the speed's level).
 MIN_PLANNED_SPEED_MPS = 0.5
+#: Taps per step of the march along the planned speed (`preview_curvature`): the march's reads of the plan are
+#: sequential, so fewer steps keep the step fast; within a step of 4 taps (0.2 s) the position is off a straight
+#: line in time by at most a dt^2 / 8 (under 1 cm at 2 m/s^2).
+MARCH_TAPS = 4
 
 
 @njit(cache=True)
@@ -81,32 +85,36 @@ def preview_curvature(
     and clamped beyond the ends, `speed_tables.bracket`) on the path's curvature where the vehicle is at each tap's
     time tau_k + shift_s from now, s_m being where it is now (`path_search.CompiledPath`'s table and record).
 
-    The taps are times, the path's curvature a function of distance: s_k is reached from s_m tap by tap at the
-    path's planned speed (PATH_SPEED), scaled by the measured speed over the planned speed at s_m (the plan's shape,
-    the speed's level now), so that a corner braked into or accelerated out of is read where the vehicle is at each
-    tap's time, not at speed_mps x tau_k. Where the path carries no planned speed (NaN), or plans less than
-    MIN_PLANNED_SPEED_MPS at s_m, the measured speed stands in for the plan, or the plan for the scaled plan."""
+    The taps are times, the path's curvature a function of distance: s_k is reached from s_m, MARCH_TAPS taps at a
+    time, at the path's planned speed (PATH_SPEED) scaled by the measured speed over the planned speed at s_m (the
+    plan's shape, the speed's level now), so that a corner braked into or accelerated out of is read where the
+    vehicle is at each tap's time, not at speed_mps x tau_k. Where the path carries no planned speed (NaN), or plans
+    less than MIN_PLANNED_SPEED_MPS at s_m, the measured speed stands in for the plan, or the plan for the scaled
+    plan."""
     shape = record[0]
     spacing, length, closed = shape.spacing, shape.length, shape.closed
     curvature, planned = table[PATH_CURVATURE], table[PATH_SPEED]
     low, high, t = bracket(speeds_kmh, speed_mps * 3.6)
     here = value_at(planned, s_m, spacing, length, closed)
     scale = speed_mps / here if here > MIN_PLANNED_SPEED_MPS else 1.0  # False for NaN
-    n = taps.shape[1]
     last_past = math.floor(-(first_tap_s + shift_s) / tap_spacing_s)  # the last tap at or before now
     s_last_past = s_m + speed_mps * (first_tap_s + last_past * tap_spacing_s + shift_s)  # within one spacing
     total = 0.0
-    s = s_last_past
-    for k in range(last_past, n):  # now and ahead, forward along the plan
-        if k > last_past:
-            s += tap_spacing_s * _speed_at(planned, s, spacing, length, closed, scale, speed_mps)
-        if k >= 0:
-            total += _tap(taps, low, high, t, k) * value_at(curvature, s, spacing, length, closed)
-    s = s_last_past
-    for k in range(last_past - 1, -1, -1):  # the path already driven, backward along the plan
-        s -= tap_spacing_s * _speed_at(planned, s, spacing, length, closed, scale, speed_mps)
-        if k < n:
-            total += _tap(taps, low, high, t, k) * value_at(curvature, s, spacing, length, closed)
+    for direction in (1, -1):  # now and ahead, then the path already driven
+        s_a, k_a = s_last_past, last_past
+        v_a = _speed_at(planned, s_a, spacing, length, closed, scale, speed_mps)
+        h = direction * MARCH_TAPS * tap_spacing_s
+        while (k_a < taps.shape[1]) if direction > 0 else (k_a > 0):
+            # one step of the march (trapezoidal, the end's speed read where the start's speed takes it); the taps
+            # within it interpolated linearly in time
+            v_b = _speed_at(planned, s_a + h * v_a, spacing, length, closed, scale, speed_mps)
+            s_b = s_a + 0.5 * h * (v_a + v_b)
+            for i in range(MARCH_TAPS) if direction > 0 else range(1, MARCH_TAPS + 1):
+                k = k_a + direction * i
+                if 0 <= k < taps.shape[1]:
+                    s = s_a + (s_b - s_a) * (i / MARCH_TAPS)
+                    total += _tap(taps, low, high, t, k) * value_at(curvature, s, spacing, length, closed)
+            s_a, v_a, k_a = s_b, v_b, k_a + direction * MARCH_TAPS
     return total
 
 

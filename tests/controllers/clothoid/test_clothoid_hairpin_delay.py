@@ -209,10 +209,10 @@ def test_the_turn_limit_is_checked(value: float) -> None:
 def test_the_loaded_truck_keeps_to_a_hairpin_with_the_automotive_delay(compensation: str, max_cte_m: float) -> None:
     """Loaded truck, automotive conditions (pose 10 ms late, steering 0.1 s dead time), known_delay_s = 0.11, 30 km/h
     planned (5.75 m/s at the apex, the profile's 0.3 g), no limit cycle; at the apex the lookahead is within 1 m of
-    the floor (0.48 m compensated by the model, 0.45 m on the arc). Compensated by the lags' model
+    the floor (0.43 m compensated by the model, 0.28 m on the arc). Compensated by the lags' model
     (`delay_predictor.py`) the floor is 6.5 m at 20 km/h (the delay-free loop's 5.5 m, raised for +-50 ms of the
     delay), and max |CTE| <= 0.15 m (issue 18's goal; measured 0.111 m). On the arc of kappa(0) the delay stays in the
-    loop, the floor is 10.5 m and max |CTE| <= 0.33 m (measured 0.296 m; 0.47 m before the floor took the lookahead
+    loop, the floor is 10.5 m and max |CTE| <= 0.33 m (measured 0.291 m; 0.47 m before the floor took the lookahead
     down at once: the sideslip relaxing at the apex, a heading step of ~0.03 rad, leaves about 0.02 m per metre of
     lookahead). The truck's feed-forward and reference come from its preview responses (`feedforward_model` auto):
     identified at 0.1 g and a held speed, they hold this braking-and-accelerating 0.3 g corner less well than its

@@ -14,7 +14,7 @@ from hypothesis import strategies as st
 
 from controllers.base import Measurement
 from controllers.clothoid import ClothoidConfig, ClothoidController
-from controllers.clothoid.preview_model import PreviewResponse, preview_curvature
+from controllers.clothoid.preview_model import MARCH_TAPS, PreviewResponse, preview_curvature
 from tuning.own_tuning import tuning_for
 from workbench.base.clothoid_chain import ClothoidChain
 from workbench.base.errors import WorkbenchInputError
@@ -95,16 +95,18 @@ def test_a_held_planned_speed_gives_the_taps_at_the_measured_speed(taps, speed, 
 @pytest.mark.parametrize("tau_s", [-1.0, -0.55, 0.0, 0.35, 2.0])
 def test_braking_or_accelerating_the_taps_are_where_the_vehicle_is_at_their_time(accel_mps2, tau_s) -> None:
     """A plan of constant acceleration a (v^2 = v0^2 + 2 a (s - s0)) and one unit tap at tau on kappa = c s: the sum
-    is c s(tau), s(tau) = s0 + v0 tau + a tau^2 / 2, within the tap-by-tap stepping's first-order error a |tau| dt
-    (explicit steps of dt at the speed where each starts: a |tau| dt / 2 plus the speed read where the position
-    lags) and 1 mm of the plan's sampling; held at v0 it would be off by a tau^2 / 2 (up to 2 m here)."""
+    is c s(tau), s(tau) = s0 + v0 tau + a tau^2 / 2, within a h^2 / 8 of a tap between two of the march's steps
+    (h = MARCH_TAPS taps: the straight line in time), the trapezoidal steps' a^2 h^2 |tau| / (4 v) and 1 mm of the
+    plan's sampling; held at v0 it would be off by a tau^2 / 2 (up to 2 m here)."""
     s0, v0 = 150.0, 8.0
     planned = np.sqrt(np.maximum(v0**2 + 2.0 * accel_mps2 * (S_GRID - s0), 0.0))
     h = np.zeros(round((tau_s - FIRST_S) / TAP_S) + 1)
     h[-1] = 1.0
     got = _sum(RATE_1PM2 * S_GRID, s0, v0, h, planned=planned) / RATE_1PM2
     expected = s0 + v0 * tau_s + 0.5 * accel_mps2 * tau_s**2
-    tolerance = abs(accel_mps2 * tau_s) * TAP_S + 1e-3
+    h = MARCH_TAPS * TAP_S
+    a = abs(accel_mps2)
+    tolerance = a * h**2 / 8.0 + a**2 * h**2 * abs(tau_s) / (4.0 * (v0 - 2.0 * a)) + 1e-3
     assert got == pytest.approx(expected, abs=tolerance)
     if tau_s != 0.0:
         assert abs((s0 + v0 * tau_s) - expected) > tolerance
