@@ -100,13 +100,12 @@ def test_braking_or_accelerating_the_taps_are_where_the_vehicle_is_at_their_time
     plan's sampling; held at v0 it would be off by a tau^2 / 2 (up to 2 m here)."""
     s0, v0 = 150.0, 8.0
     planned = np.sqrt(np.maximum(v0**2 + 2.0 * accel_mps2 * (S_GRID - s0), 0.0))
-    h = np.zeros(round((tau_s - FIRST_S) / TAP_S) + 1)
-    h[-1] = 1.0
-    got = _sum(RATE_1PM2 * S_GRID, s0, v0, h, planned=planned) / RATE_1PM2
+    unit = np.zeros(round((tau_s - FIRST_S) / TAP_S) + 1)
+    unit[-1] = 1.0
+    got = _sum(RATE_1PM2 * S_GRID, s0, v0, unit, planned=planned) / RATE_1PM2
     expected = s0 + v0 * tau_s + 0.5 * accel_mps2 * tau_s**2
-    h = MARCH_TAPS * TAP_S
-    a = abs(accel_mps2)
-    tolerance = a * h**2 / 8.0 + a**2 * h**2 * abs(tau_s) / (4.0 * (v0 - 2.0 * a)) + 1e-3
+    h, a = MARCH_TAPS * TAP_S, abs(accel_mps2)
+    tolerance = a * h**2 / 8.0 + a**2 * h**2 * abs(tau_s) / (4.0 * (v0 - 2.0 * a)) + 1e-3  # v0 - 2a: the slowest
     assert got == pytest.approx(expected, abs=tolerance)
     if tau_s != 0.0:
         assert abs((s0 + v0 * tau_s) - expected) > tolerance
