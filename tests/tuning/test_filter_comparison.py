@@ -30,14 +30,16 @@ def test_fixed_and_scheduled_files_for_the_closed_loop_comparison(truck, result,
 
 
 def test_closed_loop_comparison_runs_the_clothoid_controller(truck, result, tmp_path: Path) -> None:
-    # Measured on the dlc at 60 km/h (0.3 g speed profile): max |CTE| 2.33 m with the 30 km/h filter (cancelling,
-    # no delay), 2.80 m without a lead filter: the controller keeps its margins by the lookahead floor it computes
-    # from the truck's lags at 60 km/h and the filter it runs, and a 30 km/h filter there needs long lookaheads.
+    # Measured on the dlc at 60 km/h (0.3 g speed profile): max |CTE| 0.068 m with this schedule's 30 km/h filter,
+    # 0.066 m without a lead filter (RMS 0.033 / 0.034 m). The controller keeps its margins by the lookahead floor it
+    # computes from the truck's lags at 60 km/h and the filter it runs, and its feed-forward does most of the
+    # tracking, so either way it keeps to the path; the filter still reaches the loop (the runs differ).
     files = {"fixed": fixed_and_scheduled_filters(truck, result, 30.0, tmp_path)["fixed 30 km/h"], "off": None}
     rows = compare_closed_loop(lambda: make_vehicle("tractor-semitrailer"), files, [60.0])
     by_filter = {row.filter: row for row in rows}
     assert all(row.completed and row.speed_kmh == 60.0 for row in rows)
-    assert by_filter["fixed"].max_abs_cte_m < by_filter["off"].max_abs_cte_m
+    assert all(row.max_abs_cte_m < 0.1 for row in rows)
+    assert by_filter["fixed"].rms_cte_m != pytest.approx(by_filter["off"].rms_cte_m, rel=1e-2)
     # The 0.3 g profile asks for 60 km/h on the straights and slows the truck for the lane changes.
     assert by_filter["fixed"].max_speed_kmh == pytest.approx(60.0, abs=0.5)
     assert by_filter["fixed"].min_speed_kmh < 45.0
@@ -46,8 +48,9 @@ def test_closed_loop_comparison_runs_the_clothoid_controller(truck, result, tmp_
 def test_the_scheduled_filter_tracks_better_than_the_30_kmh_filter_at_60_and_80_kmh(tmp_path: Path) -> None:
     """Issue 6, item 5, on the truck's shipped schedule (`python -m tuning.preset_tuning`: `tuning schedule --speeds
     10,20,...,100 --delay --design margins`) against its own 30 km/h filter held fixed, the dlc at 60 and 80 km/h
-    with the clothoid controller's defaults. Measured: max |CTE| 0.175 / 0.172 m scheduled, 2.33 / 2.32 m with the
-    30 km/h filter (-93 %); 2.80 m without a filter."""
+    with the clothoid controller's defaults. Measured: max |CTE| 0.086 / 0.084 m scheduled, 0.366 / 0.374 m with the
+    30 km/h filter (-77 %); 0.066 / 0.074 m without a filter (its floor is longer, and its margins are the floor's;
+    the feed-forward does most of the tracking)."""
     lead = shipped_tuning_root() / "tractor-semitrailer" / LEAD_FILE
     schedule = read_filter_file(lead)
     fixed = write_filter_file(tmp_path / "fixed.json", schedule.at_speed(30.0), source="test", speed_kmh=30.0)
