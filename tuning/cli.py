@@ -539,7 +539,7 @@ def _steering_limits(args: argparse.Namespace) -> int:
 def _schedule(args: argparse.Namespace) -> int:
     from tuning.filter_comparison import compare_closed_loop, fixed_and_scheduled_filters, scheduled_against_fixed
     from tuning.lag_fit import LagFitOptions
-    from tuning.preview_fit import PreviewFitOptions
+    from tuning.preview_fit import FUTURE_RANGE_S, PAST_RANGE_S, PreviewFitOptions
     from tuning.schedule import PAPER_SPEED_KMH, SPEED_MATCH_KMH, identify_schedule
     from tuning.speeds import parse_speeds
     from workbench.base.errors import require_in_range
@@ -562,8 +562,8 @@ def _schedule(args: argparse.Namespace) -> int:
             "km/h); the nominal (top-level) filter is the one designed at one of the speeds identified: give one "
             "of them, or add it to --speeds"
         )
-    require_in_range("--preview-past-s", args.preview_past_s, 0.0, 30.0, "s")
-    require_in_range("--preview-future-s", args.preview_future_s, 0.0, 10.0, "s")
+    require_in_range("--preview-past-s", args.preview_past_s, *PAST_RANGE_S, "s")
+    require_in_range("--preview-future-s", args.preview_future_s, *FUTURE_RANGE_S, "s")
     preview = PreviewFitOptions(past_s=args.preview_past_s, future_s=args.preview_future_s)
     with _progress_bar(len(speeds), "speed", "tuning schedule") as bar:
         bar.set_postfix_str(f"{speeds[0]:g} km/h")

@@ -37,7 +37,7 @@ from typing import Any
 
 from tuning.lag_fit import LagFitOptions
 from tuning.limits_file import write_limits_file
-from tuning.preview_fit import PreviewFitOptions
+from tuning.preview_fit import FUTURE_RANGE_S, PAST_RANGE_S, PreviewFitOptions
 from tuning.rollover import LTR_OUTPUT, rollover_limits
 from tuning.rollover import to_curvature_limits as rollover_curvature_limits
 from tuning.schedule import (
@@ -159,8 +159,8 @@ class PresetTuningOptions:
             raise WorkbenchInputError(f"design must be one of {', '.join(DESIGNS)}; got {self.design!r}")
         require_in_range("controller_rate_hz", self.controller_rate_hz, 1.0, 1000.0, "Hz")
         require_in_range("prediction_time_s", self.prediction_time_s, 0.0, 2.0, "s")
-        require_in_range("preview_past_s", self.preview_past_s, 0.0, 30.0, "s")  # PreviewFitOptions' ranges
-        require_in_range("preview_future_s", self.preview_future_s, 0.0, 10.0, "s")
+        require_in_range("preview_past_s", self.preview_past_s, *PAST_RANGE_S, "s")
+        require_in_range("preview_future_s", self.preview_future_s, *FUTURE_RANGE_S, "s")
 
     def for_model(self, model_type: str) -> VehicleTuningOptions:
         override = next((o for o in self.speed_overrides if o.model == model_type), None)

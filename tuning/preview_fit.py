@@ -39,6 +39,11 @@ from tuning.log_file import VehicleLog
 from workbench.base.errors import WorkbenchInputError, require_in_range
 from workbench.vehicles.geometry import VehicleGeometry
 
+#: s: the ranges of how far before (past_s) and after (future_s) the present the taps may reach; the CLI's
+#: --preview-past-s / --preview-future-s and the preset options check the same.
+PAST_RANGE_S = (0.0, 30.0)
+FUTURE_RANGE_S = (0.0, 10.0)
+
 
 @dataclass(frozen=True)
 class PreviewFitOptions:
@@ -53,8 +58,8 @@ class PreviewFitOptions:
 
     def __post_init__(self) -> None:
         require_in_range("tap_spacing_s", self.tap_spacing_s, 0.005, 0.5, "s")
-        require_in_range("past_s", self.past_s, 0.0, 30.0, "s")
-        require_in_range("future_s", self.future_s, 0.0, 10.0, "s")
+        require_in_range("past_s", self.past_s, *PAST_RANGE_S, "s")
+        require_in_range("future_s", self.future_s, *FUTURE_RANGE_S, "s")
         require_in_range("ridge", self.ridge, 0.0, 1e3)
         require_in_range("smoothness", self.smoothness, 0.0, 1e6)
         require_in_range("smooth_s", self.smooth_s, 0.0, 10.0, "s")
