@@ -44,9 +44,15 @@ if TYPE_CHECKING:  # the clothoid controller and the tuning tools (python-contro
     from workbench.simulation.known_delays import KnownDelays
 
 
+#: The version of what the tuning chain identifies (2: the preview responses' handling gain from steady turns): a
+#: cached tuning made by an earlier chain lacks what this one adds, so the version is part of `cache_key`.
+CHAIN_VERSION = 2
+
+
 def cache_key(vehicle: VehicleModel, options: PresetTuningOptions) -> str:
-    """Name of the vehicle's cache directory: sha256 of its canonical parameters and of the tuning options resolved
-    for it (so that changed options make a new tuning rather than reuse one made with the old).
+    """Name of the vehicle's cache directory: sha256 of CHAIN_VERSION, the vehicle's canonical parameters and the
+    tuning options resolved for it (so that a changed chain or options make a new tuning rather than reuse one
+    made with the old).
 
     Parameters
     ----------
@@ -63,7 +69,8 @@ def cache_key(vehicle: VehicleModel, options: PresetTuningOptions) -> str:
     from tuning.preset_tuning import options_dict
     from tuning.tuning_dirs import canonical_vehicle_toml
 
-    text = canonical_vehicle_toml(vehicle) + json.dumps(options_dict(options, vehicle.name), sort_keys=True)
+    text = f"chain {CHAIN_VERSION}\n" + canonical_vehicle_toml(vehicle)
+    text += json.dumps(options_dict(options, vehicle.name), sort_keys=True)
     return hashlib.sha256(text.encode("utf-8")).hexdigest()
 
 

@@ -38,6 +38,7 @@ from controllers.clothoid.loop_analysis import LoopSettings, PlantLags
 from controllers.clothoid.loop_requirements import REQUIRED_GAIN_MARGIN_DB, REQUIRED_PHASE_MARGIN_DEG
 from tuning.data_generation import generate_open_loop_log
 from tuning.filter_file import write_filter_file
+from tuning.handling_fit import HANDLING_LADDER_G, HandlingFit, fit_handling
 from tuning.lag_fit import LagFit, LagFitOptions, fit_lag
 from tuning.lead_design import (
     DEFAULT_MAX_CASCADE_PEAK_DB,
@@ -91,6 +92,7 @@ class ScheduleEntry:
     measured_fit: LagFit | None = None  # the fit of the measured (yaw-rate) lag (None: not identified)
     margins: MarginsDesign | None = None  # the margins design's lookahead floors (None: the cancel design)
     preview: PreviewFit | None = None  # the preview responses fitted to the same logs (None: not identified)
+    handling: HandlingFit | None = None  # the steady turns the preview's handling gain came from (None: none)
 
     def row(self) -> dict[str, Any]:
         """The entry as one row of the lead-filter file's ``design.per_speed`` table and of `ScheduleResult.table`.
@@ -102,8 +104,9 @@ class ScheduleEntry:
             under the same keys prefixed ``measured_`` when it was identified; the filter (omega_z_rad_s, psi,
             omega_p_rad_s), its lead_peak_gain and the plant's and cascade's bandwidths (rad/s); with the margins
             design, lookahead_floor_m (or margin_score when no lookahead keeps the margins) and
-            floor_without_lead_m when finite; with the preview responses, their first tap and spacing (s), NRMSE and
-            taps (lists of float), under keys prefixed ``preview_``.
+            floor_without_lead_m when finite; with the preview responses, their first tap and spacing (s), NRMSE,
+            taps and handling gain (lists of float), under keys prefixed ``preview_``; with the steady turns, their
+            lateral accelerations (g) and steering ratios as handling_lat_accel_g and handling_ratio (lists).
         """
         lag, d = self.fit.lag, self.design
         out: dict[str, Any] = {
@@ -148,6 +151,12 @@ class ScheduleEntry:
                 preview_measured_nrmse=self.preview.measured_nrmse,
                 preview_steering_taps=[float(f"{v:.7g}") for v in response.steering_taps],
                 preview_measured_taps=list(response.measured_taps),
+                preview_handling_gain=[float(f"{v:.7g}") for v in response.handling_gain],
+            )
+        if self.handling is not None:
+            out.update(
+                handling_lat_accel_g=[float(f"{t.lat_accel_g:.5g}") for t in self.handling.turns],
+                handling_ratio=[float(f"{t.steering_ratio:.7g}") for t in self.handling.turns],
             )
         return out
 
@@ -409,6 +418,50 @@ def identification_logs(
     return logs
 
 
+def handling_logs(
+    vehicle: VehicleModel, speed_kmh: float, duration_s: float = 20.0, sample_rate_hz: float = 100.0
+) -> list[VehicleLog]:
+    """Open-loop steering steps at speed_kmh for the handling gain (`tuning.handling_fit`, ISO 4138's constant-speed
+    method): one per rung of HANDLING_LADDER_G whose kinematic curvature is short of the steering lock, at most
+    IDENTIFICATION_RATE_FRACTION of the vehicle's steering-wheel rate, held to the log's end.
+
+    Parameters
+    ----------
+    vehicle : VehicleModel
+        The plant driven open loop.
+    speed_kmh : float, km/h
+        The held speed, within SPEED_RANGE_KMH (5-200 km/h).
+    duration_s : float, s
+        Each log's duration, > 0: long enough for the turn to settle (`handling_fit.STEADY_WINDOW_S` at its end).
+    sample_rate_hz : float, Hz
+        The logs' sample rate, 1-10000 Hz.
+
+    Returns
+    -------
+    list of VehicleLog
+        One log per rung, named "step to <g> g at <speed> km/h"; none when even the first rung reaches the lock.
+
+    Raises
+    ------
+    WorkbenchInputError
+        A speed, duration or sample rate out of its range.
+    """
+    require_in_range("speed_kmh", speed_kmh, *SPEED_RANGE_KMH, "km/h")
+    v = speed_kmh / 3.6
+    max_rate = IDENTIFICATION_RATE_FRACTION * math.degrees(vehicle.geometry.max_steer_wheel_rate_rad_s)
+    logs = []
+    for rung in HANDLING_LADDER_G:
+        if rung * G_MPS2 / (v * v) >= lock_curvature_1pm(vehicle):
+            break
+        step = Maneuver(
+            "step", amplitude_deg=steer_amplitude_deg(vehicle, speed_kmh, rung), duration_s=duration_s,
+            max_rate_deg_s=max_rate,
+        )  # fmt: skip
+        frame = generate_open_loop_log(vehicle, step, speed_kmh, sample_rate_hz=sample_rate_hz)
+        logs.append(VehicleLog.from_frame(frame, name=f"step to {rung:g} g at {speed_kmh:g} km/h"))
+    return logs
+
+
 def steer_amplitude_deg(vehicle: VehicleModel, speed_kmh: float, lat_accel_g: float) -> float:
     """Steering-wheel angle (deg) whose kinematic curvature gives lat_accel_g at speed_kmh, capped at the lock.
 
@@ -491,7 +544,8 @@ def identify_schedule(
     margins_arc_curvature_1pm; bounded by max_lead_gain). A speed whose fit or design is refused makes the whole
     schedule refused, naming the speed; with drop_refused=True it is left out and recorded in `dropped` instead
     (refused only when no speed is left). progress, if given, is called with one line per speed. The preview
-    responses (`tuning.preview_fit`) are fitted to the same logs at each speed.
+    responses (`tuning.preview_fit`) are fitted to the same logs at each speed, their handling gain
+    (`tuning.handling_fit`) to steady turns at the same speed (`handling_logs`).
 
     Parameters
     ----------
@@ -567,6 +621,10 @@ def identify_schedule(
             except WorkbenchInputError as exc:
                 raise WorkbenchInputError(f"the measured (yaw-rate) lag: {exc}") from None
             preview = fit_preview(logs, vehicle.geometry, preview_options)
+            handling = fit_handling(handling_logs(vehicle, speed), vehicle.geometry, lat_accel_g)
+            preview = dataclasses.replace(
+                preview, response=dataclasses.replace(preview.response, handling_gain=handling.gain)
+            )
             margins = None
             if design == "cancel":
                 lead = design_lead(fit.lag, max_lead_gain=max_lead_gain, max_cascade_peak_db=max_cascade_peak_db)
@@ -589,7 +647,7 @@ def identify_schedule(
             if progress is not None:
                 progress(f"{speed:g} km/h: dropped: {exc}")
             continue
-        entries.append(ScheduleEntry(speed, fit, lead, measured, margins, preview))
+        entries.append(ScheduleEntry(speed, fit, lead, measured, margins, preview, handling))
         if progress is not None:
             floors = ""
             if margins is not None:
@@ -599,7 +657,7 @@ def identify_schedule(
                 )
             progress(
                 f"{speed:g} km/h: path {fit.summary()}; measured {measured.summary()}; {preview.summary()}; "
-                f"{lead.summary()}{floors}"
+                f"{handling.summary()}; {lead.summary()}{floors}"
             )
     if not entries:
         reasons = "; ".join(f"at {d.speed_kmh:g} km/h: {d.reason}" for d in dropped)
@@ -625,6 +683,7 @@ __all__ = [
     "DroppedSpeed",
     "ScheduleEntry",
     "ScheduleResult",
+    "handling_logs",
     "identification_logs",
     "identify_schedule",
     "lock_curvature_1pm",

@@ -59,6 +59,8 @@ MEASURED_PREFIX = "measured_"
 MEASURED_LAG_KEYS = ("measured_omega_n_rad_s", "measured_zeta")
 #: The per_speed keys of the preview responses (`tuning.schedule.ScheduleEntry.row`); all of them or none.
 PREVIEW_KEYS = ("preview_first_tap_s", "preview_tap_spacing_s", "preview_steering_taps", "preview_measured_taps")
+#: The preview responses' handling gain, optional (files made before it was identified: gains of one).
+HANDLING_KEY = "preview_handling_gain"
 
 
 # ---- the vehicle's identity -------------------------------------------------------------------------------------
@@ -234,8 +236,9 @@ FLOOR_DESIGN_KEYS = ("controller_rate_hz", "prediction_time_s", "arc_lateral_acc
 
 
 def _previews(path: Path, design: Mapping[str, Any]) -> tuple[tuple[float, PreviewResponse], ...]:
-    """(speed_kmh, the preview responses) of design.per_speed (PREVIEW_KEYS); empty when no row has them (files made
-    before they were recorded), refused when only some rows have them or a row's are not a valid response."""
+    """(speed_kmh, the preview responses) of design.per_speed (PREVIEW_KEYS, and HANDLING_KEY where given); empty
+    when no row has them (files made before they were recorded), refused when only some rows have them or a row's
+    are not a valid response."""
     rows = design["per_speed"]  # checked by _lags
     if not any(k in row for row in rows for k in PREVIEW_KEYS):
         return ()
@@ -247,7 +250,8 @@ def _previews(path: Path, design: Mapping[str, Any]) -> tuple[tuple[float, Previ
                 "the preview responses at every speed or at none"
             )
         try:
-            response = PreviewResponse(*(row[k] for k in PREVIEW_KEYS))
+            handling = {"handling_gain": row[HANDLING_KEY]} if HANDLING_KEY in row else {}
+            response = PreviewResponse(*(row[k] for k in PREVIEW_KEYS), **handling)
         except (WorkbenchInputError, TypeError, ValueError) as exc:
             raise WorkbenchInputError(f"{path}: design.per_speed[{i}] (preview responses): {exc}") from None
         out.append((float(row["speed_kmh"]), response))

@@ -322,6 +322,14 @@ class ClothoidConfig:
         "lags); either way the loop and its margins are the same",
         Choice(FEEDFORWARD_MODELS),
     )
+    handling_gain: bool = option(
+        True,
+        "with the preview responses (feedforward_model): the feed-forward's steering scaled by the vehicle's handling "
+        "gain, the steady-state steering per curvature at the lateral acceleration where each tap reads the path over "
+        "the one the taps were identified at (`preview_model.py`; a tuning made without steady turns has gains of "
+        "one); false: the taps alone, linear at any lateral acceleration; the loop is the same either way",
+        Flag(),
+    )
     tuning: VehicleTuning | None = option(  # noqa: RUF009  (option is a dataclasses.field)
         None,
         "the steered vehicle's own tuning: lead filter, curvature limits, identified lags "
@@ -526,13 +534,16 @@ class ClothoidController(Controller[ClothoidConfig]):
     def _tables(self) -> None:
         """The tables the compiled step reads (step_kernel.py): the limits, the identified lags and the lead
         filter's schedule (no rows: untuned, no lead filter), each against speed, the lags' rows followed by the
-        preview responses' steering and measured taps when the feed-forward uses them (`step_kernel.LAG_COLUMNS`);
+        preview responses' steering and measured taps when the feed-forward uses them, the steering taps by the
+        handling gain with handling_gain (`step_kernel.LAG_COLUMNS`);
         built once, with the controller (they depend on its config alone, not on the path or the period)."""
         self._limit_speeds, self._limits = self.limits.table
         if self.tuning is not None:
             self._lag_speeds, self._lags, self._measured_lags = self.tuning.lag_tables
             if self.uses_preview:
                 self._lag_speeds, self._lags, self._measured_lags = self.tuning.preview_lag_tables
+                if not self.config.handling_gain:  # the steering taps alone (step_kernel: columns past the measured)
+                    self._lags = self._lags[:, : self._measured_lags.shape[1]]
                 first, spacing, _, _ = self.tuning.preview_tables
                 self._params["preview_first_tap"], self._params["preview_spacing"] = first, spacing
         else:

@@ -7,6 +7,15 @@ path rather than in its loop: the feed-forward (the steering that drives the pat
 pose's curvature (`path_feedforward.py`). Both depend on the path alone, so the loop and its margins are those of
 Eq. 3 and the lags (`loop_analysis.py`) whichever model they use. The controller uses them when the lag of Eq. 5
 does not explain the vehicle's logs (`VehicleTuning.lag_explains_logs`; `ClothoidConfig.feedforward_model`).
+
+The taps are identified at a small lateral acceleration (`tuning/schedule.py`: 0.1 g), where the vehicle is linear.
+In a tighter or faster corner a real vehicle takes more steering per unit of curvature (its understeer grows as the
+tyres and the trailer's load transfer leave their linear range; ISO 4138's steady-state circular test). The response's
+handling_gain holds that growth, identified from steady turns (`tuning/handling_fit.py`): the steady-state steering
+per curvature at lateral accelerations HANDLING_GRID_G, over the one at which the taps were identified. The
+feed-forward scales each steering tap's term by the gain at the lateral acceleration v^2 |kappa_p| / g the vehicle
+has where that tap reads the path (a static nonlinearity before the linear taps: a Hammerstein model). The measured
+taps are not scaled: in a steady turn yaw rate / speed is the path's curvature at any lateral acceleration.
 """
 
 from __future__ import annotations
@@ -16,10 +25,18 @@ from dataclasses import dataclass
 
 import numpy as np
 from numba import njit
+from scipy.constants import g as G_MPS2  # standard gravity, 9.80665 m/s^2
 
 from controllers.clothoid.speed_tables import bracket
 from workbench.base.errors import WorkbenchInputError, value_text
 from workbench.base.path_search import PATH_CURVATURE, PATH_SPEED, value_at
+
+#: g: the lateral accelerations (v^2 |kappa| / g) the handling gain is given at: uniform from zero, held beyond.
+HANDLING_GRID_G = (0.0, 0.05, 0.1, 0.15, 0.2, 0.25, 0.3, 0.35, 0.4)
+HANDLING_STEP_G = HANDLING_GRID_G[1]
+#: -: the range a handling gain may take (a vehicle whose steering per curvature changes more than twofold is not
+#: in a steady turn the feed-forward can model).
+HANDLING_GAIN_RANGE = (0.5, 2.0)
 
 
 @dataclass(frozen=True)
@@ -33,6 +50,7 @@ class PreviewResponse:
     tap_spacing_s: float  # s, in (0, 0.5]: the time between taps
     steering_taps: tuple[float, ...]  # 1/1: one per tap, finite
     measured_taps: tuple[float, ...]  # 1/1: one per tap, finite, summing to one within 1e-6
+    handling_gain: tuple[float, ...] = (1.0,) * len(HANDLING_GRID_G)  # -: one per HANDLING_GRID_G, in [0.5, 2]
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.first_tap_s) and -30.0 <= self.first_tap_s <= 0.0):
@@ -50,8 +68,16 @@ class PreviewResponse:
             raise WorkbenchInputError("steering_taps and measured_taps must be finite; got a NaN or infinite tap")
         if abs(sum(measured) - 1.0) > 1e-6:
             raise WorkbenchInputError(f"measured_taps must sum to one (rigid-body steady turn); got {sum(measured)!r}")
+        handling = tuple(float(v) for v in self.handling_gain)
+        low, high = HANDLING_GAIN_RANGE
+        if len(handling) != len(HANDLING_GRID_G) or not all(low <= v <= high for v in handling):  # False for NaN
+            raise WorkbenchInputError(
+                f"handling_gain must be {len(HANDLING_GRID_G)} gains (at {', '.join(f'{a:g}' for a in HANDLING_GRID_G)}"
+                f" g), each in [{low:g}, {high:g}]; got {list(handling)}"
+            )
         object.__setattr__(self, "steering_taps", steering)
         object.__setattr__(self, "measured_taps", measured)
+        object.__setattr__(self, "handling_gain", handling)
 
     def same_taps(self, other: PreviewResponse) -> bool:
         """Whether other's taps are at the same times (a table over speed needs one grid)."""
@@ -80,6 +106,7 @@ def preview_curvature(
     tap_spacing_s: float,
     speeds_kmh: np.ndarray,
     taps: np.ndarray,
+    handling: np.ndarray,
 ) -> float:  # pragma: no cover - compiled
     """sum_k h_k kappa_p(s_k) (1/m): the taps (n speeds, m taps; rows at speeds_kmh, interpolated linearly in speed
     and clamped beyond the ends, `speed_tables.bracket`) on the path's curvature where the vehicle is at each tap's
@@ -90,7 +117,11 @@ def preview_curvature(
     plan's shape, the speed's level now), so that a corner braked into or accelerated out of is read where the
     vehicle is at each tap's time, not at speed_mps x tau_k. Where the path carries no planned speed (NaN), or plans
     less than MIN_PLANNED_SPEED_MPS at s_m, the measured speed stands in for the plan, or the plan for the scaled
-    plan."""
+    plan.
+
+    handling (n speeds, len(HANDLING_GRID_G) gains, or no columns: none) scales each tap's term by the gain at the
+    lateral acceleration v_k^2 |kappa_p(s_k)| / g, v_k the march's speed at the tap (interpolated linearly on the
+    grid, held beyond its end; module docstring)."""
     shape = record[0]
     spacing, length, closed = shape.spacing, shape.length, shape.closed
     curvature, planned = table[PATH_CURVATURE], table[PATH_SPEED]
@@ -113,7 +144,12 @@ def preview_curvature(
                 k = k_a + direction * i
                 if 0 <= k < taps.shape[1]:
                     s = s_a + (s_b - s_a) * (i / MARCH_TAPS)
-                    total += _tap(taps, low, high, t, k) * value_at(curvature, s, spacing, length, closed)
+                    kappa = value_at(curvature, s, spacing, length, closed)
+                    term = _tap(taps, low, high, t, k) * kappa
+                    if handling.shape[1] > 0:
+                        v = v_a + (v_b - v_a) * (i / MARCH_TAPS)
+                        term *= _handling(handling, low, high, t, v * v * abs(kappa) / G_MPS2)
+                    total += term
             s_a, v_a, k_a = s_b, v_b, k_a + direction * MARCH_TAPS
     return total
 
@@ -132,3 +168,16 @@ def _speed_at(
 def _tap(taps: np.ndarray, low: int, high: int, t: float, k: int) -> float:  # pragma: no cover - compiled
     """Tap k interpolated between the rows low and high (weight t on high)."""
     return taps[low, k] + t * (taps[high, k] - taps[low, k])
+
+
+@njit(cache=True)
+def _handling(handling: np.ndarray, low: int, high: int, t: float, lat_accel_g: float) -> float:  # pragma: no cover
+    """The handling gain at lat_accel_g (g, >= 0), between the rows low and high (weight t on high): linear on the
+    uniform HANDLING_GRID_G, held beyond its last point."""
+    x = lat_accel_g / HANDLING_STEP_G
+    last = handling.shape[1] - 1
+    i = min(int(x), last - 1)
+    w = min(x - i, 1.0)
+    at_low = handling[low, i] + w * (handling[low, i + 1] - handling[low, i])
+    at_high = handling[high, i] + w * (handling[high, i + 1] - handling[high, i])
+    return at_low + t * (at_high - at_low)

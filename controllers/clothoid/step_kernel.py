@@ -42,7 +42,8 @@ from workbench.base.path_search import TRACK_OUT_SIZE, TRACK_PROGRESS, TRACK_S, 
 MODE_ADAPTIVE, MODE_FIXED, MODE_SPEED = 0, 1, 2
 KAPPA0_YAW_RATE, KAPPA0_COMMAND, KAPPA0_STEERING = 0, 1, 2
 #: How many columns of a row of the lag tables hold the lag (`vehicle_tuning.LAG_COLUMNS`: wn, zeta, delay, K); the
-#: preview response's taps follow them when the feed-forward uses them.
+#: preview response's taps (and, after the steering taps, the handling gain) follow them when the feed-forward uses
+#: them.
 LAG_COLUMNS = len(LAG_PARAMETERS)
 
 #: The step's parameters (`params`, one record, made by `parameters`): the vehicle's geometry (wheelbase m,
@@ -258,8 +259,9 @@ def clothoid_step(
     scores, results: the search's work arrays (`lookahead.py`); history: the delay predictor's commands sent
     (`delay_predictor.history_length` slots; any size without it). lags and measured_lags hold each speed's lag in
     their first LAG_COLUMNS columns and, when the feed-forward and the reference curvature come from the preview
-    responses (`preview_model.py`), its steering and its measured taps after them; with four columns they come from
-    the lags."""
+    responses (`preview_model.py`), its steering and its measured taps after them (lags may then end with the
+    handling gain, `VehicleTuning.preview_lag_tables`: its columns beyond measured_lags'); with four columns they
+    come from the lags."""
     m, p, st = measurement[0], params[0], state[0]
     t_s, x_m, y_m, vx_mps, vy_mps = m.t, m.x, m.y, m.vx, m.vy
     yaw_rad, yaw_rate_rad_s, steer_wheel_rad = m.yaw, m.yaw_rate, m.steer_wheel
@@ -376,7 +378,7 @@ def clothoid_step(
             if previewing:  # the measured curvature of a vehicle that drives the path, from its preview response
                 reference_kappa = preview_curvature(
                     path, record, s_ref, speed, 0.0, p.preview_first_tap, p.preview_spacing, lag_speeds,
-                    measured_lags[:, LAG_COLUMNS:],
+                    measured_lags[:, LAG_COLUMNS:], measured_lags[:, :0],
                 )  # fmt: skip
             else:
                 reference_kappa = reference_curvature(
@@ -395,9 +397,10 @@ def clothoid_step(
         if inverting:  # the lag inverted, added after the lead filter; the integrator holds the feedback alone
             kdot = clothoid_kdot - reference_kdot
             if previewing:  # the steering that drives the path, from the preview response, the known delay ahead
+                taps_end = measured_lags.shape[1]  # the steering taps, then the handling gain
                 feedforward_kappa = preview_curvature(
                     path, record, foot[0], speed, p.known_delay, p.preview_first_tap, p.preview_spacing, lag_speeds,
-                    lags[:, LAG_COLUMNS:],
+                    lags[:, LAG_COLUMNS:taps_end], lags[:, taps_end:],
                 )  # fmt: skip
             else:
                 omega_n, zeta, dead_time = math.nan, 1.0, 0.0

@@ -192,13 +192,22 @@ class VehicleTuning:
     @functools.cached_property
     def preview_lag_tables(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """`lag_tables` with each speed's preview taps after its lag's columns (the path lag's row the steering
-        taps, the measured lag's the measured taps), as the compiled step reads them when the feed-forward uses the
-        preview responses (`step_kernel.LAG_COLUMNS`); `lag_tables` itself without previews."""
+        taps then the handling gain, the measured lag's the measured taps), as the compiled step reads them when the
+        feed-forward uses the preview responses (`step_kernel.LAG_COLUMNS`); `lag_tables` itself without
+        previews."""
         speeds, lags, measured = self.lag_tables
         if not self.previews:
             return speeds, lags, measured
         _, _, steering, measured_taps = self.preview_tables
-        return speeds, np.hstack([lags, steering]), np.hstack([measured, measured_taps])
+        return speeds, np.hstack([lags, steering, self.handling_table]), np.hstack([measured, measured_taps])
+
+    @functools.cached_property
+    def handling_table(self) -> np.ndarray:
+        """The preview responses' handling gains (n speeds, len(HANDLING_GRID_G)), as
+        `preview_model.preview_curvature` reads them; (0, 0) without previews."""
+        if not self.previews:
+            return np.zeros((0, 0))
+        return np.array([r.handling_gain for _, r in self.previews], dtype=float)
 
     def recorded_floor_m(
         self, inputs: FloorInputs, lock_curvature_1pm: float, curvature_limit_1pm: float = math.inf

@@ -1,7 +1,8 @@
 """The preview responses along the path (`preview_model.py`): the response's checks, `preview_curvature` against
 the taps summed by hand on paths whose curvature is constant and linear in arc length (and, as a property, on any
-taps), interpolated in speed like the lags; the controller's choice of model (`ClothoidConfig.feedforward_model`)
-and the step's feed-forward and reference from the truck's own responses, with the loop and its floor unchanged."""
+taps), interpolated in speed like the lags, the handling gain against np.interp on arcs; the controller's choice of
+model (`ClothoidConfig.feedforward_model`) and the step's feed-forward (with and without the handling gain) and
+reference from the truck's own responses, with the loop and its floor unchanged."""
 
 from __future__ import annotations
 
@@ -11,10 +12,16 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from scipy.constants import g as G_MPS2
 
 from controllers.base import Measurement
 from controllers.clothoid import ClothoidConfig, ClothoidController
-from controllers.clothoid.preview_model import MARCH_TAPS, PreviewResponse, preview_curvature
+from controllers.clothoid.preview_model import (
+    HANDLING_GRID_G,
+    MARCH_TAPS,
+    PreviewResponse,
+    preview_curvature,
+)
 from tuning.own_tuning import tuning_for
 from workbench.base.clothoid_chain import ClothoidChain
 from workbench.base.errors import WorkbenchInputError
@@ -30,14 +37,21 @@ FIRST_S, TAP_S = -1.0, 0.05
 
 
 def _sum(
-    curvature: np.ndarray, s_m: float, speed_mps: float, taps: np.ndarray, speeds=(30.0,), shift_s=0.0, planned=None
+    curvature: np.ndarray,
+    s_m: float,
+    speed_mps: float,
+    taps: np.ndarray,
+    speeds=(30.0,),
+    shift_s=0.0,
+    planned=None,
+    handling=None,
 ) -> float:
     zeros = np.zeros_like(curvature)
     samples = (zeros, zeros, zeros, curvature, planned)
     compiled = CompiledPath.of(samples, SPACING_M, float(S_GRID[-1]), False, 0.0, 5.0)
     return preview_curvature(
         compiled.table, compiled.record, s_m, speed_mps, shift_s, FIRST_S, TAP_S, np.array(speeds, dtype=float),
-        np.atleast_2d(taps),
+        np.atleast_2d(taps), np.zeros((len(speeds), 0)) if handling is None else np.atleast_2d(handling),
     )  # fmt: skip
 
 
@@ -52,11 +66,44 @@ def test_a_response_is_checked() -> None:
         PreviewResponse(-1.0, 0.05, (math.nan,), (1.0,))
     with pytest.raises(WorkbenchInputError, match="sum to one"):
         PreviewResponse(-1.0, 0.05, (1.0, 0.0), (0.6, 0.6))
+    ones = (1.0,) * len(HANDLING_GRID_G)
+    assert PreviewResponse(-1.0, 0.05, (1.0,), (1.0,)).handling_gain == ones
+    for bad in ((1.0,) * 3, (*ones[:-1], 2.5), (*ones[:-1], 0.4), (*ones[:-1], math.nan)):
+        with pytest.raises(WorkbenchInputError, match=r"handling_gain must be 9 gains .* each in \[0.5, 2\]"):
+            PreviewResponse(-1.0, 0.05, (1.0,), (1.0,), bad)
 
 
 def test_on_an_arc_it_is_the_curvature_times_the_taps_sum() -> None:
     taps = np.linspace(-0.1, 0.3, 41)
     assert _sum(np.full(S_GRID.size, 0.02), 100.0, 8.0, taps) == pytest.approx(0.02 * taps.sum(), rel=1e-12)
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    taps=st.lists(st.floats(-2.0, 2.0), min_size=1, max_size=60),
+    gains=st.lists(st.floats(0.5, 2.0), min_size=len(HANDLING_GRID_G), max_size=len(HANDLING_GRID_G)),
+    kappa=st.floats(-0.2, 0.2),
+    speed=st.floats(1.0, 30.0),
+)
+def test_on_an_arc_the_handling_gain_scales_the_taps_at_its_lateral_acceleration(taps, gains, kappa, speed) -> None:
+    """On an arc at a held speed every tap reads v^2 |kappa| / g: the sum is kappa x sum(h) x the gain there,
+    np.interp on HANDLING_GRID_G (held beyond its end)."""
+    h = np.array(taps)
+    gain = np.interp(speed**2 * abs(kappa) / G_MPS2, HANDLING_GRID_G, gains)
+    got = _sum(np.full(S_GRID.size, kappa), 150.0, speed, h, handling=gains)
+    assert got == pytest.approx(kappa * h.sum() * gain, rel=1e-9, abs=1e-12)
+
+
+def test_the_handling_gain_is_interpolated_in_speed_like_the_taps() -> None:
+    """Two speeds, one tap of one, gains 1 and 1.2 at 0.2 g: halfway in speed, 1.1 (the arc at 0.2 g there)."""
+    speed = 30.0 / 3.6
+    kappa = 0.2 * G_MPS2 / speed**2
+    gains = np.ones((2, len(HANDLING_GRID_G)))
+    gains[1, HANDLING_GRID_G.index(0.2)] = 1.2
+    rows = np.ones((2, 1))
+    got = _sum(np.full(S_GRID.size, kappa), 100.0, speed, rows, (20.0, 40.0), handling=gains)
+    assert got == pytest.approx(kappa * 1.1, rel=1e-12)
+    assert _sum(np.full(S_GRID.size, kappa), 100.0, speed, rows, (20.0, 40.0)) == pytest.approx(kappa, rel=1e-12)
 
 
 @settings(max_examples=40, deadline=None)
@@ -157,9 +204,20 @@ def test_the_step_sends_the_trucks_preview_response_and_keeps_its_loop() -> None
     first, spacing, steering, _ = TRUCK_TUNING.preview_tables
     speeds = np.array(TRUCK_TUNING.lag_speeds_kmh)
     row = np.array([np.interp(speed * 3.6, speeds, steering[:, k]) for k in range(steering.shape[1])])
+    handling = TRUCK_TUNING.handling_table
+    gains = [np.interp(speed * 3.6, speeds, handling[:, k]) for k in range(handling.shape[1])]
     s_taps = float(path.s_m[i]) + speed * (first + spacing * np.arange(row.size) + known)
-    expected = float(row @ np.interp(s_taps, path.s_m, path.curvature_1pm))
+    kappa_taps = np.interp(s_taps, path.s_m, path.curvature_1pm)
+    gain_taps = np.interp(speed**2 * np.abs(kappa_taps) / G_MPS2, HANDLING_GRID_G, gains)
+    assert gain_taps.max() > 1.01  # the truck's identified gain matters on this path (kappa up to 0.06 1/m)
+    expected = float(row @ (kappa_taps * gain_taps))
     assert controller._state[0]["feedforward_kappa"] == pytest.approx(expected, rel=1e-3)
+    linear = ClothoidController(
+        TRUCK.geometry, ClothoidConfig(tuning=TRUCK_TUNING, known_delay_s=known, handling_gain=False), vehicle=TRUCK
+    )
+    linear.reset(path, 0.02)
+    linear.step(m, path)
+    assert linear._state[0]["feedforward_kappa"] == pytest.approx(float(row @ kappa_taps), rel=1e-3)
     lags = ClothoidController(
         TRUCK.geometry, ClothoidConfig(tuning=TRUCK_TUNING, known_delay_s=known, feedforward_model="lag")
     )
