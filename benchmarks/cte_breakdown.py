@@ -22,6 +22,8 @@ Switches (each against `nominal`, the shipped defaults on the preset vehicle):
   - lag_model, preview_model: the feed-forward and the reference curvature from the lags of Eq. 5
     (`feedforward_model='lag'`) or from the preview responses identified from the same logs ('preview'); by default
     ('auto') the truck uses the preview responses and the car the lags, so on each one of the two is nominal;
+  - handling_off: the preview responses' steering taps without their handling gain (`handling_gain=false`: linear
+    at any lateral acceleration, as identified at 0.1 g; no change where the lags are used);
   - nmpc_identified_lag: the clothoid controller as by default against the NMPC predicting with the identified lag
     of Eq. 5 the clothoid controller is designed on (its `kinematic-lag` model, the lag at 30 km/h) instead of the
     vehicle's single-track equivalent: how much of the gap is the model each is given, not the control law.
@@ -92,7 +94,7 @@ SPEED_KMH = 30.0
 PLANT_SWITCHES = ("no_actuator_lag", "stiff_tyres", "constant_speed", "ideal_plant")
 CONTROLLER_SWITCHES = (
     "floor_lowered", "floor_off", "feedforward_off", "feedforward_rate", "reference_lead", "lag_model",
-    "preview_model",
+    "preview_model", "handling_off",
 )  # fmt: skip
 #: The feed-forward's curvature-rate window (m) in its rate form (the feedforward_rate switch).
 RATE_FEEDFORWARD_WINDOW_M = 6.0
@@ -139,6 +141,8 @@ def clothoid_config_for(switch: str, config):
         return dataclasses.replace(config, feedforward_inversion=False, feedforward_window_m=RATE_FEEDFORWARD_WINDOW_M)
     if switch == "reference_lead":
         return dataclasses.replace(config, lag_model_reference=False)
+    if switch == "handling_off":
+        return dataclasses.replace(config, handling_gain=False)
     if switch in ("lag_model", "preview_model"):
         return dataclasses.replace(config, feedforward_model=switch.removesuffix("_model"))
     return config
@@ -201,8 +205,8 @@ def model_errors(trace: dict, path, tuning, geometry, window_m: float) -> dict[s
     for j, i in enumerate(moving):
         if steering_taps.shape[0] > 0:
             args = (compiled.table, compiled.record, s[i], speed[i], 0.0, first, spacing, speeds)
-            preview_reference[j] = preview_curvature(*args, measured_taps)
-            preview_feedforward[j] = preview_curvature(*args, steering_taps)
+            preview_reference[j] = preview_curvature(*args, measured_taps, measured_taps[:, :0])
+            preview_feedforward[j] = preview_curvature(*args, steering_taps, tuning.handling_table)
         reference[j] = reference_curvature(
             compiled.table, compiled.record, s[i], speed[i], lags, measured_lags, speeds, window_m, rows
         )

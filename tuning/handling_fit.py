@@ -99,7 +99,8 @@ def steady_turn(log: VehicleLog, geometry: VehicleGeometry | SteeringGeometry) -
             f"{log.name}: a steady turn is read over the last {STEADY_WINDOW_S:g} s; the log lasts {log.duration_s:g} s"
         )
     window = log.t_s >= log.t_s[-1] - STEADY_WINDOW_S
-    turn = yaw_rate_curvature(log)[window]
+    turn = yaw_rate_curvature(log)[window]  # refuses a log without yaw rate
+    yaw_rate = np.asarray(log.yaw_rate_rad_s)[window]
     steering = kinematic_curvature(log.steer_wheel_rad[window], geometry)
     mean = float(np.mean(turn))
     if not (np.all(np.isfinite(turn)) and abs(mean) > 0.0):
@@ -107,7 +108,7 @@ def steady_turn(log: VehicleLog, geometry: VehicleGeometry | SteeringGeometry) -
     if np.ptp(turn) > STEADY_TOLERANCE * abs(mean) or np.ptp(steering) > 1e-9 * max(abs(float(steering[0])), 1.0):
         return None
     ratio = float(np.mean(steering)) / mean
-    lat_accel_g = float(np.mean(log.speed_mps[window] * log.yaw_rate_rad_s[window])) / G_MPS2
+    lat_accel_g = float(np.mean(log.speed_mps[window] * yaw_rate)) / G_MPS2
     if not (ratio > 0.0 and math.isfinite(ratio)):
         return None
     return SteadyTurn(abs(lat_accel_g), ratio)
