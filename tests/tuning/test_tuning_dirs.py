@@ -11,6 +11,7 @@ import math
 import shutil
 from pathlib import Path
 
+import numpy as np
 import pytest
 from quick_tuning import QUICK
 
@@ -299,6 +300,25 @@ def test_a_lead_file_with_preview_responses_at_some_speeds_only_is_refused(tmp_p
             del row[key]
     _write_lead(directory, doc)
     assert read_vehicle_tuning(directory).previews == ()  # files made before they were recorded
+
+
+def test_the_handling_gain_is_read_checked_and_optional(tmp_path: Path) -> None:
+    """The shipped truck's handling gain is its rows' `preview_handling_gain`; a gain out of range is refused naming
+    the row; a file without it (made before it was identified) reads as gains of one."""
+    directory = _copy_shipped("tractor-semitrailer", tmp_path / "handling")
+    doc = json.loads((directory / LEAD_FILE).read_text())
+    rows = doc["design"]["per_speed"]
+    tuning = read_vehicle_tuning(directory)
+    assert tuning.handling_table.tolist() == [row["preview_handling_gain"] for row in rows]
+    assert tuning.handling_table[2, -1] > 1.02  # 30 km/h: the loaded truck understeers more at 0.4 g
+    rows[3]["preview_handling_gain"] = [1.0] * 8 + [3.0]
+    _write_lead(directory, doc)
+    with pytest.raises(WorkbenchInputError, match=r"per_speed\[3\] \(preview responses\): handling_gain must be 9"):
+        read_vehicle_tuning(directory)
+    for row in rows:
+        del row["preview_handling_gain"]
+    _write_lead(directory, doc)
+    assert np.all(read_vehicle_tuning(directory).handling_table == 1.0)
 
 
 def _longer_car(tmp_path: Path) -> Path:
