@@ -273,6 +273,13 @@ def _parser(command: str | None = None) -> argparse.ArgumentParser:
             help=f"how far after the present they reach (default {PreviewFitOptions.future_s:g} s; the lag's preview)",
         )
         sched.add_argument(
+            "--preview-lat-accel-g",
+            type=float,
+            default=PreviewFitOptions.lat_accel_g,
+            help="the kinematic lateral acceleration of the maneuvers the preview responses are fitted to (default "
+            f"{PreviewFitOptions.lat_accel_g:g} g: the feed-forward's operating range; the lags stay at --lat-accel-g)",
+        )
+        sched.add_argument(
             "--drop-refused",
             action="store_true",
             help="leave out a speed whose lag fit or lead design is refused (saying why, on stderr and in the file's "
@@ -564,7 +571,10 @@ def _schedule(args: argparse.Namespace) -> int:
         )
     require_in_range("--preview-past-s", args.preview_past_s, *PAST_RANGE_S, "s")
     require_in_range("--preview-future-s", args.preview_future_s, *FUTURE_RANGE_S, "s")
-    preview = PreviewFitOptions(past_s=args.preview_past_s, future_s=args.preview_future_s)
+    require_in_range("--preview-lat-accel-g", args.preview_lat_accel_g, 0.001, 1.0, "g")
+    preview = PreviewFitOptions(
+        past_s=args.preview_past_s, future_s=args.preview_future_s, lat_accel_g=args.preview_lat_accel_g
+    )
     with _progress_bar(len(speeds), "speed", "tuning schedule") as bar:
         bar.set_postfix_str(f"{speeds[0]:g} km/h")
 

@@ -100,6 +100,7 @@ class VehicleTuningOptions:
     prediction_time_s: float = DEFAULT_PREDICTION_TIME_S
     preview_past_s: float = PREVIEW_DEFAULTS.past_s
     preview_future_s: float = PREVIEW_DEFAULTS.future_s
+    preview_lat_accel_g: float = PREVIEW_DEFAULTS.lat_accel_g
 
     def to_dict(self) -> dict[str, Any]:
         out = asdict(self)
@@ -127,7 +128,9 @@ class PresetTuningOptions:
     controller_rate_hz, prediction_time_s: the clothoid controller's rate and pose prediction the margins design
     analyses (`--controller-rate-hz`, `--prediction-time-s`; its defaults, 50 Hz and 0.2 s); preview_past_s,
     preview_future_s: how far before and after the present the preview responses reach (`--preview-past-s`,
-    `--preview-future-s`, `tuning/preview_fit.py`; 8 s holds the truck's trailer settling, 2 s its lag's preview).
+    `--preview-future-s`, `tuning/preview_fit.py`; 8 s holds the truck's trailer settling, 2 s its lag's preview);
+    preview_lat_accel_g: the kinematic lateral acceleration of their maneuvers (`--preview-lat-accel-g`, 0.2 g: the
+    feed-forward's operating range, `PreviewFitOptions.lat_accel_g`).
     """
 
     schedule_speeds_kmh: tuple[float, ...]
@@ -143,6 +146,7 @@ class PresetTuningOptions:
     prediction_time_s: float = DEFAULT_PREDICTION_TIME_S
     preview_past_s: float = PREVIEW_DEFAULTS.past_s
     preview_future_s: float = PREVIEW_DEFAULTS.future_s
+    preview_lat_accel_g: float = PREVIEW_DEFAULTS.lat_accel_g
 
     def __post_init__(self) -> None:
         for name in ("schedule_speeds_kmh", "limits_speeds_kmh"):
@@ -161,6 +165,7 @@ class PresetTuningOptions:
         require_in_range("prediction_time_s", self.prediction_time_s, 0.0, 2.0, "s")
         require_in_range("preview_past_s", self.preview_past_s, *PAST_RANGE_S, "s")
         require_in_range("preview_future_s", self.preview_future_s, *FUTURE_RANGE_S, "s")
+        require_in_range("preview_lat_accel_g", self.preview_lat_accel_g, 0.001, 1.0, "g")
 
     def for_model(self, model_type: str) -> VehicleTuningOptions:
         override = next((o for o in self.speed_overrides if o.model == model_type), None)
@@ -178,6 +183,7 @@ class PresetTuningOptions:
             prediction_time_s=float(self.prediction_time_s),
             preview_past_s=float(self.preview_past_s),
             preview_future_s=float(self.preview_future_s),
+            preview_lat_accel_g=float(self.preview_lat_accel_g),
         )
 
 
@@ -196,6 +202,7 @@ PRESET_TUNING_OPTIONS = PresetTuningOptions(
     prediction_time_s=0.2,
     preview_past_s=8.0,
     preview_future_s=2.0,
+    preview_lat_accel_g=0.2,
 )
 
 
@@ -243,6 +250,7 @@ def tuning_commands(
         schedule += ["--prediction-time-s", _number(options.prediction_time_s)]
     schedule += ["--preview-past-s", _number(options.preview_past_s)]
     schedule += ["--preview-future-s", _number(options.preview_future_s)]
+    schedule += ["--preview-lat-accel-g", _number(options.preview_lat_accel_g)]
     schedule += ["--drop-refused", "--out", LEAD_FILE]
     if has_roll_model(vehicle):
         limits = ["tuning", "rollover-limits", *vehicle_args, "--speeds", _speeds(options.limits_speeds_kmh)]
@@ -331,7 +339,11 @@ def write_tuning_files(
         design=resolved.design,
         controller_rate_hz=resolved.controller_rate_hz,
         prediction_time_s=resolved.prediction_time_s,
-        preview_options=PreviewFitOptions(past_s=resolved.preview_past_s, future_s=resolved.preview_future_s),
+        preview_options=PreviewFitOptions(
+            past_s=resolved.preview_past_s,
+            future_s=resolved.preview_future_s,
+            lat_accel_g=resolved.preview_lat_accel_g,
+        ),
     )
     result.write(directory / LEAD_FILE)
     middle = time.perf_counter()

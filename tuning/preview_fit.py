@@ -55,6 +55,10 @@ class PreviewFitOptions:
     ridge: float = 1e-3  # the regularisation's weight relative to the regressors' mean energy (-), in [0, 1e3]
     smoothness: float = 10.0  # the second difference's weight in the regularisation (-), in [0, 1e6]
     smooth_s: float = 0.3  # the Savitzky-Golay window of the path's derivatives (s), in [0, 10] (`path_curvature`)
+    lat_accel_g: float = 0.2  # the kinematic lateral acceleration (g), in [0.001, 1], of the logs tuning.schedule
+    # makes for them (fit_preview fits the logs it is given): the middle of the range the feed-forward serves
+    # (corners planned up to 0.3 g, the handling gain's grid to 0.4 g), so that the taps' dynamics, not only their
+    # gain, are the tyres' in the corners; the lags of Eq. 5, a linearisation for the loop, stay at the schedule's 0.1 g
 
     def __post_init__(self) -> None:
         require_in_range("tap_spacing_s", self.tap_spacing_s, 0.005, 0.5, "s")
@@ -63,6 +67,7 @@ class PreviewFitOptions:
         require_in_range("ridge", self.ridge, 0.0, 1e3)
         require_in_range("smoothness", self.smoothness, 0.0, 1e6)
         require_in_range("smooth_s", self.smooth_s, 0.0, 10.0, "s")
+        require_in_range("lat_accel_g", self.lat_accel_g, 0.001, 1.0, "g")
 
     @property
     def tap_range(self) -> tuple[int, int]:

@@ -544,8 +544,10 @@ def identify_schedule(
     margins_arc_curvature_1pm; bounded by max_lead_gain). A speed whose fit or design is refused makes the whole
     schedule refused, naming the speed; with drop_refused=True it is left out and recorded in `dropped` instead
     (refused only when no speed is left). progress, if given, is called with one line per speed. The preview
-    responses (`tuning.preview_fit`) are fitted to the same logs at each speed, their handling gain
-    (`tuning.handling_fit`) to steady turns at the same speed (`handling_logs`).
+    responses (`tuning.preview_fit`) are fitted to the same maneuvers at each speed, at preview_options.lat_accel_g
+    (0.2 g by default: the feed-forward's operating range, where the lags are a linearisation at lat_accel_g), their
+    handling gain (`tuning.handling_fit`, one at that lateral acceleration) to steady turns at the same speed
+    (`handling_logs`).
 
     Parameters
     ----------
@@ -608,6 +610,7 @@ def identify_schedule(
     require_in_range("lat_accel_g", lat_accel_g, *LAT_ACCEL_RANGE_G, "g")  # before any speed is identified
     check_design_bounds(max_lead_gain, max_cascade_peak_db)
     options = fit_options or LagFitOptions()
+    preview_options = preview_options or PreviewFitOptions()
     measured_options = dataclasses.replace(options, curvature_from="yaw-rate")
     settings = LoopSettings(sample_time_s=1.0 / controller_rate_hz, prediction_time_s=prediction_time_s)
     entries, dropped = [], []
@@ -620,8 +623,11 @@ def identify_schedule(
                 measured = fit_lag(logs, vehicle.geometry, measured_options)
             except WorkbenchInputError as exc:
                 raise WorkbenchInputError(f"the measured (yaw-rate) lag: {exc}") from None
-            preview = fit_preview(logs, vehicle.geometry, preview_options)
-            handling = fit_handling(handling_logs(vehicle, speed), vehicle.geometry, lat_accel_g)
+            preview_logs = logs
+            if preview_options.lat_accel_g != lat_accel_g:  # the feed-forward's model, at its operating amplitude
+                preview_logs = identification_logs(vehicle, speed, preview_options.lat_accel_g)
+            preview = fit_preview(preview_logs, vehicle.geometry, preview_options)
+            handling = fit_handling(handling_logs(vehicle, speed), vehicle.geometry, preview_options.lat_accel_g)
             preview = dataclasses.replace(
                 preview, response=dataclasses.replace(preview.response, handling_gain=handling.gain)
             )
@@ -671,7 +677,7 @@ def identify_schedule(
         design,
         float(controller_rate_hz),
         float(prediction_time_s),
-        preview_options or PreviewFitOptions(),
+        preview_options,
     )
 
 

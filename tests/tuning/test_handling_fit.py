@@ -16,6 +16,7 @@ from tuning.handling_fit import STEADY_TOLERANCE, STEADY_WINDOW_S, fit_handling,
 from tuning.lag_fit import SteeringGeometry
 from tuning.log_file import VehicleLog
 from tuning.own_tuning import tuning_for
+from tuning.preview_fit import PreviewFitOptions
 from tuning.schedule import handling_logs
 from workbench.base.errors import WorkbenchInputError
 from workbench.vehicles import make_vehicle
@@ -77,18 +78,21 @@ def test_a_gain_out_of_range_and_a_bad_reference_are_refused() -> None:
 
 
 def test_the_trucks_steady_turns_agree_with_its_preview_taps_and_grow_with_lateral_acceleration() -> None:
-    """At 30 km/h, the steady turn at the identification's 0.1 g takes the steering per curvature the preview taps
-    sum to (fitted to other maneuvers: dlc, step-series, chirp), within 1 %; understeer grows with lateral
-    acceleration (the gain rises monotonically to a few percent at 0.35 g) and the shipped tuning holds this gain."""
+    """At 30 km/h, the steady turn at the preview taps' identification amplitude (0.2 g) takes the steering per
+    curvature the taps sum to (fitted to other maneuvers: dlc, step-series, chirp), within 1 %; understeer grows
+    with lateral acceleration (the gain rises monotonically, to a few percent at 0.35 g) and the shipped tuning holds
+    this gain."""
     truck = make_vehicle("tractor-semitrailer")
-    fit = fit_handling(handling_logs(truck, 30.0), truck.geometry, 0.1)
+    amplitude = PreviewFitOptions().lat_accel_g
+    fit = fit_handling(handling_logs(truck, 30.0), truck.geometry, amplitude)
     tuning = tuning_for(truck)
     speeds = tuning.lag_speeds_kmh
     _, _, steering, _ = tuning.preview_tables
     taps_sum = float(steering[speeds.index(30.0)].sum())
-    near = min(fit.turns, key=lambda t: abs(t.lat_accel_g - 0.1))
+    near = min(fit.turns, key=lambda t: abs(t.lat_accel_g - amplitude))
     assert near.steering_ratio == pytest.approx(taps_sum, rel=0.01)
     assert len(fit.turns) >= 6
     assert np.all(np.diff(fit.gain) >= -1e-12)
     assert 1.01 < fit.gain[HANDLING_GRID_G.index(0.35)] < 1.2
+    assert fit.gain[HANDLING_GRID_G.index(0.05)] < 1.0
     assert tuning.handling_table[speeds.index(30.0)] == pytest.approx(fit.gain, rel=1e-6)

@@ -72,6 +72,7 @@ def test_it_predicts_a_maneuver_it_was_not_fitted_on() -> None:
         ({"past_s": float("nan")}, "past_s"),
         ({"future_s": -1.0}, "future_s"),
         ({"ridge": 1e4}, "ridge"),
+        ({"lat_accel_g": 0.0}, "lat_accel_g"),
     ],
 )
 def test_options_out_of_range_are_refused(options: dict[str, float], match: str) -> None:

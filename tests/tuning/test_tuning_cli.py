@@ -133,10 +133,12 @@ def test_schedule_designs_for_the_margins_from_both_lags(tmp_path: Path, capsys)
     a 0.05 s first-order actuator, the same lag to both curvatures; floors 3 m with the lead, 5.5 m without.)"""
     out = tmp_path / "lead.json"
     argv = ["schedule", "--vehicle", "kinematic-bicycle", "--speeds", "40", "--delay", "--design", "margins"]
-    argv += ["--controller-rate-hz", "50", "--prediction-time-s", "0.2", "--preview-past-s", "3", "--out", str(out)]
+    argv += ["--controller-rate-hz", "50", "--prediction-time-s", "0.2", "--preview-past-s", "3"]
+    argv += ["--preview-lat-accel-g", "0.15", "--out", str(out)]
     assert main(argv) == 0
     design = json.loads(out.read_text())["design"]
     assert design["preview_fit"]["past_s"] == 3.0 and design["preview_fit"]["future_s"] == 2.0
+    assert design["preview_fit"]["lat_accel_g"] == 0.15 and design["lat_accel_g"] == 0.1  # the lags' stays
     assert design["method"] == "margins" and design["fit_delay"] is True
     assert (design["controller_rate_hz"], design["prediction_time_s"]) == (50.0, 0.2)
     (row,) = design["per_speed"]
@@ -152,6 +154,8 @@ def test_schedule_designs_for_the_margins_from_both_lags(tmp_path: Path, capsys)
     assert info.value.code == 2
     assert main([*argv[:-2], "--preview-past-s", "31", "--out", str(out), "--overwrite"]) == 2
     assert "--preview-past-s must be a finite number in [0, 30] s; got 31" in capsys.readouterr().err
+    assert main([*argv[:-2], "--preview-lat-accel-g", "nan", "--out", str(out), "--overwrite"]) == 2
+    assert "--preview-lat-accel-g must be a finite number in [0.001, 1] g; got nan" in capsys.readouterr().err
 
 
 # --- bad input ------------------------------------------------------------------------------------------------

@@ -405,6 +405,8 @@ def test_options_are_validated() -> None:
         dataclasses.replace(PRESET_TUNING_OPTIONS, preview_past_s=40.0)
     with pytest.raises(WorkbenchInputError, match="preview_future_s must be a finite number in"):
         dataclasses.replace(PRESET_TUNING_OPTIONS, preview_future_s=math.nan)
+    with pytest.raises(WorkbenchInputError, match="preview_lat_accel_g must be a finite number in"):
+        dataclasses.replace(PRESET_TUNING_OPTIONS, preview_lat_accel_g=0.0)
 
 
 def test_the_preset_options_are_the_margins_design_with_a_delay() -> None:

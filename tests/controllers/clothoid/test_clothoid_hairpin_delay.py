@@ -211,16 +211,16 @@ def test_the_loaded_truck_keeps_to_a_hairpin_with_the_automotive_delay(compensat
     planned (5.75 m/s at the apex, the profile's 0.3 g), no limit cycle; at the apex the lookahead is within 1 m of
     the floor (0.43 m compensated by the model, 0.28 m on the arc). Compensated by the lags' model
     (`delay_predictor.py`) the floor is 6.5 m at 20 km/h (the delay-free loop's 5.5 m, raised for +-50 ms of the
-    delay), and max |CTE| <= 0.15 m (issue 18's goal; measured 0.108 m). On the arc of kappa(0) the delay stays in the
-    loop, the floor is 10.5 m and max |CTE| <= 0.43 m (measured 0.390 m; 0.47 m before the floor took the lookahead
+    delay), and max |CTE| <= 0.15 m (issue 18's goal; measured 0.105 m). On the arc of kappa(0) the delay stays in the
+    loop, the floor is 10.5 m and max |CTE| <= 0.43 m (measured 0.381 m; 0.47 m before the floor took the lookahead
     down at once: the sideslip relaxing at the apex, a heading step of ~0.03 rad, leaves about 0.02 m per metre of
-    lookahead). The truck's feed-forward and reference come from its preview responses (`feedforward_model` auto):
-    identified at a held speed, they hold this braking-and-accelerating 0.3 g corner less well than its lags do
-    (with `feedforward_model = "lag"`: 0.087 m and 0.215 m), though their taps are read where the planned speed takes
-    the vehicle (at the speed now: 0.117 m and 0.318 m). Their handling gain (the steering per curvature growing
-    with lateral acceleration in steady turns, 1.02-1.03 here) asks more steering at the apex, which the truck, turning
-    tighter at a held steering while it brakes, does not need: 0.108 m and 0.390 m with it, 0.111 m and 0.291 m
-    without (`handling_gain = false`); with the delay left in the loop (the arc) the feedback corrects it late."""
+    lookahead). The truck's feed-forward and reference come from its preview responses (`feedforward_model` auto),
+    their taps read where the planned speed takes the vehicle: identified at a held speed, they hold this
+    braking-and-accelerating 0.3 g corner less well than its lags do (with `feedforward_model = "lag"`: 0.087 m and
+    0.215 m). Their handling gain (the steering per curvature growing with lateral acceleration in steady turns)
+    asks more steering at the apex, which the truck, turning tighter at a held steering while it brakes, does not
+    need (without it, `handling_gain = false`: 0.107 m and 0.354 m); with the delay left in the loop (the arc) the
+    feedback corrects it late."""
     config = ClothoidConfig(known_delay_s=0.11, delay_compensation=compensation)
     controller = tuned_controller("clothoid", TRUCK, config)
     sim = SimulationConfig(conditions=load_conditions("automotive"))
