@@ -23,7 +23,7 @@ Switches (each against `nominal`, the shipped defaults on the preset vehicle):
     (`feedforward_model='lag'`) or from the preview responses identified from the same logs ('preview'); by default
     ('auto') the truck uses the preview responses and the car the lags, so on each one of the two is nominal;
   - handling_off: the preview responses' steering taps without their handling gain (`handling_gain=false`: linear
-    at any lateral acceleration, as identified at 0.1 g; no change where the lags are used);
+    at any lateral acceleration, as identified at 0.2 g; no change where the lags are used);
   - nmpc_identified_lag: the clothoid controller as by default against the NMPC predicting with the identified lag
     of Eq. 5 the clothoid controller is designed on (its `kinematic-lag` model, the lag at 30 km/h) instead of the
     vehicle's single-track equivalent: how much of the gap is the model each is given, not the control law.

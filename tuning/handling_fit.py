@@ -1,8 +1,8 @@
 """Identification of the vehicle's handling gain (`PreviewResponse.handling_gain`) from steady turns: how the
 steering a steady turn takes per unit of its curvature grows with lateral acceleration.
 
-Why. The preview responses (`tuning/preview_fit.py`) are fitted to logs at a small lateral acceleration (0.1 g,
-`tuning/schedule.py`), where the vehicle is linear. In tighter or faster corners a real vehicle's understeer grows:
+Why. The preview responses (`tuning/preview_fit.py`) are fitted to logs at one lateral acceleration (0.2 g,
+`PreviewFitOptions.lat_accel_g`). In tighter or faster corners a real vehicle's understeer grows:
 its tyres leave their linear range and the load moves across the axles (for the loaded tractor-semitrailer, its
 trailer's too), so it takes more steering per unit of curvature than the taps say, and the feed-forward falls short
 by that much in exactly the corners that matter.

@@ -405,17 +405,10 @@ def identification_logs(
     require_in_range("speed_kmh", speed_kmh, *SPEED_RANGE_KMH, "km/h")
     require_in_range("lat_accel_g", lat_accel_g, *LAT_ACCEL_RANGE_G, "g")
     amplitude = steer_amplitude_deg(vehicle, speed_kmh, lat_accel_g)
-    max_rate = IDENTIFICATION_RATE_FRACTION * math.degrees(vehicle.geometry.max_steer_wheel_rate_rad_s)
-    logs = []
-    for kind in maneuvers:
-        frame = generate_open_loop_log(
-            vehicle,
-            Maneuver(kind, amplitude_deg=amplitude, duration_s=duration_s, max_rate_deg_s=max_rate),
-            speed_kmh,
-            sample_rate_hz=sample_rate_hz,
-        )
-        logs.append(VehicleLog.from_frame(frame, name=f"{kind} at {speed_kmh:g} km/h"))
-    return logs
+    return [
+        _open_loop_log(vehicle, kind, amplitude, speed_kmh, duration_s, sample_rate_hz, f"{kind} at {speed_kmh:g} km/h")
+        for kind in maneuvers
+    ]
 
 
 def handling_logs(
@@ -448,18 +441,31 @@ def handling_logs(
     """
     require_in_range("speed_kmh", speed_kmh, *SPEED_RANGE_KMH, "km/h")
     v = speed_kmh / 3.6
-    max_rate = IDENTIFICATION_RATE_FRACTION * math.degrees(vehicle.geometry.max_steer_wheel_rate_rad_s)
     logs = []
     for rung in HANDLING_LADDER_G:
         if rung * G_MPS2 / (v * v) >= lock_curvature_1pm(vehicle):
             break
-        step = Maneuver(
-            "step", amplitude_deg=steer_amplitude_deg(vehicle, speed_kmh, rung), duration_s=duration_s,
-            max_rate_deg_s=max_rate,
-        )  # fmt: skip
-        frame = generate_open_loop_log(vehicle, step, speed_kmh, sample_rate_hz=sample_rate_hz)
-        logs.append(VehicleLog.from_frame(frame, name=f"step to {rung:g} g at {speed_kmh:g} km/h"))
+        amplitude = steer_amplitude_deg(vehicle, speed_kmh, rung)
+        name = f"step to {rung:g} g at {speed_kmh:g} km/h"
+        logs.append(_open_loop_log(vehicle, "step", amplitude, speed_kmh, duration_s, sample_rate_hz, name))
     return logs
+
+
+def _open_loop_log(
+    vehicle: VehicleModel,
+    kind: str,
+    amplitude_deg: float,
+    speed_kmh: float,
+    duration_s: float,
+    sample_rate_hz: float,
+    name: str,
+) -> VehicleLog:
+    """One open-loop log of the maneuver `kind` at amplitude_deg (steering wheel), its rate at most
+    IDENTIFICATION_RATE_FRACTION of the vehicle's steering-wheel rate limit."""
+    max_rate = IDENTIFICATION_RATE_FRACTION * math.degrees(vehicle.geometry.max_steer_wheel_rate_rad_s)
+    maneuver = Maneuver(kind, amplitude_deg=amplitude_deg, duration_s=duration_s, max_rate_deg_s=max_rate)
+    frame = generate_open_loop_log(vehicle, maneuver, speed_kmh, sample_rate_hz=sample_rate_hz)
+    return VehicleLog.from_frame(frame, name=name)
 
 
 def steer_amplitude_deg(vehicle: VehicleModel, speed_kmh: float, lat_accel_g: float) -> float:

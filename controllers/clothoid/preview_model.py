@@ -8,7 +8,7 @@ pose's curvature (`path_feedforward.py`). Both depend on the path alone, so the 
 Eq. 3 and the lags (`loop_analysis.py`) whichever model they use. The controller uses them when the lag of Eq. 5
 does not explain the vehicle's logs (`VehicleTuning.lag_explains_logs`; `ClothoidConfig.feedforward_model`).
 
-The taps are identified at a small lateral acceleration (`tuning/schedule.py`: 0.1 g), where the vehicle is linear.
+The taps are identified at one lateral acceleration (`tuning/schedule.py`: 0.2 g, `PreviewFitOptions.lat_accel_g`).
 In a tighter or faster corner a real vehicle takes more steering per unit of curvature (its understeer grows as the
 tyres and the trailer's load transfer leave their linear range; ISO 4138's steady-state circular test). The response's
 handling_gain holds that growth, identified from steady turns (`tuning/handling_fit.py`): the steady-state steering
