@@ -263,6 +263,13 @@ class ClothoidConfig:
         "loop analysis has it",
         Number(0.0, 1.0, "s", note="0: none"),
     )
+    yaw_rate_age_s: float = option(
+        0.0,
+        "how much older the measured yaw rate is than the measured pose (the yaw rate's latency less the pose's): "
+        "with delay_compensation 'model', kappa(0) is predicted over it as well as over known_delay_s "
+        "(`delay_predictor.predicted_start`)",
+        Number(-1.0, 1.0, "s", note="0: as old as the pose; negative: fresher"),
+    )
     delay_compensation: str = option(
         "model",
         'how the pose is predicted over known_delay_s: "model" (the identified lags driven by the commands already '
@@ -366,8 +373,9 @@ class ClothoidConfig:
 
     @property
     def predicts_with_model(self) -> bool:
-        """Whether the pose is predicted over a known delay with the identified lags (`delay_predictor.py`)."""
-        return requirements.predicts_with_model(self.delay_compensation, self.known_delay_s)
+        """Whether the pose and kappa(0) are predicted over a known delay and the yaw rate's age with the identified
+        lags (`delay_predictor.py`)."""
+        return requirements.predicts_with_model(self.delay_compensation, self.known_delay_s, self.yaw_rate_age_s)
 
     def __post_init__(self) -> None:
         # Every field on its own first (its rule, `config_checks.check_options`), then what relates them.
@@ -375,7 +383,8 @@ class ClothoidConfig:
         if self.predicts_with_model and self.initial_curvature != "yaw-rate":
             raise WorkbenchInputError(
                 f"delay_compensation 'model' predicts the measured kappa(0), initial_curvature 'yaw-rate'; got "
-                f"initial_curvature {self.initial_curvature!r} with known_delay_s = {value_text(self.known_delay_s)}: "
+                f"initial_curvature {self.initial_curvature!r} with known_delay_s = {value_text(self.known_delay_s)} s, "
+                f"yaw_rate_age_s = {value_text(self.yaw_rate_age_s)} s: "
                 "set delay_compensation = 'arc' (the pose predicted on kappa(0)) or initial_curvature = 'yaw-rate'"
             )
         if self.max_lookahead_m < self.min_lookahead_m:
@@ -445,22 +454,24 @@ class ClothoidController(Controller[ClothoidConfig]):
     def informed_config(cls, config: ClothoidConfig, delays: KnownDelays) -> ClothoidConfig:
         """`config` with known_delay_s = the loop's dead time, the pose latency plus the actuation dead time
         (`KnownDelays.loop_delay_s`), which the pose prediction and the lookahead floor's loop analysis then
-        have; every other option as it is.
+        have, and yaw_rate_age_s = the yaw rate's latency less the pose's, over which kappa(0) is predicted too;
+        every other option as it is.
 
         Parameters
         ----------
         config : ClothoidConfig
             The controller's options.
         delays : KnownDelays
-            The conditions' nominal delays; the yaw rate's own latency and the pose noise are not used (the pose
-            prediction starts from the pose; the lead filter and the lookahead floor are the noise's answer).
+            The conditions' nominal delays; the pose noise is not used (the lead filter and the lookahead floor are
+            the noise's answer).
 
         Returns
         -------
         ClothoidConfig
             The informed options (refused, naming the option, when the delay is beyond known_delay_s's range or
             the config's delay compensation cannot take it)."""
-        return replace(config, known_delay_s=delays.loop_delay_s)
+        age = delays.yaw_rate_latency_s - delays.pose_latency_s
+        return replace(config, known_delay_s=delays.loop_delay_s, yaw_rate_age_s=age)
 
     def __init__(
         self, geometry: VehicleGeometry, config: ClothoidConfig | None = None, vehicle: VehicleModel | None = None
@@ -517,7 +528,7 @@ class ClothoidController(Controller[ClothoidConfig]):
         self._params["dt"] = self._dt
         self._diag = self._declare_diagnostics(DIAGNOSTIC_KEYS)
         if self.config.predicts_with_model:
-            longest = self.config.known_delay_s + float(
+            longest = self.config.known_delay_s + max(self.config.yaw_rate_age_s, 0.0) + float(
                 max(self._lags[:, 2].max(), self._measured_lags[:, 2].max(initial=0.0))
             )
             self._history = np.empty(history_length(self._dt, longest))
@@ -564,6 +575,7 @@ class ClothoidController(Controller[ClothoidConfig]):
             dt=math.nan,
             horizon=self._prediction_horizon_s,
             known_delay=cfg.known_delay_s,
+            yaw_rate_age=cfg.yaw_rate_age_s,
             lookahead_mode=LOOKAHEAD_MODES.index(cfg.lookahead_mode),
             initial_curvature=INITIAL_CURVATURE.index(cfg.initial_curvature),
             course=cfg.heading == "course",

@@ -16,9 +16,13 @@ What. A model of each lag (to the path curvature, which turns the course, and to
 run from the kinematic curvature of the steering sent, delayed by T plus the lag's own delay; over the next T the
 curvature changes by the model's change, added to what is measured now (the measurement anchors the prediction,
 so a model's steady-state error in K does not bias it):
-    kappa_path(t + tau) = kappa(0) + K_p (x_p(t + tau) - x_p(t)),   kappa(0)' = kappa(0) + K_m (x_m(t + T) - x_m(t))
+    kappa_path(t + tau) = kappa(0) + K_p (x_p(t + tau) - x_p(t)),   kappa(0)' = kappa(0) + K_m (x_m(t + T) - x_m(t - A))
 and the pose is moved along kappa_path in substeps of at most SUBSTEP_S, each on its mean curvature. The lags are
-discretised exactly (zero-order hold) at the substep, per step at the speed's interpolated lag.
+discretised exactly (zero-order hold) at the substep, per step at the speed's interpolated lag. A is how much older
+the yaw rate (kappa(0)) is than the pose (`ClothoidConfig.yaw_rate_age_s`: a vehicle bus often delivers it later
+than the localisation its pose): read as the pose's age, a 10 ms older yaw rate entering a hairpin is 1 % of its
+curvature behind, which the feedback takes for the vehicle's own and steers against (the dynamic car on
+Zandvoort's hairpin: max |CTE| twice that with an aligned yaw rate).
 """
 
 from __future__ import annotations
@@ -172,13 +176,18 @@ def predicted_start(
     path_lag: np.ndarray,
     measured_lag: np.ndarray,
     known_delay_s: float,
+    yaw_rate_age_s: float = 0.0,
 ) -> tuple[float, float, float, float]:  # pragma: no cover - compiled
-    """(x, y, heading, kappa(0)) known_delay_s ahead (module docstring); the model is left as it was."""
+    """(x, y, heading, kappa(0)) known_delay_s ahead (module docstring); the model is left as it was.
+
+    kappa0 is measured yaw_rate_age_s (s) before the pose (the yaw rate's latency less the pose's; negative: after
+    it), so its prediction starts from the measured lag's model then (`_measured_at`)."""
     per, path, measured, d_path, d_measured = _substep_lags(period_s, path_lag, measured_lag, known_delay_s)
     h = period_s / per
     head = int(model[M_HEAD])
     yp, dyp, ym, dym = model[M_PATH], model[M_PATH + 1], model[M_MEASURED], model[M_MEASURED + 1]
-    yp0, ym0 = yp, ym
+    yp0 = yp
+    ym0 = _measured_at(ym, dym, measured_lag, history, head, -round(yaw_rate_age_s / h), d_measured, per, h)
     x, y, heading = x_m, y_m, heading_rad
     for offset in range(round(known_delay_s / h)):
         before = yp
@@ -187,3 +196,23 @@ def predicted_start(
         kappa = kappa0 + path_lag[3] * (0.5 * (before + yp) - yp0)  # the substep's mean (trapezoidal)
         x, y, heading = along_arc(x, y, heading, kappa, speed_mps * h)
     return x, y, heading, kappa0 + measured_lag[3] * (ym - ym0)
+
+
+@njit(cache=True)
+def _measured_at(
+    ym: float,
+    dym: float,
+    measured_lag: np.ndarray,
+    history: np.ndarray,
+    head: int,
+    offset: int,
+    d_measured: int,
+    per: int,
+    h: float,
+) -> float:  # pragma: no cover - compiled
+    """The measured lag's model output `offset` substeps of h from now (ym, dym: its state now): stepped back
+    exactly (Eq. 5 discretised over -h, each substep's input held as it was sent) or on (as `predicted_start`)."""
+    lag = lag_transition(measured_lag[0], measured_lag[1], -h if offset < 0 else h)
+    for k in range(abs(offset)):
+        ym, dym = _advance(ym, dym, lag, _input(history, head, -1 - k if offset < 0 else k, d_measured, per))
+    return ym

@@ -33,7 +33,7 @@ UNCERTAIN_DELAY_MARGIN_FRACTION = 0.5
 DELAY_COMPENSATIONS = ("model", "arc")
 
 
-def predicts_with_model(delay_compensation: str, known_delay_s: float) -> bool:
-    """Whether the pose is predicted over a known delay with the identified lags: delay compensation "model" and a
-    known delay (s) above zero."""
-    return delay_compensation == "model" and known_delay_s > 0.0
+def predicts_with_model(delay_compensation: str, known_delay_s: float, yaw_rate_age_s: float = 0.0) -> bool:
+    """Whether the pose and kappa(0) are predicted with the identified lags: delay compensation "model" and a known
+    delay (s) above zero or a yaw rate older or fresher than the pose (s, `ClothoidConfig.yaw_rate_age_s`)."""
+    return delay_compensation == "model" and (known_delay_s > 0.0 or yaw_rate_age_s != 0.0)

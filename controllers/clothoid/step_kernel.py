@@ -53,7 +53,7 @@ LAG_COLUMNS = len(LAG_PARAMETERS)
 #: (`lookahead.SEARCH_SETTINGS`), so the step hands its parameters to the search as they are.
 PARAMS = np.dtype(
     [(name, np.float64) for name in (
-        "wheelbase", "steering_ratio", "max_steer", "dt", "horizon", "known_delay", "min_lookahead", "max_lookahead",
+        "wheelbase", "steering_ratio", "max_steer", "dt", "horizon", "known_delay", "yaw_rate_age", "min_lookahead", "max_lookahead",
         "lookahead_step", "min_preview", "fixed_lookahead", "lookahead_gain", "max_turn", "frechet_threshold",
         "point_spacing", "tolerance_x", "tolerance_y", "kdot_max", "feedforward_window", "feedforward_time",
         "reference_lead", "hysteresis", "max_growth", "max_shrink", "min_speed", "band_kmh", "band_hysteresis_kmh",
@@ -323,7 +323,7 @@ def clothoid_step(
         delay = p.known_delay
         dp.record_and_advance(model, history, t_s, p.dt, path_lag, measured_lag, delay, steering_kappa)
         px, py, ph, kappa0 = dp.predicted_start(
-            model, history, x_m, y_m, heading, kappa0, speed, p.dt, path_lag, measured_lag, delay
+            model, history, x_m, y_m, heading, kappa0, speed, p.dt, path_lag, measured_lag, delay, p.yaw_rate_age
         )
         kappa0 = min(max(kappa0, -kappa_max), kappa_max)
         horizon -= delay

@@ -96,6 +96,34 @@ def test_the_predicted_pose_is_where_the_vehicle_will_be(delay_s: float) -> None
     assert arc_worst > 50 * worst
 
 
+@pytest.mark.parametrize("age_s", [0.01, 0.02, -0.02])
+def test_a_yaw_rate_older_than_the_pose_is_predicted_from_its_own_time(age_s: float) -> None:
+    """The same vehicle, its yaw-rate curvature measured age_s before its pose (a vehicle bus's latency beyond the
+    localisation's; negative: fresher): told the age, the predicted kappa(0) is the curvature the vehicle has the
+    known delay later (to rounding: the model stepped back exactly); predicted from the pose's time instead it
+    misses by over 5 % of the random steering's largest curvature step (measured 7 % at 10 ms, 14 % at 20 ms)."""
+    rng = np.random.default_rng(5)
+    steps, fine, speed, delay_s = 300, 0.0005, 8.0, 0.11
+    commands = np.repeat(rng.uniform(-0.05, 0.05, steps // 10), 10)
+    kappa = _plant(commands, PATH_LAG, delay_s, fine)
+    per, ahead, back = round(PERIOD / fine), round(delay_s / fine), round(age_s / fine)
+    model, history = np.full(dp.MODEL_SIZE, np.nan), np.empty(dp.history_length(PERIOD, delay_s + PATH_LAG[2]))
+    told, untold = [], []
+    for step in range(steps - 20):
+        i = step * per
+        dp.record_and_advance(model, history, step * PERIOD, PERIOD, PATH_LAG, PATH_LAG, delay_s, commands[0])
+        measured = kappa[i - back]  # the yaw rate's curvature, age_s older than the pose
+        if step > 20:
+            for age, out in ((age_s, told), (0.0, untold)):
+                k0 = dp.predicted_start(
+                    model, history, 0.0, 0.0, 0.0, measured, speed, PERIOD, PATH_LAG, PATH_LAG, delay_s, age
+                )[3]
+                out.append(abs(k0 - kappa[i + ahead]))
+        dp.send(model, history, commands[step])
+    assert max(told) < 1e-12
+    assert max(untold) > 0.05 * np.abs(np.diff(commands)).max() * PATH_LAG[3]
+
+
 def test_with_nothing_changing_the_prediction_is_the_arc_of_kappa0() -> None:
     """A vehicle on an arc, every command the same as long as the buffer holds: the model at rest, the pose moved on
     kappa(0) alone (to rounding), kappa(0) unchanged."""
