@@ -383,8 +383,8 @@ class ClothoidConfig:
         if self.predicts_with_model and self.initial_curvature != "yaw-rate":
             raise WorkbenchInputError(
                 f"delay_compensation 'model' predicts the measured kappa(0), initial_curvature 'yaw-rate'; got "
-                f"initial_curvature {self.initial_curvature!r} with known_delay_s = {value_text(self.known_delay_s)} s, "
-                f"yaw_rate_age_s = {value_text(self.yaw_rate_age_s)} s: "
+                f"initial_curvature {self.initial_curvature!r} with known_delay_s = {value_text(self.known_delay_s)} "
+                f"s, yaw_rate_age_s = {value_text(self.yaw_rate_age_s)} s: "
                 "set delay_compensation = 'arc' (the pose predicted on kappa(0)) or initial_curvature = 'yaw-rate'"
             )
         if self.max_lookahead_m < self.min_lookahead_m:

@@ -53,8 +53,9 @@ LAG_COLUMNS = len(LAG_PARAMETERS)
 #: (`lookahead.SEARCH_SETTINGS`), so the step hands its parameters to the search as they are.
 PARAMS = np.dtype(
     [(name, np.float64) for name in (
-        "wheelbase", "steering_ratio", "max_steer", "dt", "horizon", "known_delay", "yaw_rate_age", "min_lookahead", "max_lookahead",
-        "lookahead_step", "min_preview", "fixed_lookahead", "lookahead_gain", "max_turn", "frechet_threshold",
+        "wheelbase", "steering_ratio", "max_steer", "dt", "horizon", "known_delay", "yaw_rate_age", "min_lookahead",
+        "max_lookahead", "lookahead_step", "min_preview", "fixed_lookahead", "lookahead_gain", "max_turn",
+        "frechet_threshold",
         "point_spacing", "tolerance_x", "tolerance_y", "kdot_max", "feedforward_window", "feedforward_time",
         "reference_lead", "hysteresis", "max_growth", "max_shrink", "min_speed", "band_kmh", "band_hysteresis_kmh",
         "preview_first_tap", "preview_spacing",
