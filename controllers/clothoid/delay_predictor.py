@@ -188,12 +188,13 @@ def predicted_start(
     yp, dyp, ym, dym = model[M_PATH], model[M_PATH + 1], model[M_MEASURED], model[M_MEASURED + 1]
     yp0 = yp
     ym0 = _measured_at(ym, dym, measured_lag, history, head, -round(yaw_rate_age_s / h), d_measured, per, h)
+    kappa_now = kappa0 + measured_lag[3] * (ym - ym0)  # kappa(0) at the pose's time
     x, y, heading = x_m, y_m, heading_rad
     for offset in range(round(known_delay_s / h)):
         before = yp
         yp, dyp = _advance(yp, dyp, path, _input(history, head, offset, d_path, per))
         ym, dym = _advance(ym, dym, measured, _input(history, head, offset, d_measured, per))
-        kappa = kappa0 + path_lag[3] * (0.5 * (before + yp) - yp0)  # the substep's mean (trapezoidal)
+        kappa = kappa_now + path_lag[3] * (0.5 * (before + yp) - yp0)  # the substep's mean (trapezoidal)
         x, y, heading = along_arc(x, y, heading, kappa, speed_mps * h)
     return x, y, heading, kappa0 + measured_lag[3] * (ym - ym0)
 
