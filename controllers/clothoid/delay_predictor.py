@@ -213,6 +213,8 @@ def _measured_at(
 ) -> float:  # pragma: no cover - compiled
     """The measured lag's model output `offset` substeps of h from now (ym, dym: its state now): stepped back
     exactly (Eq. 5 discretised over -h, each substep's input held as it was sent) or on (as `predicted_start`)."""
+    if offset == 0:
+        return ym
     lag = lag_transition(measured_lag[0], measured_lag[1], -h if offset < 0 else h)
     for k in range(abs(offset)):
         ym, dym = _advance(ym, dym, lag, _input(history, head, -1 - k if offset < 0 else k, d_measured, per))
