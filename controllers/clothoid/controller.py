@@ -268,7 +268,7 @@ class ClothoidConfig:
         "how much older the measured yaw rate is than the measured pose (the yaw rate's latency less the pose's): "
         "with delay_compensation 'model', kappa(0) is predicted over it as well as over known_delay_s "
         "(`delay_predictor.predicted_start`)",
-        Number(-1.0, 1.0, "s", note="0: as old as the pose; negative: fresher"),
+        Number(-0.5, 0.5, "s", note="0: as old as the pose; negative: fresher"),
     )
     delay_compensation: str = option(
         "model",
@@ -488,8 +488,9 @@ class ClothoidController(Controller[ClothoidConfig]):
         self.tuning: VehicleTuning | None = cfg.tuning
         if cfg.predicts_with_model and self.tuning is None:
             raise WorkbenchInputError(
-                f"delay_compensation 'model' (known_delay_s = {value_text(cfg.known_delay_s)} s) predicts with the "
-                "vehicle's identified lags, and this controller has no tuning: give ClothoidConfig(tuning=...) "
+                f"delay_compensation 'model' (known_delay_s = {value_text(cfg.known_delay_s)} s, yaw_rate_age_s = "
+                f"{value_text(cfg.yaw_rate_age_s)} s) predicts with the vehicle's identified lags, and this controller "
+                "has no tuning: give ClothoidConfig(tuning=...) "
                 "(tuning.own_tuning.tuning_for) or set delay_compensation = 'arc'"
             )
         if cfg.feedforward_model == "preview" and (self.tuning is None or not self.tuning.previews):
