@@ -17,7 +17,9 @@ run from the kinematic curvature of the steering sent, delayed by T plus the lag
 curvature changes by the model's change, added to what is measured now (the measurement anchors the prediction,
 so a model's steady-state error in K does not bias it):
     kappa_path(t + tau) = kappa(0) + K_p (x_p(t + tau) - x_p(t)),   kappa(0)' = kappa(0) + K_m (x_m(t + T) - x_m(t - A))
-and the pose is moved along kappa_path in substeps of at most SUBSTEP_S, each on its mean curvature. The lags are
+and the pose is moved along kappa_path in substeps of at most SUBSTEP_S, each on its mean curvature. The course
+(yaw plus sideslip) is thus turned from the yaw rate's curvature: the sideslip's change over T is not predicted
+(docs/clothoid.md, Known delays, measures what that costs in a transient). The lags are
 discretised exactly (zero-order hold) at the substep, per step at the speed's interpolated lag. A is how much older
 the yaw rate (kappa(0)) is than the pose (`ClothoidConfig.yaw_rate_age_s`: a vehicle bus often delivers it later
 than the localisation its pose): read as the pose's age, a 10 ms older yaw rate entering a hairpin is 1 % of its
