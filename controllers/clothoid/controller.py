@@ -454,7 +454,8 @@ class ClothoidController(Controller[ClothoidConfig]):
     def informed_config(cls, config: ClothoidConfig, delays: KnownDelays) -> ClothoidConfig:
         """`config` with known_delay_s = the loop's dead time, the pose latency plus the actuation dead time
         (`KnownDelays.loop_delay_s`), which the pose prediction and the lookahead floor's loop analysis then
-        have; every other option as it is.
+        have, and yaw_rate_age_s = the yaw rate's latency less the pose's, which aligns kappa(0) with the pose;
+        every other option as it is.
 
         Parameters
         ----------
@@ -462,16 +463,18 @@ class ClothoidController(Controller[ClothoidConfig]):
             The controller's options.
         delays : KnownDelays
             The conditions' nominal delays; the pose noise is not used (the lead filter and the lookahead floor are
-            the noise's answer), nor the yaw rate's own latency: `yaw_rate_age_s` would align it with the pose,
-            which tracks the car's braked hairpins better and the loaded truck's corners worse (docs/clothoid.md,
-            Known delays), so it is the user's to set.
+            the noise's answer).
 
         Returns
         -------
         ClothoidConfig
             The informed options (refused, naming the option, when the delay is beyond known_delay_s's range or
             the config's delay compensation cannot take it)."""
-        return replace(config, known_delay_s=delays.loop_delay_s)
+        return replace(
+            config,
+            known_delay_s=delays.loop_delay_s,
+            yaw_rate_age_s=delays.yaw_rate_latency_s - delays.pose_latency_s,
+        )
 
     def __init__(
         self, geometry: VehicleGeometry, config: ClothoidConfig | None = None, vehicle: VehicleModel | None = None

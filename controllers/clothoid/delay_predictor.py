@@ -13,13 +13,16 @@ the start pose and kappa(0) the controller fits from are then where the vehicle 
 takes effect, and the loop the clothoid law closes is the delay-free one (`loop_analysis.py`).
 
 What. A model of each lag (to the path curvature, which turns the course, and to the measured yaw-rate curvature),
-run from the kinematic curvature of the steering sent, delayed by T plus the lag's own delay; over the next T the
-curvature changes by the model's change, added to what is measured now (the measurement anchors the prediction,
-so a model's steady-state error in K does not bias it):
-    kappa_path(t + tau) = kappa(0) + K_p (x_p(t + tau) - x_p(t)),   kappa(0)' = kappa(0) + K_m (x_m(t + T) - x_m(t - A))
-and the pose is moved along kappa_path in substeps of at most SUBSTEP_S, each on its mean curvature. The course
-(yaw plus sideslip) is thus turned from the yaw rate's curvature: the sideslip's change over T is not predicted
-(docs/clothoid.md, Known delays, measures what that costs in a transient). The lags are
+run from the kinematic curvature of the steering sent, delayed by T plus the lag's own delay. Over the next T the
+course turns by the yaw-rate curvature measured now plus the path lag's output less the yaw-rate lag's now, and
+kappa(0) changes by the yaw-rate lag's change (the measurement anchors the prediction, so a model's steady-state
+error in K does not bias it):
+    kappa_path(t + tau) = kappa(0) + K_m (x_p(t + tau) - x_m(t)),   kappa(0)' = kappa(0) + K_m (x_m(t + T) - x_m(t - A))
+and the pose is moved along kappa_path in substeps of at most SUBSTEP_S, each on its mean curvature. The path lag's
+output less the yaw-rate lag's is the sideslip's rate (over speed) the commands sent make, so the course's change
+over T includes the sideslip's; with the two lags the plant's, on one gain, the loop with the delay and this
+predictor has every pole of the delay-free loop (Smith's property, `loop_analysis.py`, `test_clothoid_delay.py`),
+where turning the course with the path lag's own change misses the sideslip's rate now over T. The lags are
 discretised exactly (zero-order hold) at the substep, per step at the speed's interpolated lag. A is how much older
 the yaw rate (kappa(0)) is than the pose (`ClothoidConfig.yaw_rate_age_s`: a vehicle bus often delivers it later
 than the localisation its pose): read as the pose's age, a 10 ms older yaw rate entering a hairpin is 1 % of its
@@ -188,7 +191,7 @@ def predicted_start(
     h = period_s / per
     head = int(model[M_HEAD])
     yp, dyp, ym, dym = model[M_PATH], model[M_PATH + 1], model[M_MEASURED], model[M_MEASURED + 1]
-    yp0 = yp
+    ym_pose = ym
     ym0 = _measured_at(ym, dym, measured_lag, history, head, -round(yaw_rate_age_s / h), d_measured, per, h)
     kappa_now = kappa0 + measured_lag[3] * (ym - ym0)  # kappa(0) at the pose's time
     x, y, heading = x_m, y_m, heading_rad
@@ -196,7 +199,7 @@ def predicted_start(
         before = yp
         yp, dyp = _advance(yp, dyp, path, _input(history, head, offset, d_path, per))
         ym, dym = _advance(ym, dym, measured, _input(history, head, offset, d_measured, per))
-        kappa = kappa_now + path_lag[3] * (0.5 * (before + yp) - yp0)  # the substep's mean (trapezoidal)
+        kappa = kappa_now + measured_lag[3] * (0.5 * (before + yp) - ym_pose)  # the substep's mean (trapezoidal)
         x, y, heading = along_arc(x, y, heading, kappa, speed_mps * h)
     return x, y, heading, kappa0 + measured_lag[3] * (ym - ym0)
 

@@ -336,14 +336,16 @@ def _controller_step(
     sent = 0
     if model:
         # delay_predictor.py, exactly in whole periods: the plant's own equations (lags, psi, y) at the controller
-        # period, a third input adding a constant curvature to psi' (the measured curvature less the model's, which
-        # the prediction holds), each lag's input (its delay + the known delay) late
+        # period, the path lag turning psi on the measured lag's gain, a third input adding a constant curvature to
+        # psi' (the measured curvature less the measured lag's model now, which the prediction holds), each lag's
+        # input (its delay + the known delay) late
+        measured_lag = lags.measured or lags.path
+        k_measured = measured_lag.steady_state_gain
         a_c, b_c, _ = _plant_continuous(lags, v, path_curvature_1pm)
+        a_c[2, 0] = v * k_measured
         offset = np.zeros((6, 1))
         offset[2, 0] = v
         a_m, b_m, *_ = signal.cont2discrete((a_c, np.hstack([b_c, offset]), np.eye(6), np.zeros((6, 3))), dt)
-        measured_lag = lags.measured or lags.path
-        k_path, k_measured = lags.path.steady_state_gain, measured_lag.steady_state_gain
         taps = (_delay_steps(lags.path.delay_s + settings.known_delay_s, dt),
                 _delay_steps(measured_lag.delay_s + settings.known_delay_s, dt))  # fmt: skip
         ahead, sent = _delay_steps(settings.known_delay_s, dt), max(*taps, 1)
@@ -354,10 +356,11 @@ def _controller_step(
     def step(s: np.ndarray, meas: np.ndarray) -> tuple[np.ndarray, float]:
         y, psi, kappa_meas = meas
         kappa0 = kappa_meas if measured else s[0]
-        if model:  # the pose moved on the measured curvature plus the model's change, kappa(0) likewise
+        if model:  # the course turned by the measured curvature plus the path lag's output less the measured
+            # lag's now; kappa(0) the measured curvature plus the measured lag's change
             line = s[core:]
             z = np.array([s[4], s[5], psi, y, s[6], s[7]])
-            held = kappa_meas - k_path * s[4]
+            held = kappa_meas - k_measured * s[6]
             for j in range(ahead):  # the commands reaching each lag j periods from now (the last held beyond)
                 z = a_m @ z + b_m @ np.array([line[max(taps[0] - j - 1, 0)], line[max(taps[1] - j - 1, 0)], held])
             psi, y = z[2], z[3]

@@ -40,14 +40,20 @@ def test_controllers_without_delay_compensation_are_told_nothing(name: str) -> N
     assert cls.informed_config.__func__ is Controller.informed_config.__func__  # the base class's stated no-op
 
 
-def test_the_clothoid_controller_is_told_the_loops_dead_time_and_nothing_else() -> None:
+def test_the_clothoid_controller_is_told_the_loops_dead_time_and_the_yaw_rates_age() -> None:
     cls = CONTROLLERS["clothoid"]
     config = dataclasses.replace(cls.config_type(), frechet_threshold_m=0.3)
     told = cls.informed_config(config, AUTOMOTIVE)
-    # pose latency 10 ms + actuation dead time 100 ms; the yaw rate's age (10 ms) is the user's to set
-    assert _changed(config, told) == {"known_delay_s": pytest.approx(0.11, abs=1e-12)}
+    # pose latency 10 ms + actuation dead time 100 ms; the yaw rate 20 ms late, 10 ms older than the pose
+    assert _changed(config, told) == {
+        "known_delay_s": pytest.approx(0.11, abs=1e-12),
+        "yaw_rate_age_s": pytest.approx(0.01, abs=1e-12),
+    }
     assert told.frechet_threshold_m == 0.3
-    assert cls.informed_config(config, KnownDelays()).known_delay_s == 0.0
+    untold = cls.informed_config(config, KnownDelays())
+    assert (untold.known_delay_s, untold.yaw_rate_age_s) == (0.0, 0.0)
+    # a yaw rate fresher than the pose is a negative age
+    assert cls.informed_config(config, LATE_ONLY).yaw_rate_age_s == pytest.approx(-0.02, abs=1e-12)
 
 
 def test_the_clothoid_controller_refuses_a_delay_its_config_cannot_predict_over() -> None:

@@ -89,7 +89,7 @@ CASES = (
         "figure8",
         "tractor-semitrailer",
         conditions="automotive",
-        options={"known_delay_s": 0.11},
+        options={"known_delay_s": 0.11, "yaw_rate_age_s": 0.01},  # as --inform-delays tells it
         max_steps=1500,
     ),
     Case("car_dlc_degraded", "dlc", "dynamic-bicycle", speed_kmh=50.0, conditions="degraded", seed=1),
