@@ -217,7 +217,9 @@ TRUCK_LAGS_ONE_GAIN = PlantLags(
 @pytest.mark.parametrize("lookahead_m", [6.0, 9.0, 14.0])
 @pytest.mark.parametrize("delay_s", [0.04, 0.1, 0.2])
 @pytest.mark.parametrize(
-    ("lags", "tolerance"), [(PlantLags(TRUCK_LAGS.path), 1e-5), (TRUCK_LAGS_ONE_GAIN, 5e-4)], ids=["one lag", "two lags"]
+    ("lags", "tolerance"),
+    [(PlantLags(TRUCK_LAGS.path), 1e-5), (TRUCK_LAGS_ONE_GAIN, 5e-4)],
+    ids=["one lag", "two lags"],
 )
 def test_the_model_compensation_leaves_the_delay_free_loop(
     lookahead_m: float, delay_s: float, lags: PlantLags, tolerance: float
