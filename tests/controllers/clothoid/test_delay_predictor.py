@@ -59,6 +59,16 @@ def _plant(commands: np.ndarray, lag: np.ndarray, delay_s: float, fine_s: float)
     return y
 
 
+def _driven(kappa: np.ndarray, speed: float, fine_s: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(x, y, heading) of a vehicle at `speed` from the origin whose path curvature is kappa every fine_s, each fine
+    step on its mean curvature."""
+    x = np.zeros(kappa.size)
+    y, heading = x.copy(), x.copy()
+    for i, k in enumerate(0.5 * (kappa[:-1] + kappa[1:])):
+        x[i + 1], y[i + 1], heading[i + 1] = along_arc(x[i], y[i], heading[i], k, speed * fine_s)
+    return x, y, heading
+
+
 @pytest.mark.parametrize("delay_s", [0.04, 0.11, 0.3])
 def test_the_predicted_pose_is_where_the_vehicle_will_be(delay_s: float) -> None:
     """A vehicle at 8 m/s whose path curvature is the lag's response to random steering commands (scipy's lsim, the
@@ -71,10 +81,7 @@ def test_the_predicted_pose_is_where_the_vehicle_will_be(delay_s: float) -> None
     steps, fine, speed = 300, 0.0005, 8.0
     commands = np.repeat(rng.uniform(-0.05, 0.05, steps // 10), 10)  # held for 0.2 s each
     kappa = _plant(commands, PATH_LAG, delay_s, fine)
-    x = np.zeros(kappa.size)
-    y, heading = x.copy(), x.copy()
-    for i, k in enumerate(0.5 * (kappa[:-1] + kappa[1:])):  # each fine step on its mean curvature
-        x[i + 1], y[i + 1], heading[i + 1] = along_arc(x[i], y[i], heading[i], k, speed * fine)
+    x, y, heading = _driven(kappa, speed, fine)
     per, ahead = round(PERIOD / fine), round(delay_s / fine)
     model, history = np.full(dp.MODEL_SIZE, np.nan), np.empty(dp.history_length(PERIOD, delay_s + PATH_LAG[2]))
     worst, arc_worst = 0.0, 0.0
@@ -109,10 +116,7 @@ def test_the_course_turns_with_the_path_lag_and_kappa0_with_the_yaw_rate_lag() -
     measured_lag = np.array([*MEASURED_LAG[:3], PATH_LAG[3]])
     commands = np.repeat(rng.uniform(-0.05, 0.05, steps // 10), 10)
     path, yaw = _plant(commands, PATH_LAG, delay_s, fine), _plant(commands, measured_lag, delay_s, fine)
-    x = np.zeros(path.size)
-    y, heading = x.copy(), x.copy()
-    for i, k in enumerate(0.5 * (path[:-1] + path[1:])):
-        x[i + 1], y[i + 1], heading[i + 1] = along_arc(x[i], y[i], heading[i], k, speed * fine)
+    x, y, heading = _driven(path, speed, fine)
     per, ahead = round(PERIOD / fine), round(delay_s / fine)
     model = np.full(dp.MODEL_SIZE, np.nan)
     history = np.empty(dp.history_length(PERIOD, delay_s + PATH_LAG[2]))
