@@ -213,16 +213,15 @@ def test_the_loaded_truck_keeps_to_a_hairpin_with_the_automotive_delay(compensat
     (`delay_predictor.py`) the floor is the delay-free loop's, 5.5 m at 20 km/h (kept for +-50 ms of the delay), and
     max |CTE| <= 0.15 m (issue 18's goal; measured 0.128 m, the delay-free controller under `ideal` 0.125 m: the
     prediction leaves the delay-free loop, so this corner's error is the controller's own). On the arc of kappa(0)
-    the delay stays in the
-    loop, the floor is 10.5 m and max |CTE| <= 0.43 m (measured 0.381 m; 0.47 m before the floor took the lookahead
-    down at once: the sideslip relaxing at the apex, a heading step of ~0.03 rad, leaves about 0.02 m per metre of
-    lookahead). The truck's feed-forward and reference come from its preview responses (`feedforward_model` auto),
-    their taps read where the planned speed takes the vehicle: identified at a held speed, they hold this
-    braking-and-accelerating 0.3 g corner less well than its lags do (with `feedforward_model = "lag"`: 0.087 m and
-    0.215 m). Their handling gain (the steering per curvature growing with lateral acceleration in steady turns)
-    asks more steering at the apex, which the truck, turning tighter at a held steering while it brakes, does not
-    need (without it, `handling_gain = false`: 0.107 m and 0.354 m); with the delay left in the loop (the arc) the
-    feedback corrects it late."""
+    the delay stays in the loop, the floor is 10.5 m and max |CTE| <= 0.43 m (measured 0.381 m; 0.47 m before the
+    floor took the lookahead down at once: the sideslip relaxing at the apex, a heading step of ~0.03 rad, leaves
+    about 0.02 m per metre of lookahead). The truck's feed-forward and reference come from its preview responses
+    (`feedforward_model` auto), their taps read where the planned speed takes the vehicle: identified at a held
+    speed, they hold this braking-and-accelerating 0.3 g corner less well than its lags do (with
+    `feedforward_model = "lag"`: 0.106 m and 0.215 m). Their handling gain (the steering per curvature growing with
+    lateral acceleration in steady turns) asks more steering at the apex, which the truck, turning tighter at a held
+    steering while it brakes, does not need (without it, `handling_gain = false`: 0.122 m and 0.354 m); with the
+    delay left in the loop (the arc) the feedback corrects it late."""
     config = ClothoidConfig(known_delay_s=0.11, delay_compensation=compensation)
     controller = tuned_controller("clothoid", TRUCK, config)
     sim = SimulationConfig(conditions=load_conditions("automotive"))

@@ -96,7 +96,7 @@ def test_robustness_tells_every_run_the_base_conditions_delays_not_the_varied_on
     varied = {dict(r.values).get("actuation_dead_time_s") for r in clothoid} - {None}
     assert len(varied) == len(AXES[0].values) - 1  # the dead-time axis was run
     for run in clothoid:  # the base's 10 ms + 100 ms in every run, the 300 ms dead-time run's included; the yaw
-        # rate 20 ms late, 10 ms after the pose
+        # rate 20 ms late, 10 ms older than the pose
         assert dict(run.options) == {
             "known_delay_s": pytest.approx(AUTOMOTIVE_LOOP_DELAY_S, abs=1e-12),
             "yaw_rate_age_s": pytest.approx(0.01, abs=1e-12),
