@@ -59,7 +59,8 @@ class BackendError(RuntimeError):
 
 #: How often (s) a local worker checks that the process which started it is still there.
 ORPHAN_CHECK_S = 1.0
-#: How long (s) closing an interrupted local pool waits for its killed workers to be reaped.
+#: How long (s) closing an interrupted local pool waits for its killed workers to be reaped, and again for its
+#: manager thread to end.
 KILLED_WORKER_JOIN_S = 2.0
 #: How long (s) a study waiting for its runs may take to act on a stop signal that another of its threads received.
 SIGNAL_CHECK_S = 0.5
@@ -328,6 +329,8 @@ class LocalBackend(_StartedInWith):
             pool.shutdown(wait=True)
             return
         workers = list((pool._processes or {}).values())  # the pool has no public way to end running tasks
+        # taken now: shutdown(wait=False) drops the pool's reference (typeshed types it as the wake-up, wrongly)
+        manager: threading.Thread | None = pool._executor_manager_thread  # type: ignore[assignment]
         pool.shutdown(wait=False, cancel_futures=True)
         for worker in workers:
             if worker.is_alive():
@@ -337,10 +340,10 @@ class LocalBackend(_StartedInWith):
             worker.join(max(0.0, deadline - time.monotonic()))
         # The pool's manager thread closes its wake-up pipe as it winds down; Python 3.11's exit handler writes to
         # that pipe unless it is closed, and a close between its check and its write prints a traceback (OSError:
-        # bad file descriptor) as the interrupted command exits. Waiting for the thread closes the race.
-        manager = getattr(pool, "_executor_manager_thread", None)
+        # bad file descriptor) as the interrupted command exits. Waiting for the thread (it ends once it sees its
+        # workers gone) closes the race.
         if manager is not None:
-            manager.join(max(0.0, deadline - time.monotonic()))
+            manager.join(KILLED_WORKER_JOIN_S)
 
     def map_runs(self, runs: Sequence[PlannedRun]) -> Iterator[dict[str, Any]]:
         """Run `runs` on the pool's workers, yielding each run's row as it finishes (in completion order, not in
