@@ -28,7 +28,11 @@ Switches (each against `nominal`, the shipped defaults on the preset vehicle):
     of Eq. 5 the clothoid controller is designed on (its `kinematic-lag` model, the lag at 30 km/h) instead of the
     vehicle's single-track equivalent: how much of the gap is the model each is given, not the control law.
   - ideal_plant: no_actuator_lag + stiff_tyres + constant_speed together (what the controller's geometry and floor
-    leave).
+    leave);
+  - perfect_prediction (automotive only, both controllers): each controller handed the plant's true state one
+    actuation dead time ahead (`SimulationConfig.perfect_prediction`) and told only the sensing delays: what a
+    perfect compensation of the dead time reaches, against each one's own predictor (the clothoid controller's
+    lags of Eq. 5, `delay_predictor.py`; the NMPC's single-track model) in the nominal run.
 Both controllers are built for the vehicle they drive: the clothoid controller with that plant's own tuning (its lags
 identified, its lead filter designed and its floor computed by the tuning chain; about a minute per switched plant
 the first time, cached after: `tuning/own_tuning.py`), the NMPC with that plant's model. So a plant switch shows what
@@ -78,7 +82,6 @@ from benchmark_report import machine, write_results
 
 from tuning.own_tuning import tuned_controller
 from workbench.simulation.conditions import CONDITIONS
-from workbench.simulation.known_delays import KnownDelays
 from workbench.simulation.scenarios import ScenarioOptions, make_scenario
 from workbench.simulation.simulator import Simulation, SimulationConfig
 from workbench.vehicles import make_vehicle
@@ -100,7 +103,9 @@ CONTROLLER_SWITCHES = (
 RATE_FEEDFORWARD_WINDOW_M = 6.0
 #: Switches of the NMPC's model (the clothoid controller runs as nominal).
 MODEL_SWITCHES = ("nmpc_identified_lag",)
-SWITCHES = ("nominal", *PLANT_SWITCHES, *CONTROLLER_SWITCHES, *MODEL_SWITCHES)
+#: Switches of the conditions, run under automotive only, by both controllers.
+DELAY_SWITCHES = ("perfect_prediction",)
+SWITCHES = ("nominal", *PLANT_SWITCHES, *CONTROLLER_SWITCHES, *MODEL_SWITCHES, *DELAY_SWITCHES)
 #: The plant's actuator time constant (s) with its lag switched off (the smallest the presets allow).
 NO_LAG_TIME_CONSTANT_S = 1e-3
 #: Stiff tyres: cornering coefficients (1/rad) at the top of each model's allowed range, relaxation length (m).
@@ -240,8 +245,9 @@ def run_one(job: tuple[str, str, str, str, str]) -> tuple[Run, dict[str, list[fl
         max_lateral_accel_g=CONSTANT_SPEED_LATERAL_G if switch in ("constant_speed", "ideal_plant") else 0.3,
         conditions=CONDITIONS[conditions],
         inform_delays=conditions != "ideal",
+        perfect_prediction=switch in DELAY_SWITCHES,
     )
-    delays = KnownDelays.from_conditions(cfg.conditions) if cfg.inform_delays else None
+    delays = cfg.known_delays
     nmpc_config = nmpc_config_for(switch, plant) if controller_name == "nmpc" else None
     controller = tuned_controller(controller_name, plant, nmpc_config, delays=delays)
     if controller_name == "clothoid" and switch in CONTROLLER_SWITCHES:
@@ -288,9 +294,11 @@ def jobs_for(vehicles: list[str], scenarios: list[str], automotive: bool) -> lis
         for v in vehicles:
             for sc in names:
                 for sw in SWITCHES:
+                    if sw in DELAY_SWITCHES and conditions == "ideal":
+                        continue
                     if sw not in MODEL_SWITCHES:
                         out.append((v, sc, sw, "clothoid", conditions))
-                    if sw == "nominal" or sw in PLANT_SWITCHES or sw in MODEL_SWITCHES:
+                    if sw == "nominal" or sw in PLANT_SWITCHES or sw in MODEL_SWITCHES or sw in DELAY_SWITCHES:
                         out.append((v, sc, sw, "nmpc", conditions))
     return out
 

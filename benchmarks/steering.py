@@ -59,7 +59,6 @@ from tuning.own_tuning import tuned_controller
 from workbench.apps.comparison import converge_distance_m
 from workbench.simulation.circuits import circuit_name
 from workbench.simulation.conditions import CONDITIONS
-from workbench.simulation.known_delays import KnownDelays
 from workbench.simulation.scenarios import ZANDVOORT_ENV, ScenarioOptions, make_scenario
 from workbench.simulation.simulator import Simulation, SimulationConfig
 from workbench.vehicles import make_vehicle
@@ -191,7 +190,7 @@ def _simulation(job: Job) -> Simulation:
     vehicle = make_vehicle(job.vehicle)
     told = job.conditions != "ideal"  # ideal has no delay to tell: its controllers are built as `workbench run`'s
     config = SimulationConfig(speed_kmh=SPEED_KMH, conditions=CONDITIONS[job.conditions], inform_delays=told)
-    delays = KnownDelays.from_conditions(config.conditions) if config.inform_delays else None
+    delays = config.known_delays
     controller = tuned_controller(job.controller, vehicle, None, delays)
     options = ScenarioOptions(vehicle.geometry.width_m, Path(job.track) if job.track else None)
     return Simulation(make_scenario(job.scenario, options), vehicle, controller, config)

@@ -70,13 +70,17 @@ def test_the_held_out_circuits_are_refused(breakdown, capsys) -> None:
     assert "circuit:9003" in capsys.readouterr().err
 
 
-def test_the_plan_runs_the_nmpc_on_plant_and_model_switches_only(breakdown) -> None:
+def test_the_plan_runs_the_nmpc_on_plant_model_and_delay_switches_only(breakdown) -> None:
     jobs = breakdown.jobs_for(["dynamic-bicycle"], ["dlc"], automotive=False)
     nmpc = {j[2] for j in jobs if j[3] == "nmpc"}
     assert nmpc == {"nominal", *breakdown.PLANT_SWITCHES, *breakdown.MODEL_SWITCHES}
-    assert {j[2] for j in jobs if j[3] == "clothoid"} == set(breakdown.SWITCHES) - set(breakdown.MODEL_SWITCHES)
+    controller_free = set(breakdown.MODEL_SWITCHES) | set(breakdown.DELAY_SWITCHES)  # the delay: automotive only
+    assert {j[2] for j in jobs if j[3] == "clothoid"} == set(breakdown.SWITCHES) - controller_free
     with_automotive = breakdown.jobs_for(["dynamic-bicycle"], ["dlc"], automotive=True)
     assert {j[1] for j in with_automotive if j[4] == "automotive"} == set(breakdown.AUTOMOTIVE_SCENARIOS)
+    perfect = {j[3] for j in with_automotive if j[2] == "perfect_prediction"}
+    assert perfect == {"clothoid", "nmpc"}
+    assert all(j[4] == "automotive" for j in with_automotive if j[2] == "perfect_prediction")
 
 
 def _run(breakdown, scenario: str, switch: str, controller: str, cte: float, rms: float = 0.01):

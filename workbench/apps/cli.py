@@ -1047,14 +1047,13 @@ def _run_stages(
     more than the bounds of `run_size` without --allow-long-run), simulate, write."""
     from tuning.own_tuning import tuned_controller
     from workbench.simulation.feasibility import refuse_infeasible
-    from workbench.simulation.known_delays import KnownDelays
     from workbench.simulation.run_size import check_run_size, duration_text
     from workbench.simulation.simulator import Simulation
 
     config = _run_config(args)
     progress.stage("building the vehicle, the controller and the scenario")
     vehicle, options = _vehicle_and_options(args, progress.warn)
-    delays = KnownDelays.from_conditions(config.conditions) if config.inform_delays else None
+    delays = config.known_delays
     controller = tuned_controller(args.controller, vehicle, options, delays)
     scenario = _scenario(args, vehicle)
     if args.scenario == TRACK_SCENARIO and scenario.name != TRACK_SCENARIO:  # another file given: named by it

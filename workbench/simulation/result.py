@@ -209,6 +209,8 @@ class SimulationResult:
         if not self.config.conditions.is_ideal:  # only a run under conditions records them
             c = self.config  # inform_delays: whether the controller was told the conditions' delays
             document |= {"conditions": c.conditions.name, "seed": c.seed, "inform_delays": c.inform_delays}
+            if c.perfect_prediction:  # the controller was handed the state one dead time ahead
+                document["perfect_prediction"] = True
         written[1].write_text(json.dumps(document, indent=2) + "\n")
         if with_plots:
             drawn = plot_worker.wait() if plot_worker is not None else None

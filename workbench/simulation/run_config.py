@@ -2,10 +2,12 @@
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 from workbench.base.errors import WorkbenchInputError, require_in_range, require_positive, value_text
 from workbench.simulation.conditions import CONDITIONS, Conditions
+from workbench.simulation.known_delays import KnownDelays
 
 #: The longest time-out a run may be given (s; about 32 years): beyond it a number of steps no longer fits a
 #: machine integer, and `run_size` refuses far shorter runs anyway.
@@ -27,8 +29,11 @@ class SimulationConfig:
     default, `ideal`, changes nothing); seed: the seed of the conditions' noise (the same seed, the same run);
     inform_delays: whether the run's controller is told the conditions' nominal delays and pose noise
     (`known_delays.KnownDelays`, `Controller.informed_config`). Whoever builds the controller applies it (`workbench
-    run`, compare, fig17, the study runner); the simulator steps the controller it is given, and metrics.json
-    records the choice with the conditions.
+    run`, compare, fig17, the study runner; `known_delays` says what to tell); the simulator steps the controller it
+    is given, and metrics.json records the choice with the conditions. perfect_prediction: the controller is handed
+    the plant's true state one actuation dead time ahead (the steering commands already sent applied, the
+    acceleration command held), before the sensing conditions act on it: a perfect compensation of the dead time,
+    the bound any delay predictor is measured against (an analysis; the dead time is then not told).
     """
 
     speed_kmh: float = 30.0
@@ -45,6 +50,7 @@ class SimulationConfig:
     conditions: Conditions = CONDITIONS["ideal"]
     seed: int = 0
     inform_delays: bool = False
+    perfect_prediction: bool = False
 
     def __post_init__(self) -> None:
         require_in_range("speed_kmh", self.speed_kmh, 1e-3, 400.0, "km/h (must be > 0)")
@@ -77,6 +83,24 @@ class SimulationConfig:
             raise WorkbenchInputError(f"seed must be a whole number in [0, 2**63); got {value_text(self.seed)}")
         if not isinstance(self.inform_delays, bool):
             raise WorkbenchInputError(f"inform_delays must be True or False; got {value_text(self.inform_delays)}")
+        if not isinstance(self.perfect_prediction, bool):
+            value = value_text(self.perfect_prediction)
+            raise WorkbenchInputError(f"perfect_prediction must be True or False; got {value}")
+        if self.perfect_prediction and self.conditions.actuation.dead_time_s == 0.0:
+            raise WorkbenchInputError(
+                f"perfect_prediction hands the controller the state one actuation dead time ahead; the conditions "
+                f"{self.conditions.name!r} have no dead time (actuation.dead_time_s = 0)"
+            )
+
+    @property
+    def known_delays(self) -> KnownDelays | None:
+        """What the run's controller is told (`Controller.informed_config`): None unless inform_delays; else the
+        conditions' nominal delays and pose noise, without the actuation dead time when perfect_prediction hands the
+        controller the state past it."""
+        if not self.inform_delays:
+            return None
+        delays = KnownDelays.from_conditions(self.conditions)
+        return dataclasses.replace(delays, dead_time_s=0.0) if self.perfect_prediction else delays
 
     @property
     def substeps(self) -> int:

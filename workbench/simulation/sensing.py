@@ -309,15 +309,50 @@ class ActuatorModel:
         substeps = self.plant_substeps
         if self.is_ideal:
             return [(substeps, steer_wheel_cmd_rad)]
-        history, k, whole, part = self._history, self._step, self._whole, self._part
-        size = len(history)
-        history[k % size] = steer_wheel_cmd_rad
+        k = self._step
+        self._history[k % len(self._history)] = steer_wheel_cmd_rad
         self._step = k + 1
+        out, self._applied = self._limited(self._delayed(k, substeps), self._applied)
+        return out
+
+    def segments_ahead(self) -> list[tuple[int, float]]:
+        """The (plant substeps, steering-wheel command) segments the plant will apply over the next dead time, from
+        the commands already sent (the dead time's worth of them decides it): what a perfect delay compensation
+        knows before this step's command is sent. Changes nothing; their substeps add up to the dead time's.
+
+        Returns
+        -------
+        list of (int, float)
+            The segments, in order; none without a dead time.
+        """
+        out: list[tuple[int, float]] = []
+        applied, k = self._applied, self._step
+        for j in range(self._whole + 1):  # the whole steps of the dead time, then its part of the next
+            n = self.plant_substeps if j < self._whole else self._part
+            if n == 0:
+                break
+            segments, applied = self._limited(self._delayed(k + j, n), applied)
+            out += segments
+        return out
+
+    def _delayed(self, k: int, substeps: int) -> tuple[tuple[int, float], ...]:
+        """The commands that reach the plant over the first `substeps` plant steps of controller step k, before
+        the rate limit: those sent dead_time_substeps earlier (the dead time honoured to the plant's step)."""
+        history, whole, part = self._history, self._whole, self._part
+        size = len(history)
         late = history[(k - whole) % size]
-        raw = ((part, history[(k - whole - 1) % size]), (substeps - part, late)) if part else ((substeps, late),)
+        if not part:
+            return ((substeps, late),)
+        early = (min(part, substeps), history[(k - whole - 1) % size])
+        return (early, (substeps - part, late)) if substeps > part else (early,)
+
+    def _limited(
+        self, raw: tuple[tuple[int, float], ...], applied: float
+    ) -> tuple[list[tuple[int, float]], float]:
+        """The segments `raw` under the rate limit from the command applied before them, merging equal
+        neighbours; and the command applied after them."""
         limit = self._max_change_per_substep
         out: list[tuple[int, float]] = []
-        applied = self._applied
         for n, command in raw:
             if limit is not None:
                 change = limit * n
@@ -330,8 +365,7 @@ class ActuatorModel:
                 out[-1] = (out[-1][0] + n, command)
             else:
                 out.append((n, command))
-        self._applied = applied
-        return out
+        return out, applied
 
 
 __all__ = ["NOISE_SOURCES", "ActuatorModel", "SensorModel"]

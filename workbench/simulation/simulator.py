@@ -331,6 +331,7 @@ class Simulation:
         if getattr(vehicle, "road_friction", 1.0) != friction:
             vehicle.set_road_friction(friction)
         seen = not conditions.is_ideal
+        ahead = cfg.perfect_prediction and actuator is not None
         speed_gains = PISpeedGains()
         settings = run_settings(  # the kernels' constants and the PI speed controller's state
             cfg.max_past_end_m, cfg.max_abs_cte_m, total_length, dt, cfg.speed_feedforward, speed_gains
@@ -367,6 +368,12 @@ class Simulation:
             if where:
                 status, message = _projection_end(where, foot.tolist(), t, cfg)
                 break
+            if ahead:  # the true state one dead time on, the commands already sent applied (SimulationConfig)
+                future = state
+                for segment_substeps, command in actuator.segments_ahead():
+                    segment_s = dt * segment_substeps / substeps
+                    future = advance(future, command, accel_cmd, segment_s, segment_substeps)
+                x, y, yaw, vx, vy, yaw_rate, steer_wheel = measured(outputs(future, command, accel_cmd))
             measurement = Measurement(t, x, y, vx, vy, yaw, yaw_rate, steer_wheel)
             if sensors is not None:
                 measurement = sensors.measure(measurement)

@@ -415,6 +415,31 @@ def test_the_actuator_keeps_the_order_and_never_exceeds_its_rate(
         assert limited_calls == unlimited_calls
 
 
+@settings(max_examples=150, deadline=None)
+@given(
+    sent=st.lists(st.floats(-10.0, 10.0), min_size=0, max_size=30),
+    later=st.lists(st.floats(-10.0, 10.0), min_size=22, max_size=22),  # 0.2 s at 0.01 s and two more
+    dead_time_s=st.floats(0.0, 0.2),
+    substeps=st.integers(1, 25),
+    sample_time_s=st.sampled_from([0.01, 0.02, 0.05]),
+    rate=st.one_of(st.none(), st.floats(0.1, 50.0)),
+    initial=st.floats(-5.0, 5.0),
+)
+def test_the_segments_ahead_are_what_the_plant_gets_over_the_next_dead_time(
+    sent, later, dead_time_s, substeps, sample_time_s, rate, initial
+) -> None:
+    """Whatever is sent from now on, the plant's next dead time of commands is the look-ahead taken before it."""
+    conditions = Conditions(actuation=Actuation(dead_time_s=dead_time_s, max_steer_wheel_rate_rad_s=rate))
+    actuator = ActuatorModel(conditions, sample_time_s, substeps)
+    actuator.reset(initial)
+    _drive(actuator, sent)
+    ahead = actuator.segments_ahead()
+    assert actuator.segments_ahead() == ahead  # it changes nothing
+    assert sum(n for n, _ in ahead) == actuator.dead_time_substeps and all(n > 0 for n, _ in ahead)
+    then = [value for segments in _drive(actuator, later) for value in _expand(segments)]
+    assert _expand(ahead) == then[: actuator.dead_time_substeps]
+
+
 # ------------------------------------------------------------------------------------------------------- cost
 def test_a_call_costs_a_few_microseconds() -> None:
     truth = _cruise(2000)

@@ -1,6 +1,7 @@
 """The simulator under sensing, actuation and road conditions (issue 18): ideal is today's run bit for bit; the
 controller sees the conditions' measurements while the trace and the metrics keep the true state; the actuator's
-dead time delays what reaches the plant; the road's friction is set on the vehicle; a seed reproduces a run."""
+dead time delays what reaches the plant, and a perfect prediction of it hands the controller the state past it; the
+road's friction is set on the vehicle; a seed reproduces a run."""
 
 from __future__ import annotations
 
@@ -111,3 +112,42 @@ def test_a_bad_conditions_or_seed_is_refused_naming_it() -> None:
     for seed in (-1, 1.5, True, 2**63):
         with pytest.raises(WorkbenchInputError, match="seed must be a whole number"):
             SimulationConfig(seed=seed)  # type: ignore[arg-type]
+
+
+DEAD = Conditions(name="dead time", actuation=Actuation(dead_time_s=0.1))
+
+
+def test_perfect_prediction_hands_the_controller_the_true_state_one_dead_time_on() -> None:
+    """On the dlc at a held speed (the lateral bound lifted: no braking, so the acceleration command held over the
+    dead time is the one that comes) what the controller saw at a step is the plant's true state 0.1 s (5 steps at
+    50 Hz) later, steering included: the commands already sent decide it."""
+    trace = _run(DEAD, perfect_prediction=True, max_lateral_accel_g=2.0).trace
+    k = 5
+    for signal in ("x_m", "y_m", "yaw_rad", "vy_mps", "yaw_rate_rad_s", "steer_wheel_rad"):
+        seen, true = trace[f"seen_{signal}"][:-k], trace[signal][k:]
+        assert np.max(np.abs(seen - true)) < 1e-5, signal  # m, rad, m/s, rad/s: the integration's rounding
+    assert np.ptp(trace["yaw_rate_rad_s"]) > 0.1  # the check is on a run that steers
+
+
+def test_perfect_prediction_takes_the_dead_time_out_of_the_loop() -> None:
+    """With the dead time perfectly predicted the loop is the delay-free one: pure pursuit's max |CTE| on the dlc
+    (at a held speed, the lateral bound lifted) is the ideal run's to a millimetre, where the same dead time
+    unpredicted moves it by centimetres."""
+    held = {"max_lateral_accel_g": 2.0}
+    ideal, late = _run(**held).metrics.max_abs_cte_m, _run(DEAD, **held).metrics.max_abs_cte_m
+    predicted = _run(DEAD, perfect_prediction=True, **held).metrics.max_abs_cte_m
+    assert abs(late - ideal) > 0.02
+    assert predicted == pytest.approx(ideal, abs=1e-3)
+
+
+def test_perfect_prediction_is_not_told_the_dead_time_and_needs_one() -> None:
+    automotive = CONDITIONS["automotive"]
+    told = SimulationConfig(conditions=automotive, inform_delays=True, perfect_prediction=True).known_delays
+    assert told is not None and told.dead_time_s == 0.0
+    assert told.pose_latency_s == automotive.localisation.latency_s > 0.0
+    assert SimulationConfig(conditions=automotive, inform_delays=True).known_delays.dead_time_s == 0.1
+    assert SimulationConfig(conditions=automotive).known_delays is None
+    with pytest.raises(WorkbenchInputError, match=r"perfect_prediction .* 'rtk' have no dead time"):
+        SimulationConfig(conditions=CONDITIONS["rtk"], perfect_prediction=True)
+    with pytest.raises(WorkbenchInputError, match="perfect_prediction must be True or False; got 'yes'"):
+        SimulationConfig(conditions=DEAD, perfect_prediction="yes")  # type: ignore[arg-type]

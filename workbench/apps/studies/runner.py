@@ -123,7 +123,7 @@ def simulate(run: PlannedRun, progress: bool = False) -> SimulationResult:
     scenario = started_scenario(
         scenario, extra["initial_offset_m"], extra["initial_heading_error_deg"], config.max_abs_cte_m
     )
-    delays = KnownDelays.from_conditions(config.conditions) if config.inform_delays else None
+    delays = config.known_delays
     options = build_controller_config(run, built_for, delays)
     controller = make_controller(run.controller, vehicle.geometry, options, vehicle=built_for)
     return Simulation(scenario, vehicle, controller, config).run(progress=progress)
