@@ -373,6 +373,13 @@ def _run_options(parser: argparse.ArgumentParser, several: bool) -> None:
     )
     _allow_infeasible_option(parser)
     _conditions_options(parser)
+    parser.add_argument(
+        "--perfect-prediction",
+        action="store_true",
+        help="hand each controller the plant's true state one actuation dead time of --conditions ahead (the "
+        "commands already sent applied; --inform-delays then tells the sensing delays only): the bound a perfect "
+        "delay compensation reaches (needs a dead time; an analysis, not a sensor)",
+    )
     what = "trace and metrics" if not several else "traces, metrics and summary.csv, without figures or report.html"
     parser.add_argument("--no-plots", action="store_true", help=f"write the {what} only")
     _overwrite_option(parser)
@@ -462,6 +469,7 @@ def _run_config(args: argparse.Namespace) -> SimulationConfig:
         plant_rate_hz=args.plant_rate_hz,
         max_lateral_accel_g=args.lat_accel_g,
         max_time_s=args.max_time_s,
+        perfect_prediction=args.perfect_prediction,
     )
 
 
@@ -951,6 +959,8 @@ def _run_with(args: argparse.Namespace, plot_worker: PlotWorker | None) -> int:
     run_config = simulation.config
     if not run_config.conditions.is_ideal:
         told = "told their delays" if run_config.inform_delays else "not told their delays (--inform-delays tells it)"
+        if run_config.perfect_prediction:
+            told += ", and handed the true state one dead time ahead (--perfect-prediction)"
         print(f"  conditions {run_config.conditions.name}, seed {run_config.seed}: the controller {told}")
     print(f"  distance {fmt(m.distance_m, 'm')} of {fmt(m.path_length_m, 'm')}")
     print(f"  max |CTE| {fmt(m.max_abs_cte_m, 'm')}, RMS CTE {fmt(m.rms_cte_m, 'm')}")

@@ -38,7 +38,6 @@ from workbench.apps.controller_config import read_controller_config
 from workbench.base.console import warn_on_stderr
 from workbench.base.errors import WorkbenchInputError
 from workbench.simulation.feasibility import refuse_infeasible
-from workbench.simulation.known_delays import KnownDelays
 from workbench.simulation.limit_cycle import LimitCycle, detect_limit_cycle
 from workbench.simulation.metrics import CONVERGED_CTE_M, METRIC_KEYS, approach_end
 from workbench.simulation.plots import RunStyle, Stretch, run_styles
@@ -243,8 +242,11 @@ class Comparison:
         config = self.config
         if config.conditions.is_ideal:
             return ""
-        if config.inform_delays:
-            told = f"told their nominal delays ({KnownDelays.from_conditions(config.conditions).describe()})"
+        delays = config.known_delays
+        if delays is not None:
+            told = f"told their nominal delays ({delays.describe()})"
+            if config.perfect_prediction:
+                told += ", and handed the true state one dead time ahead (a perfect prediction)"
         else:
             told = "not told their delays"
         return (
@@ -463,7 +465,7 @@ def _simulation(
         scen = make_scenario(scenario, replace(options, vehicle_width_m=vehicle.geometry.width_m))
     config_type = CONTROLLERS[spec.controller].config_type
     options = read_controller_config(spec.config_file, spec.controller, config_type, spec.overrides, vehicle.geometry)
-    delays = KnownDelays.from_conditions(config.conditions) if config.inform_delays else None
+    delays = config.known_delays
     return Simulation(scen, vehicle, tuned_controller(spec.controller, vehicle, options, delays), config)
 
 

@@ -120,3 +120,24 @@ def test_the_robustness_report_says_whether_the_controllers_were_told() -> None:
 
     assert "told the base conditions' nominal delays, not the varied ones" in intro(True)
     assert "were not told the conditions' delays" in intro(False)
+
+
+def test_run_with_a_perfect_prediction_tells_the_sensing_delays_only_and_says_so(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], built_configs: list[object]
+) -> None:
+    out = tmp_path / "run"
+    args = ["run", "dlc", "--conditions", "automotive", "--inform-delays", "--perfect-prediction", "--no-plots"]
+    main([*args, "--max-time-s", "3", "--out", str(out)])
+    (config,) = built_configs
+    assert config.known_delay_s == pytest.approx(AUTOMOTIVE_LOOP_DELAY_S - 0.1, abs=1e-12)  # the pose latency
+    assert json.loads((out / "metrics.json").read_text())["perfect_prediction"] is True
+    assert "handed the true state one dead time ahead (--perfect-prediction)" in capsys.readouterr().out
+
+
+def test_a_perfect_prediction_without_a_dead_time_is_refused_naming_it(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    code = main(["run", "dlc", "--perfect-prediction", "--no-plots", "--out", str(tmp_path / "run")])
+    err = capsys.readouterr().err
+    assert code != 0 and "perfect_prediction" in err and "'ideal' have no dead time" in err
+    assert "Traceback" not in err
