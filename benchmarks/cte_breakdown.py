@@ -364,7 +364,8 @@ def summary(runs: list[Run]) -> list[dict[str, object]]:
     out = []
     for vehicle, conditions in sorted({(r.vehicle, r.conditions) for r in runs}):
         scenarios = sorted({r.scenario for r in runs if r.vehicle == vehicle and r.conditions == conditions})
-        for sw in [sw for sw in SWITCHES if any(r.switch == sw for r in runs)]:
+        run_here = {r.switch for r in runs if (r.vehicle, r.conditions) == (vehicle, conditions)}
+        for sw in [sw for sw in SWITCHES if sw in run_here]:  # the delay switch: under automotive only
             ratios, closed, vs_nmpc, rms, cycles = [], [], [], [], 0
             for sc in scenarios:
                 c0 = by[(vehicle, sc, "nominal", "clothoid", conditions)]

@@ -121,6 +121,20 @@ def test_the_summary_arithmetic(breakdown) -> None:
     }  # switches not run are not summarised
 
 
+def test_a_switch_is_summarised_only_under_the_conditions_it_ran(breakdown) -> None:
+    """The delay switch runs under automotive only: under ideal it has no row (not the nominal run's again)."""
+    runs = []
+    for conditions in ("ideal", "automotive"):
+        for controller, cte in (("clothoid", 0.08), ("nmpc", 0.04)):
+            runs.append(dataclasses.replace(_run(breakdown, "dlc", "nominal", controller, cte), conditions=conditions))
+    for controller, cte in (("clothoid", 0.06), ("nmpc", 0.04)):
+        perfect = _run(breakdown, "dlc", "perfect_prediction", controller, cte)
+        runs.append(dataclasses.replace(perfect, conditions="automotive"))
+    rows = {(row["conditions"], row["switch"]): row for row in breakdown.summary(runs)}
+    assert set(rows) == {("ideal", "nominal"), ("automotive", "nominal"), ("automotive", "perfect_prediction")}
+    assert rows[("automotive", "perfect_prediction")]["median_gap_closed"] == pytest.approx(0.5)
+
+
 def test_the_result_records_the_machine_and_the_date(breakdown) -> None:
     from benchmark_report import machine
 
