@@ -331,7 +331,7 @@ class Simulation:
         if getattr(vehicle, "road_friction", 1.0) != friction:
             vehicle.set_road_friction(friction)
         seen = not conditions.is_ideal
-        ahead = cfg.perfect_prediction and actuator is not None
+        ahead = actuator if cfg.perfect_prediction else None  # the actuator whose pending commands it applies
         speed_gains = PISpeedGains()
         settings = run_settings(  # the kernels' constants and the PI speed controller's state
             cfg.max_past_end_m, cfg.max_abs_cte_m, total_length, dt, cfg.speed_feedforward, speed_gains
@@ -368,9 +368,9 @@ class Simulation:
             if where:
                 status, message = _projection_end(where, foot.tolist(), t, cfg)
                 break
-            if ahead:  # the true state one dead time on, the commands already sent applied (SimulationConfig)
+            if ahead is not None:  # the true state one dead time on, the commands already sent applied
                 future = state
-                for segment_substeps, command in actuator.segments_ahead():
+                for segment_substeps, command in ahead.segments_ahead():
                     segment_s = dt * segment_substeps / substeps
                     future = advance(future, command, accel_cmd, segment_s, segment_substeps)
                 x, y, yaw, vx, vy, yaw_rate, steer_wheel = measured(outputs(future, command, accel_cmd))
