@@ -368,13 +368,14 @@ class Simulation:
             if where:
                 status, message = _projection_end(where, foot.tolist(), t, cfg)
                 break
+            measurement = Measurement(t, x, y, vx, vy, yaw, yaw_rate, steer_wheel)
             if ahead is not None:  # the true state one dead time on, the commands already sent applied
                 future = state
                 for segment_substeps, command in ahead.segments_ahead():
                     segment_s = dt * segment_substeps / substeps
                     future = advance(future, command, accel_cmd, segment_s, segment_substeps)
-                x, y, yaw, vx, vy, yaw_rate, steer_wheel = measured(outputs(future, command, accel_cmd))
-            measurement = Measurement(t, x, y, vx, vy, yaw, yaw_rate, steer_wheel)
+                fx, fy, fyaw, fvx, fvy, fyaw_rate, fsteer = measured(outputs(future, command, accel_cmd))
+                measurement = Measurement(t, fx, fy, fvx, fvy, fyaw, fyaw_rate, fsteer)  # the speed loop keeps vx, vy
             if sensors is not None:
                 measurement = sensors.measure(measurement)
             start = clock()

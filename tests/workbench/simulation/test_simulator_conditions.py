@@ -129,6 +129,16 @@ def test_perfect_prediction_hands_the_controller_the_true_state_one_dead_time_on
     assert np.ptp(trace["yaw_rate_rad_s"]) > 0.1  # the check is on a run that steers
 
 
+def test_perfect_prediction_leaves_the_speed_loop_and_the_trace_on_the_true_state() -> None:
+    """Braking for the lane change (the profile's 0.3 g), the speed the trace logs and the speed controller holds
+    is the plant's now, not the one a dead time ahead the steering controller is handed."""
+    trace = _run(DEAD, perfect_prediction=True).trace
+    assert np.ptp(trace["accel_cmd_mps2"]) > 1.0  # it brakes and accelerates
+    assert np.allclose(trace["speed_mps"], np.hypot(trace["vx_mps"], trace["vy_mps"]), rtol=0, atol=1e-12)
+    seen = np.hypot(trace["seen_vx_mps"], trace["seen_vy_mps"])
+    assert np.max(np.abs(seen - trace["speed_mps"])) > 0.05  # what the controller saw was ahead
+
+
 def test_perfect_prediction_takes_the_dead_time_out_of_the_loop() -> None:
     """With the dead time perfectly predicted the loop is the delay-free one: pure pursuit's max |CTE| on the dlc
     (at a held speed, the lateral bound lifted) is the ideal run's to a millimetre, where the same dead time
