@@ -373,14 +373,21 @@ def test_the_rate_limit_ramps_the_delayed_command() -> None:
     assert down == [(SUBSTEPS, pytest.approx(1.0 - rate * DT, abs=1e-12))]
 
 
+#: An actuator's dead time (s), plant substeps per controller step, controller step (s), rate limit (rad/s; None:
+#: the plant's own) and the steering before the first command (rad), for the property tests.
+ACTUATORS = {
+    "dead_time_s": st.floats(0.0, 0.2),
+    "substeps": st.integers(1, 25),
+    "sample_time_s": st.sampled_from([0.01, 0.02, 0.05]),
+    "rate": st.one_of(st.none(), st.floats(0.1, 50.0)),
+    "initial": st.floats(-5.0, 5.0),
+}
+
+
 @settings(max_examples=150, deadline=None)
 @given(
     commands=st.lists(st.floats(-10.0, 10.0), min_size=1, max_size=40),
-    dead_time_s=st.floats(0.0, 0.2),
-    substeps=st.integers(1, 25),
-    sample_time_s=st.sampled_from([0.01, 0.02, 0.05]),
-    rate=st.one_of(st.none(), st.floats(0.1, 50.0)),
-    initial=st.floats(-5.0, 5.0),
+    **ACTUATORS,
 )
 def test_the_actuator_keeps_the_order_and_never_exceeds_its_rate(
     commands, dead_time_s, substeps, sample_time_s, rate, initial
@@ -419,11 +426,7 @@ def test_the_actuator_keeps_the_order_and_never_exceeds_its_rate(
 @given(
     sent=st.lists(st.floats(-10.0, 10.0), min_size=0, max_size=30),
     later=st.lists(st.floats(-10.0, 10.0), min_size=22, max_size=22),  # 0.2 s at 0.01 s and two more
-    dead_time_s=st.floats(0.0, 0.2),
-    substeps=st.integers(1, 25),
-    sample_time_s=st.sampled_from([0.01, 0.02, 0.05]),
-    rate=st.one_of(st.none(), st.floats(0.1, 50.0)),
-    initial=st.floats(-5.0, 5.0),
+    **ACTUATORS,
 )
 def test_the_segments_ahead_are_what_the_plant_gets_over_the_next_dead_time(
     sent, later, dead_time_s, substeps, sample_time_s, rate, initial
