@@ -2,8 +2,7 @@
 
 from __future__ import annotations
 
-import dataclasses
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from workbench.base.errors import WorkbenchInputError, require_in_range, require_positive, value_text
 from workbench.simulation.conditions import CONDITIONS, Conditions
@@ -100,7 +99,7 @@ class SimulationConfig:
         if not self.inform_delays:
             return None
         delays = KnownDelays.from_conditions(self.conditions)
-        return dataclasses.replace(delays, dead_time_s=0.0) if self.perfect_prediction else delays
+        return replace(delays, dead_time_s=0.0) if self.perfect_prediction else delays
 
     @property
     def substeps(self) -> int:

@@ -336,14 +336,15 @@ class ActuatorModel:
         return out
 
     def _delayed(self, k: int, substeps: int) -> tuple[tuple[int, float], ...]:
-        """The commands that reach the plant over the first `substeps` plant steps of controller step k, before
-        the rate limit: those sent dead_time_substeps earlier (the dead time honoured to the plant's step)."""
+        """The commands that reach the plant over the first `substeps` (at least the dead time's part of a step)
+        plant steps of controller step k, before the rate limit: those sent dead_time_substeps earlier (the dead
+        time honoured to the plant's step)."""
         history, whole, part = self._history, self._whole, self._part
         size = len(history)
         late = history[(k - whole) % size]
         if not part:
             return ((substeps, late),)
-        early = (min(part, substeps), history[(k - whole - 1) % size])
+        early = (part, history[(k - whole - 1) % size])
         return (early, (substeps - part, late)) if substeps > part else (early,)
 
     def _limited(
