@@ -2,7 +2,10 @@
 
 Every run is at 30 km/h, once under the `ideal` conditions and once under `automotive` with each controller told
 the conditions' nominal delays (`SimulationConfig(inform_delays=True)`, the controller built by `tuned_controller`
-with `KnownDelays.from_conditions`, as `workbench run --inform-delays` builds it; the conditions' noise seed 0).
+with `KnownDelays.from_conditions`, as `workbench run --inform-delays` builds it). Conditions whose sensing is not
+ideal run once per noise seed (`SimulationConfig.seed`, 0 to `--noise-seeds` - 1, NOISE_SEEDS by default): a goal
+met on one draw of the noise can be missed on the next, so each seed's pair of runs carries its goals. The
+`ideal` conditions (no noise: the seed is not used) run once.
 Scenarios: dlc, figure8, fig17, zandvoort (the third-party track file) and two sets of generated circuits
 (`circuit:SEED`, the default circuit ranges):
 
@@ -15,13 +18,13 @@ the whole run's for a run started on the path and the tracking after the approac
 
 Goals (`--check` exits 1 when one is missed; each is printed with its value and bound):
 
-- on the goal vehicles (the loaded tractor-semitrailer and the dynamic-bicycle car), under both conditions, on
-  every scenario and circuit: the clothoid run completes; its max |CTE| is at most max(1.5 x the NMPC's, the
+- on the goal vehicles (the loaded tractor-semitrailer and the dynamic-bicycle car), under both conditions (each
+  noise seed's pair of runs), on every scenario and circuit: the clothoid run completes; its max |CTE| is at most max(1.5 x the NMPC's, the
   NMPC's + 0.02 m) on the same run; no limit cycle; steer oscillation at most max(3 deg, 1.5 x the NMPC's); RMS
   steering-wheel rate at most 1.5 x the NMPC's; on fig17, |CTE| within 0.1 m after at most 1.5 x the NMPC's
   distance;
-- the median ratio clothoid / NMPC max |CTE| over the held-out circuits at most 1.3 on the truck, under each
-  conditions (checked only when the held-out set is run);
+- the median ratio clothoid / NMPC max |CTE| over the held-out circuits (and noise seeds) at most 1.3 on the truck,
+  under each conditions (checked only when the held-out set is run);
 - the clothoid step's median at most 20 us on the truck's dlc (ideal), measured as benchmarks/run.py measures it:
   a whole run's step_time_median_us after an untimed run, the least of 3 runs, in this process after the pool's
   runs have finished;
@@ -38,7 +41,7 @@ JSON.
 
     python benchmarks/steering.py [--out benchmarks/results/steering.json] [--track ZANDVOORT.csv]
         [--vehicles a,b] [--conditions ideal,automotive] [--scenarios dlc,figure8,fig17,zandvoort,development,held-out]
-        [--no-held-out] [--quick] [--workers 2] [--markdown] [--check]
+        [--no-held-out] [--quick] [--noise-seeds N] [--workers 2] [--markdown] [--check]
 """
 
 from __future__ import annotations
@@ -90,6 +93,8 @@ CTE_RATIO, CTE_MARGIN_M = 1.5, 0.02
 #: The median clothoid / NMPC max |CTE| over the held-out circuits, on the truck, at most this.
 HELD_OUT_MEDIAN_RATIO = 1.3
 OSCILLATION_RATIO, OSCILLATION_FLOOR_DEG, RATE_RATIO, CONVERGE_RATIO = 1.5, 3.0, 1.5, 1.5
+#: Noise seeds (0 to NOISE_SEEDS - 1) each run under conditions whose sensing is not ideal; `--quick`: the first.
+NOISE_SEEDS = 3
 #: The clothoid step's median (us) on the truck's dlc, at most this; timed over this many whole runs.
 STEP_GOAL_US, STEP_RUNS = 20.0, 3
 #: Absolute max |CTE| bounds (m) under `ideal`, by (vehicle, scenario), kept beside the relative bound.
@@ -108,7 +113,7 @@ _VEHICLE_COST = {"commonroad-mb": 5.0, "tractor-semitrailer": 1.5}
 @dataclass(frozen=True)
 class Job:
     """One run: a vehicle, the conditions' name, a scenario (a name or circuit:SEED), the set it belongs to, the
-    controller and the track file (None: none)."""
+    controller, the track file (None: none) and the conditions' noise seed."""
 
     vehicle: str
     conditions: str
@@ -116,6 +121,7 @@ class Job:
     scenario_set: str
     controller: str
     track: str | None = None
+    noise_seed: int = 0
 
     @property
     def cost(self) -> float:
@@ -140,6 +146,7 @@ class Run:
     converge_distance_m: float
     wall_s: float
     excluded_reason: str = ""
+    noise_seed: int = 0
 
 
 @dataclass(frozen=True)
@@ -166,20 +173,28 @@ def circuit_scenarios(sets: tuple[str, ...], quick: bool = False) -> list[tuple[
     return out
 
 
+def noise_seeds_of(conditions: str, noise_seeds: int) -> range:
+    """The noise seeds a run under `conditions` is made with: 0 to noise_seeds - 1 where its sensing is not ideal
+    (the seed drives only the sensor model), else 0 alone."""
+    return range(1 if CONDITIONS[conditions].sensing_is_ideal else noise_seeds)
+
+
 def plan(vehicles: tuple[str, ...], conditions: tuple[str, ...], scenarios: tuple[str, ...], track: str | None,
-         held_out: bool = True, quick: bool = False) -> list[Job]:  # fmt: skip
+         held_out: bool = True, quick: bool = False, noise_seeds: int = NOISE_SEEDS) -> list[Job]:  # fmt: skip
     """Every run, both controllers, the longest first. `held_out` False (or `quick`) leaves the held-out circuits
-    out; `quick` narrows to QUICK_SEEDS, QUICK_SCENARIOS and QUICK_VEHICLES; a vehicle of REPORTED_ONLY_CONDITIONS
-    runs under those conditions only. zandvoort needs `track`."""
+    out; `quick` narrows to QUICK_SEEDS, QUICK_SCENARIOS and QUICK_VEHICLES, and to noise seed 0; a vehicle of
+    REPORTED_ONLY_CONDITIONS runs under those conditions only; `noise_seeds`: `noise_seeds_of`. zandvoort needs
+    `track`."""
     sets = tuple(s for s in (DEVELOPMENT, HELD_OUT) if s in scenarios and (held_out or s != HELD_OUT))
     named = [s for s in NAMED_SCENARIOS if s in scenarios and (not quick or s in QUICK_SCENARIOS)]
     pairs = [(s, NAMED) for s in named if s != "zandvoort" or track] + circuit_scenarios(sets, quick)
     chosen = [v for v in vehicles if not quick or v in QUICK_VEHICLES]
     jobs = [
-        Job(v, c, s, scenario_set, controller, track if s == "zandvoort" else None)
+        Job(v, c, s, scenario_set, controller, track if s == "zandvoort" else None, seed)
         for v in chosen
         for c in conditions
         if c in REPORTED_ONLY_CONDITIONS.get(v, (c,))
+        for seed in noise_seeds_of(c, 1 if quick else noise_seeds)
         for s, scenario_set in pairs
         for controller in ("clothoid", "nmpc")
     ]
@@ -189,7 +204,9 @@ def plan(vehicles: tuple[str, ...], conditions: tuple[str, ...], scenarios: tupl
 def _simulation(job: Job) -> Simulation:
     vehicle = make_vehicle(job.vehicle)
     told = job.conditions != "ideal"  # ideal has no delay to tell: its controllers are built as `workbench run`'s
-    config = SimulationConfig(speed_kmh=SPEED_KMH, conditions=CONDITIONS[job.conditions], inform_delays=told)
+    config = SimulationConfig(
+        speed_kmh=SPEED_KMH, conditions=CONDITIONS[job.conditions], inform_delays=told, seed=job.noise_seed
+    )
     delays = config.known_delays
     controller = tuned_controller(job.controller, vehicle, None, delays)
     options = ScenarioOptions(vehicle.geometry.width_m, Path(job.track) if job.track else None)
@@ -203,7 +220,8 @@ def run_one(job: Job) -> Run:
     warnings = simulation.path_warnings()
     if warnings:
         nan = math.nan
-        return Run(*head, "excluded", nan, nan, nan, False, "-", nan, 0.0, "; ".join(dict.fromkeys(warnings)))
+        reason = "; ".join(dict.fromkeys(warnings))
+        return Run(*head, "excluded", nan, nan, nan, False, "-", nan, 0.0, reason, noise_seed=job.noise_seed)
     start = time.perf_counter()
     result = simulation.run()
     m, trace = result.metrics, result.trace
@@ -212,6 +230,7 @@ def run_one(job: Job) -> Run:
         *head, result.status.value, _number(m.max_abs_cte_on_path_m), _number(m.steer_oscillation_deg),
         _number(m.rms_steer_rate_deg_s), bool(m.limit_cycle), cycle,
         converge_distance_m(trace["progress_m"], trace["cte_m"]), time.perf_counter() - start,
+        noise_seed=job.noise_seed,
     )  # fmt: skip
 
 
@@ -224,7 +243,7 @@ def run_all(jobs: list[Job], workers: int) -> list[Run]:
         for k, future in enumerate(as_completed(futures), 1):
             r = future.result()
             so_far = time.perf_counter() - start
-            line = f"[{k}/{len(jobs)}] {r.vehicle} {r.conditions} {r.scenario} {r.controller}: {r.status}"
+            line = f"[{k}/{len(jobs)}] {_where(r)} {r.controller}: {r.status}"
             print(f"{line}, {r.wall_s:.1f} s ({so_far:.0f} s so far)", file=sys.stderr, flush=True)
         return [future.result() for future in sorted(futures, key=futures.get)]
 
@@ -299,7 +318,7 @@ def step_time_us(track: str | None = None) -> float:
 
 @dataclass(frozen=True)
 class Pair:
-    """The clothoid and NMPC runs of one vehicle, conditions and scenario, with their goals."""
+    """The clothoid and NMPC runs of one vehicle, conditions, scenario and noise seed, with their goals."""
 
     clothoid: Run
     reference: Run
@@ -319,22 +338,22 @@ class Pair:
 
 
 def pairs_of(runs: list[Run]) -> list[Pair]:
-    """The runs paired by (vehicle, conditions, scenario), in the order of their clothoid runs, with their goals
-    (none for an excluded pair)."""
-    by_key = {(r.vehicle, r.conditions, r.scenario, r.controller): r for r in runs}
+    """The runs paired by (vehicle, conditions, scenario, noise seed), in the order of their clothoid runs, with their
+    goals (none for an excluded pair)."""
+    by_key = {(*_pair_key(r), r.controller): r for r in runs}
     out = []
     for r in runs:
         if r.controller != "clothoid":
             continue
-        ref = by_key[(r.vehicle, r.conditions, r.scenario, "nmpc")]
+        ref = by_key[(*_pair_key(r), "nmpc")]
         excluded = "excluded" in (r.status, ref.status)
         out.append(Pair(r, ref, () if excluded else tuple(goals(r, ref))))
     return out
 
 
 def summary_rows(pairs: list[Pair]) -> list[dict]:
-    """Per (vehicle, conditions, set): pairs run and excluded, the median and worst max |CTE| ratio, goals met and
-    missed."""
+    """Per (vehicle, conditions, set): pairs run and excluded (a pair per noise seed), the median and worst max |CTE|
+    ratio, goals met and missed."""
     groups: dict[tuple[str, str, str], list[Pair]] = {}
     for p in pairs:
         groups.setdefault((p.clothoid.vehicle, p.clothoid.conditions, p.clothoid.scenario_set), []).append(p)
@@ -380,16 +399,28 @@ def summary_text(rows: list[dict], markdown: bool = False) -> str:
     return "\n".join("  ".join(c.ljust(w) for c, w in zip(row, widths, strict=True)) for row in [heads, *body])
 
 
+def _where(run: Run) -> str:
+    """'vehicle conditions scenario', with ' noise seed N' under conditions whose sensing is not ideal."""
+    seeded = not CONDITIONS[run.conditions].sensing_is_ideal
+    return f"{run.vehicle} {run.conditions} {run.scenario}" + (f" noise seed {run.noise_seed}" if seeded else "")
+
+
+def _label(run: Run) -> str:
+    """The scenario column: the scenario, '#N' after it for noise seed N under conditions whose sensing is not
+    ideal."""
+    return run.scenario + ("" if CONDITIONS[run.conditions].sensing_is_ideal else f" #{run.noise_seed}")
+
+
 def _pair_line(p: Pair) -> str:
     c, ref = p.clothoid, p.reference
     if p.excluded:
         return (
-            f"{c.vehicle:<20} {c.conditions:<10} {c.scenario:<13} excluded: {c.excluded_reason or ref.excluded_reason}"
+            f"{c.vehicle:<20} {c.conditions:<10} {_label(c):<16} excluded: {c.excluded_reason or ref.excluded_reason}"
         )
     verdict = "-" if not p.goals else ("met" if not p.missed else f"MISSED {len(p.missed)}/{len(p.goals)}")
     status = "" if c.status == ref.status == "completed" else f"  ({c.status} / {ref.status})"
     return (
-        f"{c.vehicle:<20} {c.conditions:<10} {c.scenario:<13} {c.max_abs_cte_m:7.3f} {ref.max_abs_cte_m:7.3f} "
+        f"{c.vehicle:<20} {c.conditions:<10} {_label(c):<16} {c.max_abs_cte_m:7.3f} {ref.max_abs_cte_m:7.3f} "
         f"{p.ratio:6.2f} {c.steer_oscillation_deg:6.1f} {ref.steer_oscillation_deg:6.1f} {c.rms_steer_rate_deg_s:7.1f} "
         f"{ref.rms_steer_rate_deg_s:7.1f}  {c.limit_cycle_text:<15} {verdict}{status}"
     )
@@ -404,6 +435,8 @@ def _arguments(argv: list[str] | None) -> argparse.Namespace:
     parser.add_argument("--scenarios", default=",".join(SCENARIO_CHOICES), help="named scenarios and circuit sets")
     parser.add_argument("--no-held-out", action="store_true", help="leave the held-out circuits out (iterating)")
     parser.add_argument("--quick", action="store_true", help="a subset for iterating; no held-out circuit")
+    parser.add_argument("--noise-seeds", type=int, default=NOISE_SEEDS,
+                        help="noise seeds per run under noisy conditions (0 to N - 1; --quick: 0)")  # fmt: skip
     parser.add_argument("--workers", type=int, default=os.cpu_count() or 1)
     parser.add_argument("--markdown", action="store_true", help="print the summary as a markdown table")
     parser.add_argument("--check", action="store_true", help="exit 1 if a goal is missed")
@@ -416,6 +449,8 @@ def _arguments(argv: list[str] | None) -> argparse.Namespace:
         setattr(args, option, names)
     if args.workers < 1:
         parser.error(f"--workers must be a whole number >= 1; got {args.workers}")
+    if args.noise_seeds < 1:
+        parser.error(f"--noise-seeds must be a whole number >= 1; got {args.noise_seeds}")
     if args.track is not None and not args.track.is_file():
         parser.error(f"--track: no file at {args.track}")
     return args
@@ -426,14 +461,12 @@ def main(argv: list[str] | None = None) -> int:
     track = args.track or (Path(os.environ[ZANDVOORT_ENV]) if os.environ.get(ZANDVOORT_ENV) else DEFAULT_TRACK)
     track_file = str(track) if track.is_file() else None
     held_out = not (args.no_held_out or args.quick)
-    jobs = plan(args.vehicles, args.conditions, args.scenarios, track_file, held_out=held_out, quick=args.quick)
+    jobs = plan(args.vehicles, args.conditions, args.scenarios, track_file, held_out, args.quick, args.noise_seeds)
     start = time.perf_counter()
     runs = run_all(jobs, args.workers)
     pool_wall = time.perf_counter() - start
-    order = {(j.vehicle, j.conditions, j.scenario): i for i, j in enumerate(sorted(jobs, key=_table_order))}
-    pairs = sorted(
-        pairs_of(runs), key=lambda p: order[(p.clothoid.vehicle, p.clothoid.conditions, p.clothoid.scenario)]
-    )
+    order = {_pair_key(j): i for i, j in enumerate(sorted(jobs, key=_table_order))}
+    pairs = sorted(pairs_of(runs), key=lambda p: order[_pair_key(p.clothoid)])
 
     print(f"development circuits: seeds {DEVELOPMENT_SEEDS[0]}-{DEVELOPMENT_SEEDS[-1]} (may be looked at while "
           f"changing the controller); held-out circuits: seeds {HELD_OUT_SEEDS[0]}-{HELD_OUT_SEEDS[-1]} (run only to "
@@ -441,7 +474,10 @@ def main(argv: list[str] | None = None) -> int:
     if "zandvoort" in args.scenarios and not track_file and (not args.quick):
         print(f"zandvoort skipped: no track file at {track} (--track or ${ZANDVOORT_ENV})")
     print(f"max |CTE| (m) and steering at {SPEED_KMH:g} km/h, clothoid (c) against the NMPC (n); ratio = c / n")
-    print(f"{'vehicle':<20} {'conditions':<10} {'scenario':<13} {'c CTE':>7} {'n CTE':>7} {'ratio':>6} {'c osc':>6} "
+    seeds = 1 if args.quick else args.noise_seeds
+    print(f"noise seeds under conditions whose sensing is not ideal: 0-{seeds - 1} (#N after the scenario); each "
+          "seed's pair carries its goals")  # fmt: skip
+    print(f"{'vehicle':<20} {'conditions':<10} {'scenario':<16} {'c CTE':>7} {'n CTE':>7} {'ratio':>6} {'c osc':>6} "
           f"{'n osc':>6} {'c rate':>7} {'n rate':>7}  {'c limit cycle':<15} goals")  # fmt: skip
     for p in pairs:
         print(_pair_line(p))
@@ -458,8 +494,7 @@ def main(argv: list[str] | None = None) -> int:
         goal = Goal("clothoid step median (us), dlc, as benchmarks/run.py times it", step_us, STEP_GOAL_US,
                     step_us <= STEP_GOAL_US)  # fmt: skip
         set_goals.append((f"{TRUCK} ideal", goal))
-    missed = [f"{p.clothoid.vehicle} {p.clothoid.conditions} {p.clothoid.scenario}: {g.line()}"
-              for p in pairs for g in p.missed]  # fmt: skip
+    missed = [f"{_where(p.clothoid)}: {g.line()}" for p in pairs for g in p.missed]
     missed += [f"{where}: {g.line()}" for where, g in set_goals if not g.met]
     print("\ngoals over a set and of compute:")
     for where, g in set_goals:
@@ -469,8 +504,7 @@ def main(argv: list[str] | None = None) -> int:
     if excluded:
         print(f"\n{len(excluded)} excluded (the feasibility check refuses the path at {SPEED_KMH:g} km/h):")
         for p in excluded:
-            print(f"  {p.clothoid.vehicle} {p.clothoid.conditions} {p.clothoid.scenario}: "
-                  f"{p.clothoid.excluded_reason or p.reference.excluded_reason}")  # fmt: skip
+            print(f"  {_where(p.clothoid)}: {p.clothoid.excluded_reason or p.reference.excluded_reason}")
     rows = summary_rows(pairs)
     print("\nsummary (ratio: clothoid / NMPC max |CTE|; goals met / missed):")
     print(summary_text(rows, markdown=args.markdown))
@@ -484,6 +518,7 @@ def main(argv: list[str] | None = None) -> int:
         "development_seeds": list(DEVELOPMENT_SEEDS),
         "held_out_seeds": list(HELD_OUT_SEEDS),
         "held_out_run": held_out,
+        "noise_seeds": seeds,
         "quick": args.quick,
         "pairs": [
             {
@@ -507,11 +542,16 @@ def main(argv: list[str] | None = None) -> int:
     return 1 if (args.check and missed) else 0
 
 
+def _pair_key(run: Job | Run) -> tuple[str, str, str, int]:
+    """What a pair of runs shares: (vehicle, conditions, scenario, noise seed)."""
+    return run.vehicle, run.conditions, run.scenario, run.noise_seed
+
+
 def _table_order(job: Job) -> tuple:
     sets = (NAMED, DEVELOPMENT, HELD_OUT)
     named = NAMED_SCENARIOS.index(job.scenario) if job.scenario in NAMED_SCENARIOS else 0
     return (VEHICLES.index(job.vehicle), CONDITION_NAMES.index(job.conditions), sets.index(job.scenario_set), named,
-            job.scenario)  # fmt: skip
+            job.scenario, job.noise_seed)  # fmt: skip
 
 
 if __name__ == "__main__":

@@ -1,5 +1,6 @@
 """benchmarks/steering.py without simulations: the development and held-out circuit sets kept apart (and the
-held-out one left out by --no-held-out and --quick), and the goal arithmetic on constructed pairs of runs."""
+held-out one left out by --no-held-out and --quick), the noise seeds of noisy conditions, and the goal arithmetic on
+constructed pairs of runs."""
 
 from __future__ import annotations
 
@@ -12,9 +13,9 @@ import pytest
 
 def _run(steering, controller: str, cte_m: float, *, vehicle: str = "tractor-semitrailer", scenario: str = "dlc",
          scenario_set: str = "named", conditions: str = "ideal", osc: float = 1.0, rate: float = 10.0,
-         converge: float = 5.0, status: str = "completed", limit_cycle: bool = False):  # fmt: skip
+         converge: float = 5.0, status: str = "completed", limit_cycle: bool = False, noise_seed: int = 0):  # fmt: skip
     return steering.Run(vehicle, conditions, scenario, scenario_set, controller, status, cte_m, osc, rate,
-                        limit_cycle, "no", converge, 0.1)  # fmt: skip
+                        limit_cycle, "no", converge, 0.1, noise_seed=noise_seed)  # fmt: skip
 
 
 CTE = "max |CTE| (m) <= max(1.5 x, +0.02 m) NMPC's"
@@ -114,7 +115,8 @@ def _fake_runs(steering, ratio: float):
     def run_all(jobs, workers):
         cte = {"clothoid": 0.1 * ratio, "nmpc": 0.1}
         return [_run(steering, j.controller, cte[j.controller], vehicle=j.vehicle, scenario=j.scenario,
-                     scenario_set=j.scenario_set, conditions=j.conditions) for j in jobs]  # fmt: skip
+                     scenario_set=j.scenario_set, conditions=j.conditions, noise_seed=j.noise_seed)
+                for j in jobs]  # fmt: skip
 
     return run_all
 
@@ -174,3 +176,41 @@ def test_the_result_records_the_machine_and_the_date(steering, monkeypatch, tmp_
     assert document["machine"]["platform"] == here["platform"] and document["machine"]["cpus"] == here["cpus"]
     assert document["machine"]["python"] == here["python"]
     assert before <= document["created_unix_s"] <= time.time()
+
+
+def test_noisy_conditions_run_once_per_noise_seed_each_judged(steering, monkeypatch, tmp_path, capsys) -> None:
+    """automotive (noisy sensing) runs on noise seeds 0..N-1, ideal (no noise) once; each seed's clothoid run is
+    judged against the NMPC's on the same seed, and a miss on one seed alone fails the check, naming the seed."""
+    both = ("ideal", "automotive")
+    jobs = steering.plan(("tractor-semitrailer",), both, ("fig17",), None, noise_seeds=3)
+    seeds = {(j.conditions, j.noise_seed) for j in jobs}
+    assert seeds == {("ideal", 0), ("automotive", 0), ("automotive", 1), ("automotive", 2)} and len(jobs) == 8
+    quick = steering.plan(("tractor-semitrailer",), both, ("dlc",), None, quick=True, noise_seeds=3)
+    assert {j.noise_seed for j in quick} == {0}
+
+    def run_all(jobs, workers):  # the NMPC at 0.1 m + 0.1 m per seed; the clothoid 1.4 x it, 1.6 x on seed 2
+        def cte(j):
+            nmpc = 0.1 * (1 + j.noise_seed)
+            return nmpc if j.controller == "nmpc" else nmpc * (1.6 if j.noise_seed == 2 else 1.4)
+
+        return [_run(steering, j.controller, cte(j), scenario=j.scenario, conditions=j.conditions,
+                     noise_seed=j.noise_seed) for j in jobs]  # fmt: skip
+
+    monkeypatch.setattr(steering, "run_all", run_all)
+    out = tmp_path / "s.json"
+    argv = ["--vehicles", "tractor-semitrailer", "--scenarios", "fig17", "--noise-seeds", "3", "--out", str(out)]
+    assert steering.main([*argv, "--conditions", "automotive", "--check"]) == 1
+    document = json.loads(out.read_text())
+    assert document["noise_seeds"] == 3
+    paired = [(p["clothoid"]["noise_seed"], p["nmpc"]["noise_seed"]) for p in document["pairs"]]
+    assert paired == [(0, 0), (1, 1), (2, 2)]
+    assert [p["ratio"] for p in document["pairs"]] == pytest.approx([1.4, 1.4, 1.6], abs=1e-12)
+    (miss,) = document["missed"]
+    assert miss.startswith("tractor-semitrailer automotive fig17 noise seed 2: max |CTE|")
+    assert "fig17 #2" in capsys.readouterr().out
+    assert steering.main([*argv, "--conditions", "automotive", "--noise-seeds", "2", "--check"]) == 0
+    assert steering.main([*argv, "--conditions", "ideal", "--check"]) == 0  # the ideal run once, seed 0: met
+    assert [p["clothoid"]["noise_seed"] for p in json.loads(out.read_text())["pairs"]] == [0]
+    with pytest.raises(SystemExit):
+        steering.main([*argv, "--noise-seeds", "0"])
+    assert "--noise-seeds must be a whole number >= 1; got 0" in capsys.readouterr().err
