@@ -19,15 +19,15 @@ the whole run's for a run started on the path and the tracking after the approac
 Goals (`--check` exits 1 when one is missed; each is printed with its value and bound):
 
 - on the goal vehicles (the loaded tractor-semitrailer and the dynamic-bicycle car), under both conditions (each
-  noise seed's pair of runs), on every scenario and circuit: the clothoid run completes; its max |CTE| is at most max(1.5 x the NMPC's, the
-  NMPC's + 0.02 m) on the same run; no limit cycle; steer oscillation at most max(3 deg, 1.5 x the NMPC's); RMS
-  steering-wheel rate at most 1.5 x the NMPC's; on fig17, |CTE| within 0.1 m after at most 1.5 x the NMPC's
-  distance;
+  noise seed's pair of runs), on every scenario and circuit: the clothoid run completes; its max |CTE| is at most
+  max(1.5 x the NMPC's, the NMPC's + 0.02 m) on the same run; no limit cycle; steer oscillation at most max(3 deg,
+  1.5 x the NMPC's); RMS steering-wheel rate at most 1.5 x the NMPC's; on fig17, |CTE| within 0.1 m after at most
+  1.5 x the NMPC's distance;
 - the median ratio clothoid / NMPC max |CTE| over the held-out circuits (and noise seeds) at most 1.3 on the truck,
   under each conditions (checked only when the held-out set is run);
 - the clothoid step's median at most 20 us on the truck's dlc (ideal), measured as benchmarks/run.py measures it:
-  a whole run's step_time_median_us after an untimed run, the least of 3 runs, in this process after the pool's
-  runs have finished;
+  a whole run's step_time_median_us after an untimed run, the least of 5 runs, in this process before the pool
+  starts (on this 2-core machine twenty minutes of both cores busy slowed it from about 18 to 30 us);
 - kept as they were: under `ideal` on dlc, figure8, fig17 and zandvoort, the steering goals (no limit cycle,
   oscillation, RMS rate) and fig17's convergence distance on the kinematic-bicycle and commonroad-mb cars too, and
   the absolute max |CTE| bounds of `ABSOLUTE_CTE_GOALS_M` on the truck and the car. On the truck and the car the
@@ -95,8 +95,9 @@ HELD_OUT_MEDIAN_RATIO = 1.3
 OSCILLATION_RATIO, OSCILLATION_FLOOR_DEG, RATE_RATIO, CONVERGE_RATIO = 1.5, 3.0, 1.5, 1.5
 #: Noise seeds (0 to NOISE_SEEDS - 1) each run under conditions whose sensing is not ideal; `--quick`: the first.
 NOISE_SEEDS = 3
-#: The clothoid step's median (us) on the truck's dlc, at most this; timed over this many whole runs.
-STEP_GOAL_US, STEP_RUNS = 20.0, 3
+#: The clothoid step's median (us) on the truck's dlc, at most this; timed over this many whole runs, the least
+#: taken (a shared machine's interference only adds time: the same code measured 20 to 33 us minutes apart).
+STEP_GOAL_US, STEP_RUNS = 20.0, 5
 #: Absolute max |CTE| bounds (m) under `ideal`, by (vehicle, scenario), kept beside the relative bound.
 ABSOLUTE_CTE_GOALS_M = {
     ("tractor-semitrailer", "dlc"): 0.08,
@@ -462,6 +463,8 @@ def main(argv: list[str] | None = None) -> int:
     track_file = str(track) if track.is_file() else None
     held_out = not (args.no_held_out or args.quick)
     jobs = plan(args.vehicles, args.conditions, args.scenarios, track_file, held_out, args.quick, args.noise_seeds)
+    timed = TRUCK in args.vehicles and "ideal" in args.conditions and "dlc" in args.scenarios
+    step_us = step_time_us() if timed else math.nan  # before the pool: not on a machine its load has slowed
     start = time.perf_counter()
     runs = run_all(jobs, args.workers)
     pool_wall = time.perf_counter() - start
@@ -488,9 +491,7 @@ def main(argv: list[str] | None = None) -> int:
             ratios = [p.ratio for p in pairs if not p.excluded and p.clothoid.vehicle == TRUCK
                       and p.clothoid.conditions == conditions and p.clothoid.scenario_set == HELD_OUT]  # fmt: skip
             set_goals.append((f"{TRUCK} {conditions}", held_out_goal(ratios)))
-    step_us = math.nan
-    if TRUCK in args.vehicles and "ideal" in args.conditions and "dlc" in args.scenarios:
-        step_us = step_time_us()
+    if timed:
         goal = Goal("clothoid step median (us), dlc, as benchmarks/run.py times it", step_us, STEP_GOAL_US,
                     step_us <= STEP_GOAL_US)  # fmt: skip
         set_goals.append((f"{TRUCK} ideal", goal))
