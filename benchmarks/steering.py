@@ -174,10 +174,16 @@ def circuit_scenarios(sets: tuple[str, ...], quick: bool = False) -> list[tuple[
     return out
 
 
+def is_noisy(conditions: str) -> bool:
+    """Whether the seed changes a run under `conditions`: it drives only the sensor model, so where the sensing is
+    not ideal."""
+    return not CONDITIONS[conditions].sensing_is_ideal
+
+
 def noise_seeds_of(conditions: str, noise_seeds: int) -> range:
-    """The noise seeds a run under `conditions` is made with: 0 to noise_seeds - 1 where its sensing is not ideal
-    (the seed drives only the sensor model), else 0 alone."""
-    return range(1 if CONDITIONS[conditions].sensing_is_ideal else noise_seeds)
+    """The noise seeds a run under `conditions` is made with: 0 to noise_seeds - 1 where it `is_noisy`, else 0
+    alone."""
+    return range(noise_seeds if is_noisy(conditions) else 1)
 
 
 def plan(vehicles: tuple[str, ...], conditions: tuple[str, ...], scenarios: tuple[str, ...], track: str | None,
@@ -402,14 +408,14 @@ def summary_text(rows: list[dict], markdown: bool = False) -> str:
 
 def _where(run: Run) -> str:
     """'vehicle conditions scenario', with ' noise seed N' under conditions whose sensing is not ideal."""
-    seeded = not CONDITIONS[run.conditions].sensing_is_ideal
-    return f"{run.vehicle} {run.conditions} {run.scenario}" + (f" noise seed {run.noise_seed}" if seeded else "")
+    seed = f" noise seed {run.noise_seed}" if is_noisy(run.conditions) else ""
+    return f"{run.vehicle} {run.conditions} {run.scenario}{seed}"
 
 
 def _label(run: Run) -> str:
     """The scenario column: the scenario, '#N' after it for noise seed N under conditions whose sensing is not
     ideal."""
-    return run.scenario + ("" if CONDITIONS[run.conditions].sensing_is_ideal else f" #{run.noise_seed}")
+    return run.scenario + (f" #{run.noise_seed}" if is_noisy(run.conditions) else "")
 
 
 def _pair_line(p: Pair) -> str:
