@@ -189,9 +189,9 @@ def noise_seeds_of(conditions: str, noise_seeds: int) -> range:
 def plan(vehicles: tuple[str, ...], conditions: tuple[str, ...], scenarios: tuple[str, ...], track: str | None,
          held_out: bool = True, quick: bool = False, noise_seeds: int = NOISE_SEEDS) -> list[Job]:  # fmt: skip
     """Every run, both controllers, the longest first. `held_out` False (or `quick`) leaves the held-out circuits
-    out; `quick` narrows to QUICK_SEEDS, QUICK_SCENARIOS and QUICK_VEHICLES, and to noise seed 0; a vehicle of
-    REPORTED_ONLY_CONDITIONS runs under those conditions only; `noise_seeds`: `noise_seeds_of`. zandvoort needs
-    `track`."""
+    out; `quick` narrows to QUICK_SEEDS, QUICK_SCENARIOS and QUICK_VEHICLES (not the noise seeds:
+    `main` passes one for it); a vehicle of REPORTED_ONLY_CONDITIONS runs under those conditions only; `noise_seeds`:
+    `noise_seeds_of`. zandvoort needs `track`."""
     sets = tuple(s for s in (DEVELOPMENT, HELD_OUT) if s in scenarios and (held_out or s != HELD_OUT))
     named = [s for s in NAMED_SCENARIOS if s in scenarios and (not quick or s in QUICK_SCENARIOS)]
     pairs = [(s, NAMED) for s in named if s != "zandvoort" or track] + circuit_scenarios(sets, quick)
@@ -201,7 +201,7 @@ def plan(vehicles: tuple[str, ...], conditions: tuple[str, ...], scenarios: tupl
         for v in chosen
         for c in conditions
         if c in REPORTED_ONLY_CONDITIONS.get(v, (c,))
-        for seed in noise_seeds_of(c, 1 if quick else noise_seeds)
+        for seed in noise_seeds_of(c, noise_seeds)
         for s, scenario_set in pairs
         for controller in ("clothoid", "nmpc")
     ]
@@ -468,7 +468,8 @@ def main(argv: list[str] | None = None) -> int:
     track = args.track or (Path(os.environ[ZANDVOORT_ENV]) if os.environ.get(ZANDVOORT_ENV) else DEFAULT_TRACK)
     track_file = str(track) if track.is_file() else None
     held_out = not (args.no_held_out or args.quick)
-    jobs = plan(args.vehicles, args.conditions, args.scenarios, track_file, held_out, args.quick, args.noise_seeds)
+    seeds = 1 if args.quick else args.noise_seeds  # --quick: noise seed 0 alone
+    jobs = plan(args.vehicles, args.conditions, args.scenarios, track_file, held_out, args.quick, seeds)
     timed = TRUCK in args.vehicles and "ideal" in args.conditions and "dlc" in args.scenarios
     step_us = step_time_us() if timed else math.nan  # before the pool: not on a machine its load has slowed
     start = time.perf_counter()
@@ -483,7 +484,6 @@ def main(argv: list[str] | None = None) -> int:
     if "zandvoort" in args.scenarios and not track_file and (not args.quick):
         print(f"zandvoort skipped: no track file at {track} (--track or ${ZANDVOORT_ENV})")
     print(f"max |CTE| (m) and steering at {SPEED_KMH:g} km/h, clothoid (c) against the NMPC (n); ratio = c / n")
-    seeds = 1 if args.quick else args.noise_seeds
     print(f"noise seeds under conditions whose sensing is not ideal: 0-{seeds - 1} (#N after the scenario); each "
           "seed's pair carries its goals")  # fmt: skip
     print(f"{'vehicle':<20} {'conditions':<10} {'scenario':<16} {'c CTE':>7} {'n CTE':>7} {'ratio':>6} {'c osc':>6} "
