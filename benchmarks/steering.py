@@ -36,8 +36,9 @@ Goals (`--check` exits 1 when one is missed; each is printed with its value and 
 A run on a path its vehicle cannot follow at 30 km/h (`Simulation.path_warnings`, the feasibility check) is not
 run: it is reported as excluded, with the reason, never left out silently.
 
-Prints a table of every pair of runs, the missed goals and a summary per (vehicle, conditions, set), and writes
-JSON.
+Prints a table of every pair of runs, the missed goals (a max |CTE| miss with where along the run each controller's
+max is, and the clothoid run's speed and acceleration there) and a summary per (vehicle, conditions, set), and
+writes JSON.
 
     python benchmarks/steering.py [--out benchmarks/results/steering.json] [--track ZANDVOORT.csv]
         [--vehicles a,b] [--conditions ideal,automotive] [--scenarios dlc,figure8,fig17,zandvoort,development,held-out]
@@ -56,12 +57,14 @@ from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
+import numpy as np
 from benchmark_report import machine, write_results
 
 from tuning.own_tuning import tuned_controller
 from workbench.apps.comparison import converge_distance_m
 from workbench.simulation.circuits import circuit_name
 from workbench.simulation.conditions import CONDITIONS
+from workbench.simulation.metrics import approach_end
 from workbench.simulation.scenarios import ZANDVOORT_ENV, ScenarioOptions, make_scenario
 from workbench.simulation.simulator import Simulation, SimulationConfig
 from workbench.vehicles import make_vehicle
@@ -90,6 +93,8 @@ QUICK_SCENARIOS = ("dlc", "figure8")
 QUICK_VEHICLES = GOAL_VEHICLES
 #: max |CTE| at most max(CTE_RATIO x the NMPC's, the NMPC's + CTE_MARGIN_M) on the same run.
 CTE_RATIO, CTE_MARGIN_M = 1.5, 0.02
+#: The per-run max |CTE| goal, in words.
+CTE_GOAL = "max |CTE| (m) <= max(1.5 x, +0.02 m) NMPC's"
 #: The median clothoid / NMPC max |CTE| over the held-out circuits, on the truck, at most this.
 HELD_OUT_MEDIAN_RATIO = 1.3
 OSCILLATION_RATIO, OSCILLATION_FLOOR_DEG, RATE_RATIO, CONVERGE_RATIO = 1.5, 3.0, 1.5, 1.5
@@ -148,6 +153,9 @@ class Run:
     wall_s: float
     excluded_reason: str = ""
     noise_seed: int = 0
+    worst_at_m: float = math.nan  # m: how far along the run its max |CTE| (after the approach) is
+    worst_speed_kmh: float = math.nan  # km/h: the speed there
+    worst_accel_mps2: float = math.nan  # m/s^2: the speed's rate there (braking negative)
 
 
 @dataclass(frozen=True)
@@ -237,8 +245,25 @@ def run_one(job: Job) -> Run:
         *head, result.status.value, _number(m.max_abs_cte_on_path_m), _number(m.steer_oscillation_deg),
         _number(m.rms_steer_rate_deg_s), bool(m.limit_cycle), cycle,
         converge_distance_m(trace["progress_m"], trace["cte_m"]), time.perf_counter() - start,
-        noise_seed=job.noise_seed,
+        noise_seed=job.noise_seed, **worst_place(trace),
     )  # fmt: skip
+
+
+def worst_place(trace: dict[str, np.ndarray]) -> dict[str, float]:
+    """Where a run's max |CTE| after its approach is (`metrics.approach_end`, as max_abs_cte_on_path_m counts it)
+    and how the vehicle was driving there: `Run`'s worst_at_m (progress_m), worst_speed_kmh and worst_accel_mps2
+    (the speed's rate, central differences); NaN for a trace without samples. A miss says where to look."""
+    cte, t, speed = trace["cte_m"], trace["t_s"], trace["speed_mps"]
+    if cte.size == 0:
+        return {}
+    start = approach_end(cte)
+    i = start + int(np.argmax(np.abs(cte[start:])))
+    accel = np.gradient(speed, t)[i] if t.size > 1 else math.nan
+    return {
+        "worst_at_m": float(trace["progress_m"][i]),
+        "worst_speed_kmh": float(speed[i] * 3.6),
+        "worst_accel_mps2": float(accel),
+    }
 
 
 def run_all(jobs: list[Job], workers: int) -> list[Run]:
@@ -287,7 +312,7 @@ def goals(clothoid: Run, reference: Run) -> list[Goal]:
     out = [Goal("completed", float(clothoid.status == "completed"), 1.0, clothoid.status == "completed")]
     if goal_vehicle:
         bound = cte_bound_m(reference.max_abs_cte_m)
-        out.append(Goal("max |CTE| (m) <= max(1.5 x, +0.02 m) NMPC's", clothoid.max_abs_cte_m, bound,
+        out.append(Goal(CTE_GOAL, clothoid.max_abs_cte_m, bound,
                         clothoid.max_abs_cte_m <= bound))  # fmt: skip
     out.append(Goal("limit cycle", float(clothoid.limit_cycle), 0.0, not clothoid.limit_cycle))
     osc_bound = max(OSCILLATION_RATIO * reference.steer_oscillation_deg, OSCILLATION_FLOOR_DEG)
@@ -412,6 +437,19 @@ def _where(run: Run) -> str:
     return f"{run.vehicle} {run.conditions} {run.scenario}{seed}"
 
 
+def _miss_line(p: Pair, goal: Goal) -> str:
+    """A missed goal of pair p: where, the goal; for the max |CTE| goal, where along the run each controller's max
+    is and how the clothoid run was driving there (`worst_place`)."""
+    line = f"{_where(p.clothoid)}: {goal.line()}"
+    c, ref = p.clothoid, p.reference
+    if goal.text == CTE_GOAL and math.isfinite(c.worst_at_m):
+        line += (
+            f"; its max at {c.worst_at_m:.0f} m ({c.worst_speed_kmh:.1f} km/h, {c.worst_accel_mps2:+.1f} m/s^2), the "
+            f"NMPC's at {ref.worst_at_m:.0f} m"
+        )
+    return line
+
+
 def _label(run: Run) -> str:
     """The scenario column: the scenario, '#N' after it for noise seed N under conditions whose sensing is not
     ideal."""
@@ -501,7 +539,7 @@ def main(argv: list[str] | None = None) -> int:
         goal = Goal("clothoid step median (us), dlc, as benchmarks/run.py times it", step_us, STEP_GOAL_US,
                     step_us <= STEP_GOAL_US)  # fmt: skip
         set_goals.append((f"{TRUCK} ideal", goal))
-    missed = [f"{_where(p.clothoid)}: {g.line()}" for p in pairs for g in p.missed]
+    missed = [_miss_line(p, g) for p in pairs for g in p.missed]
     missed += [f"{where}: {g.line()}" for where, g in set_goals if not g.met]
     print("\ngoals over a set and of compute:")
     for where, g in set_goals:

@@ -216,3 +216,33 @@ def test_noisy_conditions_run_once_per_noise_seed_each_judged(steering, monkeypa
     with pytest.raises(SystemExit):
         steering.main([*argv, "--noise-seeds", "0"])
     assert "--noise-seeds must be a whole number >= 1; got 0" in capsys.readouterr().err
+
+
+def test_worst_place_is_the_max_cte_after_the_approach_with_the_driving_there(steering) -> None:
+    """A run started 0.5 m off: the approach's larger errors are left out, as max_abs_cte_on_path_m leaves them."""
+    np = pytest.importorskip("numpy")
+    t = np.arange(0.0, 10.0, 0.02)
+    speed = 5.0 + 0.5 * t  # 0.5 m/s^2 throughout
+    cte = np.where(t < 1.0, 0.5, 0.02)  # onto the path (within 0.1 m) at t = 1 s
+    cte[400] = -0.08  # t = 8 s: the largest on the path
+    trace = {"t_s": t, "speed_mps": speed, "cte_m": cte, "progress_m": 5.0 * t + 0.25 * t**2}
+    place = steering.worst_place(trace)
+    assert place["worst_at_m"] == pytest.approx(5.0 * 8.0 + 0.25 * 64.0, abs=1e-9)
+    assert place["worst_speed_kmh"] == pytest.approx(9.0 * 3.6, abs=1e-9)
+    assert place["worst_accel_mps2"] == pytest.approx(0.5, abs=1e-9)
+    empty = {k: np.array([]) for k in trace}
+    assert steering.worst_place(empty) == {}
+
+
+def test_a_max_cte_miss_says_where(steering) -> None:
+    import dataclasses
+
+    clothoid = dataclasses.replace(_run(steering, "clothoid", 0.2), worst_at_m=2405.4, worst_speed_kmh=22.6,
+                                   worst_accel_mps2=0.88)  # fmt: skip
+    nmpc = dataclasses.replace(_run(steering, "nmpc", 0.1), worst_at_m=2431.0)
+    (pair,) = steering.pairs_of([clothoid, nmpc])
+    (miss,) = [g for g in pair.missed if g.text == steering.CTE_GOAL]
+    line = steering._miss_line(pair, miss)
+    assert line.endswith("; its max at 2405 m (22.6 km/h, +0.9 m/s^2), the NMPC's at 2431 m")
+    (absolute,) = [g for g in pair.missed if g.text != steering.CTE_GOAL]  # 0.2 m over the dlc's 0.08 m
+    assert "its max at" not in steering._miss_line(pair, absolute)
