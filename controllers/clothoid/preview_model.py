@@ -122,6 +122,29 @@ def preview_curvature(
     handling (n speeds, len(HANDLING_GRID_G) gains, or no columns: none) scales each tap's term by the gain at the
     lateral acceleration v_k^2 |kappa_p(s_k)| / g, v_k the march's speed at the tap (interpolated linearly on the
     grid, held beyond its end; module docstring)."""
+    return preview_curvatures(
+        table, record, s_m, speed_mps, shift_s, first_tap_s, tap_spacing_s, speeds_kmh, taps, handling, taps[:, :0]
+    )[0]
+
+
+@njit(cache=True)
+def preview_curvatures(
+    table: np.ndarray,
+    record: np.ndarray,
+    s_m: float,
+    speed_mps: float,
+    shift_s: float,
+    first_tap_s: float,
+    tap_spacing_s: float,
+    speeds_kmh: np.ndarray,
+    taps: np.ndarray,
+    handling: np.ndarray,
+    unscaled_taps: np.ndarray,
+) -> tuple[float, float]:  # pragma: no cover - compiled
+    """(`preview_curvature` of taps with handling, of unscaled_taps without) from one march along the path: both
+    sums read the path's curvature at the same s_k, so the step that needs the steering's and the measured
+    curvature's sums at the same taps (no known delay) reads the path once. Either taps or unscaled_taps may have no
+    columns (its sum 0); both on one grid of taps and speeds."""
     shape = record[0]
     spacing, length, closed = shape.spacing, shape.length, shape.closed
     curvature, planned = table[PATH_CURVATURE], table[PATH_SPEED]
@@ -130,28 +153,33 @@ def preview_curvature(
     scale = speed_mps / here if here > MIN_PLANNED_SPEED_MPS else 1.0  # False for NaN
     last_past = math.floor(-(first_tap_s + shift_s) / tap_spacing_s)  # the last tap at or before now
     s_last_past = s_m + speed_mps * (first_tap_s + last_past * tap_spacing_s + shift_s)  # within one spacing
-    total = 0.0
+    n = max(taps.shape[1], unscaled_taps.shape[1])
+    scaled, unscaled, scaling = taps.shape[1] > 0, unscaled_taps.shape[1] > 0, handling.shape[1] > 0
+    total = unscaled_total = 0.0
     for direction in (1, -1):  # now and ahead, then the path already driven
         s_a, k_a = s_last_past, last_past
         v_a = _speed_at(planned, s_a, spacing, length, closed, scale, speed_mps)
         h = direction * MARCH_TAPS * tap_spacing_s
-        while (k_a < taps.shape[1]) if direction > 0 else (k_a > 0):
+        while (k_a < n) if direction > 0 else (k_a > 0):
             # one step of the march (trapezoidal, the end's speed read where the start's speed takes it); the taps
             # within it interpolated linearly in time
             v_b = _speed_at(planned, s_a + h * v_a, spacing, length, closed, scale, speed_mps)
             s_b = s_a + 0.5 * h * (v_a + v_b)
             for i in range(MARCH_TAPS) if direction > 0 else range(1, MARCH_TAPS + 1):
                 k = k_a + direction * i
-                if 0 <= k < taps.shape[1]:
+                if 0 <= k < n:
                     s = s_a + (s_b - s_a) * (i / MARCH_TAPS)
                     kappa = value_at(curvature, s, spacing, length, closed)
-                    term = _tap(taps, low, high, t, k) * kappa
-                    if handling.shape[1] > 0:
-                        v = v_a + (v_b - v_a) * (i / MARCH_TAPS)
-                        term *= _handling(handling, low, high, t, v * v * abs(kappa) / G_MPS2)
-                    total += term
+                    if scaled:
+                        term = _tap(taps, low, high, t, k) * kappa
+                        if scaling:
+                            v = v_a + (v_b - v_a) * (i / MARCH_TAPS)
+                            term *= _handling(handling, low, high, t, v * v * abs(kappa) / G_MPS2)
+                        total += term
+                    if unscaled:
+                        unscaled_total += _tap(unscaled_taps, low, high, t, k) * kappa
             s_a, v_a, k_a = s_b, v_b, k_a + direction * MARCH_TAPS
-    return total
+    return total, unscaled_total
 
 
 @njit(cache=True)

@@ -33,7 +33,7 @@ from controllers.clothoid.lookahead import (
 from controllers.clothoid.lookahead_filter import filtered_lookahead
 from controllers.clothoid.path_feedforward import lag_inverse_curvature, previewed_curvature, two_degree_of_freedom_rate
 from controllers.clothoid.pose_prediction import along_arc
-from controllers.clothoid.preview_model import preview_curvature
+from controllers.clothoid.preview_model import preview_curvature, preview_curvatures
 from controllers.clothoid.speed_tables import table_row
 from controllers.clothoid.vehicle_tuning import LAG_COLUMNS as LAG_PARAMETERS
 from workbench.base.path_search import TRACK_OUT_SIZE, TRACK_PROGRESS, TRACK_S, TRACK_STATE_SIZE, track
@@ -374,13 +374,27 @@ def clothoid_step(
             speed, params, lags, measured_lags, lag_speeds, schedule, schedule_speeds, scratch[:4]
         )
         previewing = inverting and lags.shape[1] > LAG_COLUMNS
+        previewed = 0.0  # the preview response's steering: the feed-forward (below)
         if previewing or (inverting and p.lag_model_reference and lags.shape[0] > 0):
             s_ref = foot[0] + speed * (p.horizon - horizon)
             if previewing:  # the measured curvature of a vehicle that drives the path, from its preview response
-                reference_kappa = preview_curvature(
-                    path, record, s_ref, speed, 0.0, p.preview_first_tap, p.preview_spacing, lag_speeds,
-                    measured_lags[:, LAG_COLUMNS:], measured_lags[:, :0],
-                )  # fmt: skip
+                taps_end = measured_lags.shape[1]  # the steering taps, then the handling gain
+                steering_taps, handling = lags[:, LAG_COLUMNS:taps_end], lags[:, taps_end:]
+                measured_taps = measured_lags[:, LAG_COLUMNS:]
+                if s_ref == foot[0] and p.known_delay == 0.0:  # both read at the same taps: one march
+                    previewed, reference_kappa = preview_curvatures(
+                        path, record, s_ref, speed, 0.0, p.preview_first_tap, p.preview_spacing, lag_speeds,
+                        steering_taps, handling, measured_taps,
+                    )  # fmt: skip
+                else:
+                    reference_kappa = preview_curvature(
+                        path, record, s_ref, speed, 0.0, p.preview_first_tap, p.preview_spacing, lag_speeds,
+                        measured_taps, measured_taps[:, :0],
+                    )  # fmt: skip
+                    previewed = preview_curvature(
+                        path, record, foot[0], speed, p.known_delay, p.preview_first_tap, p.preview_spacing,
+                        lag_speeds, steering_taps, handling,
+                    )  # fmt: skip
             else:
                 reference_kappa = reference_curvature(
                     path, record, s_ref, speed, lags, measured_lags, lag_speeds, p.feedforward_window,
@@ -398,11 +412,7 @@ def clothoid_step(
         if inverting:  # the lag inverted, added after the lead filter; the integrator holds the feedback alone
             kdot = clothoid_kdot - reference_kdot
             if previewing:  # the steering that drives the path, from the preview response, the known delay ahead
-                taps_end = measured_lags.shape[1]  # the steering taps, then the handling gain
-                feedforward_kappa = preview_curvature(
-                    path, record, foot[0], speed, p.known_delay, p.preview_first_tap, p.preview_spacing, lag_speeds,
-                    lags[:, LAG_COLUMNS:taps_end], lags[:, taps_end:],
-                )  # fmt: skip
+                feedforward_kappa = previewed
             else:
                 omega_n, zeta, dead_time = math.nan, 1.0, 0.0
                 if lags.shape[0] > 0:

@@ -21,6 +21,7 @@ from controllers.clothoid.preview_model import (
     MARCH_TAPS,
     PreviewResponse,
     preview_curvature,
+    preview_curvatures,
 )
 from tuning.own_tuning import tuning_for
 from workbench.base.clothoid_chain import ClothoidChain
@@ -136,6 +137,31 @@ def test_a_held_planned_speed_gives_the_taps_at_the_measured_speed(taps, speed, 
     curvature = RATE_1PM2 * S_GRID
     held = _sum(curvature, 150.0, speed, h, shift_s=shift, planned=np.full(S_GRID.size, planned))
     assert held == pytest.approx(_sum(curvature, 150.0, speed, h, shift_s=shift), rel=1e-9, abs=1e-12)
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    taps=st.lists(st.floats(-2.0, 2.0), min_size=1, max_size=60),
+    gain=st.floats(0.5, 2.0),
+    speed=st.floats(1.0, 30.0),
+    shift=st.floats(0.0, 0.5),
+    s0=st.floats(0.0, 300.0),
+)
+def test_one_march_gives_both_sums_exactly(taps, gain, speed, shift, s0) -> None:
+    """preview_curvatures' two sums are preview_curvature's of each set of taps, to the bit (one march for both),
+    on a braked plan and a path whose curvature is not linear; the unscaled sum is not scaled."""
+    steering = np.atleast_2d(taps)
+    measured = steering[:, ::-1] * 0.5
+    handling = np.linspace(1.0, gain, len(HANDLING_GRID_G))[np.newaxis, :]
+    curvature = 0.05 * np.sin(S_GRID / 17.0)
+    planned = np.sqrt(np.maximum(64.0 - 0.2 * S_GRID, 1.0))
+    zeros = np.zeros_like(curvature)
+    compiled = CompiledPath.of((zeros, zeros, zeros, curvature, planned), SPACING_M, float(S_GRID[-1]), False, 0.0, 5.0)
+    common = (compiled.table, compiled.record, s0, speed, shift, FIRST_S, TAP_S, np.array([30.0]))
+    both = preview_curvatures(*common, steering, handling, measured)
+    alone = preview_curvature(*common, steering, handling), preview_curvature(*common, measured, measured[:, :0])
+    assert both == alone
+    assert preview_curvatures(*common, steering[:, :0], handling, measured)[0] == 0.0
 
 
 @pytest.mark.parametrize("accel_mps2", [-1.5, 1.0])
