@@ -34,6 +34,8 @@ from workbench.base.path_search import PATH_CURVATURE, PATH_SPEED, value_at
 #: g: the lateral accelerations (v^2 |kappa| / g) the handling gain is given at: uniform from zero, held beyond.
 HANDLING_GRID_G = (0.0, 0.05, 0.1, 0.15, 0.2, 0.25, 0.3, 0.35, 0.4)
 HANDLING_STEP_G = HANDLING_GRID_G[1]
+#: 1/(m/s^2): grid steps per m/s^2 of lateral acceleration.
+PER_GRID_STEP = 1.0 / (G_MPS2 * HANDLING_STEP_G)
 #: -: the range a handling gain may take (a vehicle whose steering per curvature changes more than twofold is not
 #: in a steady turn the feed-forward can model).
 HANDLING_GAIN_RANGE = (0.5, 2.0)
@@ -156,6 +158,9 @@ def preview_curvatures(
     n = max(taps.shape[1], unscaled_taps.shape[1])
     scaled, unscaled, scaling = taps.shape[1] > 0, unscaled_taps.shape[1] > 0, handling.shape[1] > 0
     total = unscaled_total = 0.0
+    gains = np.empty(handling.shape[1])  # the handling gain at this speed, on HANDLING_GRID_G
+    for j in range(gains.size):
+        gains[j] = handling[low, j] + t * (handling[high, j] - handling[low, j])
     for direction in (1, -1):  # now and ahead, then the path already driven
         s_a, k_a = s_last_past, last_past
         v_a = _speed_at(planned, s_a, spacing, length, closed, scale, speed_mps)
@@ -174,7 +179,7 @@ def preview_curvatures(
                         term = _tap(taps, low, high, t, k) * kappa
                         if scaling:
                             v = v_a + (v_b - v_a) * (i / MARCH_TAPS)
-                            term *= _handling(handling, low, high, t, v * v * abs(kappa) / G_MPS2)
+                            term *= _handling(gains, v * v * abs(kappa) * PER_GRID_STEP)
                         total += term
                     if unscaled:
                         unscaled_total += _tap(unscaled_taps, low, high, t, k) * kappa
@@ -199,13 +204,9 @@ def _tap(taps: np.ndarray, low: int, high: int, t: float, k: int) -> float:  # p
 
 
 @njit(cache=True)
-def _handling(handling: np.ndarray, low: int, high: int, t: float, lat_accel_g: float) -> float:  # pragma: no cover
-    """The handling gain at lat_accel_g (g, >= 0), between the rows low and high (weight t on high): linear on the
-    uniform HANDLING_GRID_G, held beyond its last point."""
-    x = lat_accel_g / HANDLING_STEP_G
-    last = handling.shape[1] - 1
-    i = min(int(x), last - 1)
+def _handling(gains: np.ndarray, x: float) -> float:  # pragma: no cover - compiled
+    """The handling gain (gains: at one speed, on HANDLING_GRID_G) at x grid steps of lateral acceleration (>= 0):
+    linear on the grid, held beyond its last point."""
+    i = min(int(x), gains.size - 2)
     w = min(x - i, 1.0)
-    at_low = handling[low, i] + w * (handling[low, i + 1] - handling[low, i])
-    at_high = handling[high, i] + w * (handling[high, i + 1] - handling[high, i])
-    return at_low + t * (at_high - at_low)
+    return gains[i] + w * (gains[i + 1] - gains[i])
