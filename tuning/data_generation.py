@@ -13,7 +13,7 @@ import numpy as np
 import pandas as pd
 
 from tuning.log_file import LOG_COLUMNS
-from tuning.maneuvers import Maneuver
+from tuning.maneuvers import Braking, Maneuver
 from workbench.base.errors import WorkbenchInputError, require_in_range, require_positive, value_text
 from workbench.simulation.speed_control import PISpeedController
 from workbench.vehicles.base import VehicleModel
@@ -92,23 +92,30 @@ def generate_open_loop_log(
     speed_kmh: float,
     sample_rate_hz: float = 100.0,
     plant_rate_hz: float = PLANT_RATE_HZ,
+    braking: Braking | None = None,
 ) -> pd.DataFrame:
-    """Simulate the maneuver at a held speed (PI speed control) and return the log, one row per sample. The plant
+    """Simulate the maneuver at a held speed (PI speed control; with braking, the held speed falls by its pulse,
+    `maneuvers.Braking`) and return the log, one row per sample. The plant
     is driven at plant_rate_hz with the profile at each plant step's midpoint, so that the steering between two
     log samples is the profile's, as a real steering wheel's is (not held from one sample to the next, which would
     delay the logged steering by half a sample: the fit interpolates the logged steering linearly). A log longer
     than `check_log_size` allows is refused before anything is allocated."""
     require_in_range("speed_kmh", speed_kmh, 1e-3, 400.0, "km/h (must be > 0)")
     require_in_range("plant_rate_hz", plant_rate_hz, 1.0, 100_000.0, "Hz")
+    if braking is not None and braking.decel_mps2 * braking.duration_s >= speed_kmh / 3.6:
+        raise WorkbenchInputError(
+            f"braking at {braking.decel_mps2:g} m/s^2 for {braking.duration_s:g} s would stop the vehicle from "
+            f"{speed_kmh:g} km/h; the pulse must end above standstill"
+        )
     check_log_size(maneuver.duration_s, sample_rate_hz, plant_rate_hz)
     substeps = _substeps(sample_rate_hz, plant_rate_hz)
     dt = 1.0 / sample_rate_hz
-    speed_ref = speed_kmh / 3.6
+    held = speed_kmh / 3.6
     t = np.arange(0.0, maneuver.duration_s + 0.5 * dt, dt)
     steer = maneuver.steer_wheel_rad(t)
     h = dt / substeps
     fine = maneuver.steer_wheel_rad(t[:, None] + h * (np.arange(substeps) + 0.5)[None, :])
-    state = vehicle.initial_state(0.0, 0.0, 0.0, speed_ref)
+    state = vehicle.initial_state(0.0, 0.0, 0.0, held)
     speed_control = PISpeedController()
     rows = np.empty((t.size, len(LOG_COLUMNS)))
     for k, (tk, sw) in enumerate(zip(t, steer, strict=True)):
@@ -116,7 +123,8 @@ def generate_open_loop_log(
         x, y, yaw, vx, vy, yaw_rate = out[:6]
         speed = math.hypot(vx, vy)
         rows[k] = (tk, math.degrees(sw), speed, x, y, yaw, yaw_rate)
-        accel = speed_control.step(speed_ref, speed, dt)
+        speed_ref, rate = (held, 0.0) if braking is None else braking.speed_ref(float(tk), held)
+        accel = speed_control.step(speed_ref, speed, dt, rate)
         for sw_fine in fine[k].tolist():
             state = vehicle.advance(state, sw_fine, accel, h, 1)
     return pd.DataFrame(rows, columns=list(LOG_COLUMNS))

@@ -47,6 +47,7 @@ class SteadyTurn:
 
     lat_accel_g: float  # g, > 0: speed x yaw rate / g over the window
     steering_ratio: float  # -, > 0: the steering's kinematic curvature over yaw rate / speed
+    sideslip_rad: float = math.nan  # rad: the rear-axle sideslip over the window, as of a left turn (NaN: no positions)
 
 
 @dataclass(frozen=True)
@@ -86,7 +87,8 @@ def steady_turn(log: VehicleLog, geometry: VehicleGeometry | SteeringGeometry) -
     Returns
     -------
     SteadyTurn or None
-        The turn's lateral acceleration and steering ratio; None when yaw rate / speed varies by more than
+        The turn's lateral acceleration and steering ratio, and its rear-axle sideslip when the log has positions
+        and yaw (`VehicleLog.sideslip_rad`); None when yaw rate / speed varies by more than
         STEADY_TOLERANCE over the window, the steering varies there, or the vehicle does not turn.
 
     Raises
@@ -111,7 +113,10 @@ def steady_turn(log: VehicleLog, geometry: VehicleGeometry | SteeringGeometry) -
     lat_accel_g = float(np.mean(log.speed_mps[window] * yaw_rate)) / G_MPS2
     if not (ratio > 0.0 and math.isfinite(ratio)):
         return None
-    return SteadyTurn(abs(lat_accel_g), ratio)
+    sideslip = math.nan
+    if log.has_positions and log.yaw_rad is not None:
+        sideslip = float(np.mean(log.sideslip_rad()[window])) * (1.0 if mean > 0.0 else -1.0)
+    return SteadyTurn(abs(lat_accel_g), ratio, sideslip)
 
 
 def fit_handling(

@@ -81,6 +81,22 @@ class VehicleLog:
     def __len__(self) -> int:
         return int(self.t_s.size)
 
+    def sideslip_rad(self) -> np.ndarray:
+        """The rear-axle sideslip (rad) at each sample: the course of the positions (their central differences'
+        direction) less the yaw, wrapped to (-pi, pi]; a left turn's rear axle slides out, negative.
+
+        Raises
+        ------
+        WorkbenchInputError
+            The log has no x_m, y_m or yaw_rad.
+        """
+        if self.x_m is None or self.y_m is None or self.yaw_rad is None:
+            raise WorkbenchInputError(
+                f"{self.name}: the sideslip needs x_m, y_m (rear-axle position) and yaw_rad; the log lacks some"
+            )
+        course = np.arctan2(np.gradient(self.y_m, self.t_s), np.gradient(self.x_m, self.t_s))
+        return np.angle(np.exp(1j * (course - self.yaw_rad)))
+
     @classmethod
     def from_frame(cls, frame: pd.DataFrame, name: str = "log") -> VehicleLog:
         """Validate a table in the log format (columns above) and return it, uniformly sampled. A column named twice

@@ -129,3 +129,33 @@ class Maneuver:
             frequency = self.start_hz * ratio**u
             amplitude = np.minimum(amplitude, math.radians(self.max_rate_deg_s) / (2 * np.pi * frequency))
         return np.where(inside, math.copysign(1.0, a) * amplitude * np.sin(phase), 0.0)
+
+
+@dataclass(frozen=True)
+class Braking:
+    """A braking pulse of the held speed: the speed reference falls at decel_mps2 (m/s^2, > 0) from start_s (s)
+    for duration_s (s), then holds where it ended; the speed control feeds the fall's rate forward, so the
+    vehicle brakes at about decel_mps2. The pulse of the sideslip-release identification (`tuning.release_fit`).
+    """
+
+    start_s: float  # s, >= 0: when the braking starts
+    duration_s: float  # s, > 0: how long it lasts
+    decel_mps2: float = 2.0  # m/s^2, in (0, 10]: the deceleration
+
+    def __post_init__(self) -> None:
+        require_in_range("start_s", self.start_s, 0.0, 1e4, "s")
+        require_in_range("duration_s", self.duration_s, 0.0, 60.0, "s", low_open=True)
+        require_in_range("decel_mps2", self.decel_mps2, 0.0, 10.0, "m/s^2", low_open=True)
+
+    @property
+    def end_s(self) -> float:
+        """When the braking ends (s)."""
+        return self.start_s + self.duration_s
+
+    def speed_ref(self, t_s: float, speed_mps: float) -> tuple[float, float]:
+        """(speed reference m/s, its rate m/s^2) at t_s of a run held at speed_mps before the pulse."""
+        if t_s < self.start_s:
+            return speed_mps, 0.0
+        if t_s < self.end_s:
+            return speed_mps - self.decel_mps2 * (t_s - self.start_s), -self.decel_mps2
+        return speed_mps - self.decel_mps2 * self.duration_s, 0.0

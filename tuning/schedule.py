@@ -50,8 +50,9 @@ from tuning.lead_design import (
     design_lead_for_margins,
 )
 from tuning.log_file import VehicleLog
-from tuning.maneuvers import Maneuver
+from tuning.maneuvers import Braking, Maneuver
 from tuning.preview_fit import PreviewFit, PreviewFitOptions, fit_preview
+from tuning.release_fit import RELEASE_HOLD_S, RELEASE_TURN_G, ReleaseFit, fit_release, release_braking
 from tuning.speeds import check_speeds
 from workbench.base.errors import WorkbenchInputError, require_in_range, value_text
 from workbench.vehicles.base import VehicleModel
@@ -93,6 +94,7 @@ class ScheduleEntry:
     margins: MarginsDesign | None = None  # the margins design's lookahead floors (None: the cancel design)
     preview: PreviewFit | None = None  # the preview responses fitted to the same logs (None: not identified)
     handling: HandlingFit | None = None  # the steady turns the preview's handling gain came from (None: none)
+    release: ReleaseFit | None = None  # the sideslip's steady turns and release (None: no steady sideslip)
 
     def row(self) -> dict[str, Any]:
         """The entry as one row of the lead-filter file's ``design.per_speed`` table and of `ScheduleResult.table`.
@@ -106,7 +108,10 @@ class ScheduleEntry:
             design, lookahead_floor_m (or margin_score when no lookahead keeps the margins) and
             floor_without_lead_m when finite; with the preview responses, their first tap and spacing (s), NRMSE,
             taps and handling gain (lists of float), under keys prefixed ``preview_``; with the steady turns, their
-            lateral accelerations (g) and steering ratios as handling_lat_accel_g and handling_ratio (lists).
+            lateral accelerations (g), steering ratios and (when every turn has one) sideslips (rad, as of a left
+            turn) as handling_lat_accel_g, handling_ratio and handling_sideslip_rad (lists); with the release, the
+            steady sideslip on the handling grid (rad, list), the release rate (1/s; 0: not identified) and, after a
+            braked turn, the push (rad) as release_steady_sideslip_rad, release_rate_1ps and release_push_rad.
         """
         lag, d = self.fit.lag, self.design
         out: dict[str, Any] = {
@@ -158,6 +163,16 @@ class ScheduleEntry:
                 handling_lat_accel_g=[float(f"{t.lat_accel_g:.5g}") for t in self.handling.turns],
                 handling_ratio=[float(f"{t.steering_ratio:.7g}") for t in self.handling.turns],
             )
+            if all(math.isfinite(t.sideslip_rad) for t in self.handling.turns):
+                out["handling_sideslip_rad"] = [float(f"{t.sideslip_rad:.7g}") for t in self.handling.turns]
+        if self.release is not None:
+            release = self.release.release
+            out.update(
+                release_steady_sideslip_rad=[float(f"{v:.7g}") for v in release.steady_sideslip_rad],
+                release_rate_1ps=float(f"{release.rate_1ps:.5g}"),
+            )
+            if math.isfinite(self.release.push_rad):
+                out["release_push_rad"] = float(f"{self.release.push_rad:.5g}")
         return out
 
 
@@ -451,6 +466,44 @@ def handling_logs(
     return logs
 
 
+def release_log(
+    vehicle: VehicleModel, speed_kmh: float, sample_rate_hz: float = 100.0
+) -> tuple[VehicleLog, Braking] | None:
+    """A steering step to RELEASE_TURN_G at speed_kmh, held, braked once the turn is steady (`release_fit`'s
+    `release_braking`) and held at the lower speed for RELEASE_HOLD_S: the log the sideslip's release is identified
+    from (`tuning.release_fit`), and its braking.
+
+    Parameters
+    ----------
+    vehicle : VehicleModel
+        The plant driven open loop.
+    speed_kmh : float, km/h
+        The held speed before the braking, within SPEED_RANGE_KMH (5-200 km/h).
+    sample_rate_hz : float, Hz
+        The log's sample rate, 1-10000 Hz.
+
+    Returns
+    -------
+    (VehicleLog, Braking) or None
+        The log, named "braked turn at <speed> km/h", and its braking; None when the turn's kinematic curvature
+        reaches the steering lock.
+
+    Raises
+    ------
+    WorkbenchInputError
+        A speed or sample rate out of its range.
+    """
+    require_in_range("speed_kmh", speed_kmh, *SPEED_RANGE_KMH, "km/h")
+    v = speed_kmh / 3.6
+    if RELEASE_TURN_G * G_MPS2 / (v * v) >= lock_curvature_1pm(vehicle):
+        return None
+    braking = release_braking(speed_kmh)
+    amplitude = steer_amplitude_deg(vehicle, speed_kmh, RELEASE_TURN_G)
+    name = f"braked turn at {speed_kmh:g} km/h"
+    duration = braking.end_s + RELEASE_HOLD_S
+    return _open_loop_log(vehicle, "step", amplitude, speed_kmh, duration, sample_rate_hz, name, braking), braking
+
+
 def _open_loop_log(
     vehicle: VehicleModel,
     kind: str,
@@ -459,12 +512,14 @@ def _open_loop_log(
     duration_s: float,
     sample_rate_hz: float,
     name: str,
+    braking: Braking | None = None,
 ) -> VehicleLog:
     """One open-loop log of the maneuver `kind` at amplitude_deg (steering wheel), its rate at most
-    IDENTIFICATION_RATE_FRACTION of the vehicle's steering-wheel rate limit."""
+    IDENTIFICATION_RATE_FRACTION of the vehicle's steering-wheel rate limit (with braking: the held speed braked by
+    it)."""
     max_rate = IDENTIFICATION_RATE_FRACTION * math.degrees(vehicle.geometry.max_steer_wheel_rate_rad_s)
     maneuver = Maneuver(kind, amplitude_deg=amplitude_deg, duration_s=duration_s, max_rate_deg_s=max_rate)
-    frame = generate_open_loop_log(vehicle, maneuver, speed_kmh, sample_rate_hz=sample_rate_hz)
+    frame = generate_open_loop_log(vehicle, maneuver, speed_kmh, sample_rate_hz=sample_rate_hz, braking=braking)
     return VehicleLog.from_frame(frame, name=name)
 
 
@@ -634,6 +689,7 @@ def identify_schedule(
                 preview_logs = identification_logs(vehicle, speed, preview_options.lat_accel_g)
             preview = fit_preview(preview_logs, vehicle.geometry, preview_options)
             handling = fit_handling(handling_logs(vehicle, speed), vehicle.geometry, preview_options.lat_accel_g)
+            release = fit_release(handling.turns, *(release_log(vehicle, speed) or (None, None)))
             preview = dataclasses.replace(
                 preview, response=dataclasses.replace(preview.response, handling_gain=handling.gain)
             )
@@ -659,7 +715,7 @@ def identify_schedule(
             if progress is not None:
                 progress(f"{speed:g} km/h: dropped: {exc}")
             continue
-        entries.append(ScheduleEntry(speed, fit, lead, measured, margins, preview, handling))
+        entries.append(ScheduleEntry(speed, fit, lead, measured, margins, preview, handling, release))
         if progress is not None:
             floors = ""
             if margins is not None:
@@ -669,7 +725,8 @@ def identify_schedule(
                 )
             progress(
                 f"{speed:g} km/h: path {fit.summary()}; measured {measured.summary()}; {preview.summary()}; "
-                f"{handling.summary()}; {lead.summary()}{floors}"
+                f"{handling.summary()}; {release.summary() if release else 'release: no steady sideslip'}; "
+                f"{lead.summary()}{floors}"
             )
     if not entries:
         reasons = "; ".join(f"at {d.speed_kmh:g} km/h: {d.reason}" for d in dropped)
@@ -700,5 +757,6 @@ __all__ = [
     "identify_schedule",
     "lock_curvature_1pm",
     "margins_arc_curvature_1pm",
+    "release_log",
     "steer_amplitude_deg",
 ]

@@ -18,6 +18,7 @@ from typing import Any
 from controllers.clothoid.filter_schedule import FilterSchedule
 from controllers.clothoid.loop_requirements import REQUIRED_GAIN_MARGIN_DB, REQUIRED_PHASE_MARGIN_DEG
 from controllers.clothoid.preview_model import PreviewResponse
+from controllers.clothoid.sideslip_release import SideslipRelease
 from controllers.clothoid.vehicle_tuning import FloorDesign, VehicleTuning
 from tuning.filter_file import read_filter_file
 from tuning.limits_file import read_limits_file
@@ -61,6 +62,10 @@ MEASURED_LAG_KEYS = ("measured_omega_n_rad_s", "measured_zeta")
 PREVIEW_KEYS = ("preview_first_tap_s", "preview_tap_spacing_s", "preview_steering_taps", "preview_measured_taps")
 #: The preview responses' handling gain, optional (files made before it was identified: gains of one).
 HANDLING_KEY = "preview_handling_gain"
+#: The per_speed keys of the sideslip's release (`tuning.release_fit`): the steady sideslip on the handling grid
+#: (rad) and the release rate (1/s; 0: not identified); at every speed or at none (files made before it was
+#: identified: none).
+RELEASE_KEYS = ("release_steady_sideslip_rad", "release_rate_1ps")
 
 
 # ---- the vehicle's identity -------------------------------------------------------------------------------------
@@ -258,6 +263,28 @@ def _previews(path: Path, design: Mapping[str, Any]) -> tuple[tuple[float, Previ
     return tuple(out)
 
 
+def _releases(path: Path, design: Mapping[str, Any]) -> tuple[tuple[float, SideslipRelease], ...]:
+    """(speed_kmh, the sideslip's release) of design.per_speed (RELEASE_KEYS; a release rate 0: not identified);
+    empty when no row has them, refused when only some rows have them or a row's are not a valid release."""
+    rows = design["per_speed"]  # checked by _lags
+    if not any(k in row for row in rows for k in RELEASE_KEYS):
+        return ()
+    out = []
+    for i, row in enumerate(rows):
+        if any(k not in row for k in RELEASE_KEYS):
+            raise WorkbenchInputError(
+                f"{path}: design.per_speed[{i}] lacks some of {list(RELEASE_KEYS)}, which other speeds give; give the "
+                "sideslip's release at every speed or at none"
+            )
+        sideslip, rate = row["release_steady_sideslip_rad"], row["release_rate_1ps"]
+        try:
+            release = SideslipRelease.from_rate(tuple(sideslip), rate)
+        except (WorkbenchInputError, TypeError, ValueError) as exc:
+            raise WorkbenchInputError(f"{path}: design.per_speed[{i}] (sideslip release): {exc}") from None
+        out.append((float(row["speed_kmh"]), release))
+    return tuple(out)
+
+
 def _floors(path: Path, design: Mapping[str, Any]) -> tuple[tuple[tuple[float, float], ...], FloorDesign | None]:
     """((speed_kmh, lookahead_floor_m) of the rows of design.per_speed that have one, what they were computed for):
     ((), None) unless the design is "margins" with its loop (FLOOR_DESIGN_KEYS). The margins kept are the design's
@@ -331,8 +358,9 @@ def _read(directory: str, _stamp: tuple[int, ...]) -> VehicleTuning:
     lags, measured = _lags(lead, design, schedule)
     floors, floor_design = _floors(lead, design)
     previews = _previews(lead, design)
+    releases = _releases(lead, design)
     try:
-        return VehicleTuning(schedule, limits, lags, source, measured, floors, floor_design, previews)
+        return VehicleTuning(schedule, limits, lags, source, measured, floors, floor_design, previews, releases)
     except WorkbenchInputError as exc:
         raise WorkbenchInputError(f"{lead}: {exc}") from None
 

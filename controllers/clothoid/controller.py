@@ -53,6 +53,7 @@ from controllers.clothoid.lead_filter import DiscreteLeadFilter, LeadFilterParam
 from controllers.clothoid.lookahead import MAX_CURVE_POINTS, candidate_count
 from controllers.clothoid.lookahead_filter import RATE_LIMIT
 from controllers.clothoid.path_feedforward import FeedforwardTiming
+from controllers.clothoid.preview_model import HANDLING_GRID_G
 from controllers.clothoid.vehicle_tuning import FloorInputs, VehicleTuning
 from controllers.config_checks import Choice, Flag, Instance, Number, check_options, option
 from controllers.search_space import Tunable
@@ -337,6 +338,14 @@ class ClothoidConfig:
         "one); false: the taps alone, linear at any lateral acceleration; the loop is the same either way",
         Flag(),
     )
+    sideslip_release: bool = option(
+        True,
+        "with delay_compensation 'model' and heading 'course': the measured sideslip's deviation from the steady "
+        "turn's and the lags' is released over known_delay_s at the rate the tuning identified, turning the predicted "
+        "course (`sideslip_release.py`; no effect without an identified release); false: held; the loop about a "
+        "steady state is the same either way",
+        Flag(),
+    )
     tuning: VehicleTuning | None = option(  # noqa: RUF009  (option is a dataclasses.field)
         None,
         "the steered vehicle's own tuning: lead filter, curvature limits, identified lags "
@@ -539,7 +548,7 @@ class ClothoidController(Controller[ClothoidConfig]):
         compiled = path.compiled()
         self._step_arguments = sk.StepArguments(
             self._measured, self._params, self._state, compiled.table, compiled.record, self._limits,
-            self._limit_speeds, self._lags, self._measured_lags, self._lag_speeds, self._schedule,
+            self._limit_speeds, self._lags, self._measured_lags, self._lag_speeds, self._releases, self._schedule,
             self._schedule_speeds, self._scores, self._results, self._diag, self._history,
         )  # fmt: skip
         # The planned speeds' floors at reset, not in a step (~0.04 s a band, with the delay model 0.5 s).
@@ -550,7 +559,8 @@ class ClothoidController(Controller[ClothoidConfig]):
         """The tables the compiled step reads (step_kernel.py): the limits, the identified lags and the lead
         filter's schedule (no rows: untuned, no lead filter), each against speed, the lags' rows followed by the
         preview responses' steering and measured taps when the feed-forward uses them, the steering taps by the
-        handling gain with handling_gain (`step_kernel.LAG_COLUMNS`);
+        handling gain with handling_gain (`step_kernel.LAG_COLUMNS`), and the sideslip's release
+        (`VehicleTuning.release_table`; no rows: none identified);
         built once, with the controller (they depend on its config alone, not on the path or the period)."""
         self._limit_speeds, self._limits = self.limits.table
         if self.tuning is not None:
@@ -561,8 +571,10 @@ class ClothoidController(Controller[ClothoidConfig]):
                     self._lags = self._lags[:, : self._measured_lags.shape[1]]
                 first, spacing, _, _ = self.tuning.preview_tables
                 self._params["preview_first_tap"], self._params["preview_spacing"] = first, spacing
+            self._releases = self.tuning.release_table
         else:
             self._lag_speeds, self._lags, self._measured_lags = np.zeros(0), np.zeros((0, 4)), np.zeros((0, 4))
+            self._releases = np.zeros((0, 1 + len(HANDLING_GRID_G)))
         if self.filter_schedule is not None:
             self._schedule_speeds, self._schedule = self.filter_schedule.table
         else:
@@ -610,6 +622,7 @@ class ClothoidController(Controller[ClothoidConfig]):
             delay_model=cfg.predicts_with_model,
             feedforward_inversion=cfg.feedforward_inversion,
             lag_model_reference=cfg.lag_model_reference,
+            sideslip_release=cfg.sideslip_release,
             preview_first_tap=0.0,
             preview_spacing=1.0,
         )

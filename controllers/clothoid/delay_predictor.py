@@ -182,11 +182,15 @@ def predicted_start(
     measured_lag: np.ndarray,
     known_delay_s: float,
     yaw_rate_age_s: float = 0.0,
+    deviation_rad: float = 0.0,
+    release_rate_1ps: float = 0.0,
 ) -> tuple[float, float, float, float]:  # pragma: no cover - compiled
     """(x, y, heading, kappa(0)) known_delay_s ahead (module docstring); the model is left as it was.
 
     kappa0 is measured yaw_rate_age_s (s) before the pose (the yaw rate's latency less the pose's; negative: after
-    it), so its prediction starts from the measured lag's model then (`_measured_at`)."""
+    it), so its prediction starts from the measured lag's model then (`_measured_at`). deviation_rad (rad): the
+    measured sideslip less the lags' (`lag_sideslip`), released at release_rate_1ps (1/s) over the dead time, each
+    substep's release turning the course (`sideslip_release.py`; 0: none)."""
     per, path, measured, d_path, d_measured = _substep_lags(period_s, path_lag, measured_lag, known_delay_s)
     h = period_s / per
     head = int(model[M_HEAD])
@@ -195,11 +199,17 @@ def predicted_start(
     ym0 = _measured_at(ym, dym, measured_lag, history, head, -round(yaw_rate_age_s / h), d_measured, per, h)
     kappa_now = kappa0 + measured_lag[3] * (ym - ym0)  # kappa(0) at the pose's time
     x, y, heading = x_m, y_m, heading_rad
+    kept = math.exp(-release_rate_1ps * h)  # of the deviation, over a substep
+    left = deviation_rad
     for offset in range(round(known_delay_s / h)):
         before = yp
         yp, dyp = _advance(yp, dyp, path, _input(history, head, offset, d_path, per))
         ym, dym = _advance(ym, dym, measured, _input(history, head, offset, d_measured, per))
         kappa = kappa_now + measured_lag[3] * (0.5 * (before + yp) - ym_pose)  # the substep's mean (trapezoidal)
+        if left != 0.0:  # the deviation released over the substep turns the course by as much
+            released = left * (1.0 - kept)
+            left -= released
+            kappa -= released / (speed_mps * h)
         x, y, heading = along_arc(x, y, heading, kappa, speed_mps * h)
     return x, y, heading, kappa0 + measured_lag[3] * (ym - ym0)
 
@@ -224,3 +234,39 @@ def _measured_at(
     for k in range(abs(offset)):
         ym, dym = _advance(ym, dym, lag, _input(history, head, -1 - k if offset < 0 else k, d_measured, per))
     return ym
+
+
+@njit(cache=True)
+def lag_transient_sideslip(
+    model: np.ndarray,
+    history: np.ndarray,
+    speed_mps: float,
+    period_s: float,
+    path_lag: np.ndarray,
+    measured_lag: np.ndarray,
+    known_delay_s: float,
+) -> float:  # pragma: no cover - compiled
+    """The part of the lags' sideslip (rad) not yet at its steady value for the yaw-rate curvature their model has
+    now (`sideslip_release.py`): speed K_m times the integral of the path lag's output less the measured lag's (the
+    course's rate less the yaw's, over speed), less its steady value, in closed form from the lags' states at this
+    speed's parameters. For y'' + 2 zeta wn y' + wn^2 y = wn^2 u(t - d) the integral of u(t - d) - y is
+    y' / wn^2 + (2 zeta / wn) y, so
+
+        integral (y_p - y_m) = [y'_m / wn_m^2 + (2 zeta_m / wn_m) y_m] - [y'_p / wn_p^2 + (2 zeta_p / wn_p) y_p]
+                               + integral of u from t - d_m to t - d_p
+
+    (d: the known delay plus the lag's own), whose steady value at y_m is (group delay_m - group delay_p) y_m. Zero
+    in a steady turn; at a held speed its rate is the lags' sideslip rate less the steady part's."""
+    per = substeps_per_period(period_s)
+    h = period_s / per
+    yp, dyp, ym, dym = model[M_PATH], model[M_PATH + 1], model[M_MEASURED], model[M_MEASURED + 1]
+    wp, zp, wm, zm = path_lag[0], path_lag[1], measured_lag[0], measured_lag[1]
+    states = (dym / (wm * wm) + 2.0 * zm / wm * ym) - (dyp / (wp * wp) + 2.0 * zp / wp * yp)
+    d_path, d_measured = round((known_delay_s + path_lag[2]) / h), round((known_delay_s + measured_lag[2]) / h)
+    head = int(model[M_HEAD])
+    inputs = 0.0  # the commands sent between the two lags' delays, summed over their substeps
+    for back in range(min(d_path, d_measured), max(d_path, d_measured)):
+        inputs += _input(history, head, -1 - back, 0, per)
+    inputs *= h if d_measured > d_path else -h
+    steady = (2.0 * zm / wm - 2.0 * zp / wp + (d_measured - d_path) * h) * ym
+    return speed_mps * measured_lag[3] * (states + inputs - steady)

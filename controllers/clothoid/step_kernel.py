@@ -33,7 +33,8 @@ from controllers.clothoid.lookahead import (
 from controllers.clothoid.lookahead_filter import filtered_lookahead
 from controllers.clothoid.path_feedforward import lag_inverse_curvature, previewed_curvature, two_degree_of_freedom_rate
 from controllers.clothoid.pose_prediction import along_arc
-from controllers.clothoid.preview_model import preview_curvature, preview_curvatures
+from controllers.clothoid.preview_model import HANDLING_GRID_G, preview_curvature, preview_curvatures
+from controllers.clothoid.sideslip_release import RELEASE_MIN_ACCEL_MPS2, planned_acceleration, steady_sideslip
 from controllers.clothoid.speed_tables import table_row
 from controllers.clothoid.vehicle_tuning import LAG_COLUMNS as LAG_PARAMETERS
 from workbench.base.path_search import TRACK_OUT_SIZE, TRACK_PROGRESS, TRACK_S, TRACK_STATE_SIZE, track
@@ -63,7 +64,7 @@ PARAMS = np.dtype(
     + [(name, np.int64) for name in ("lookahead_mode", "initial_curvature")]
     + [(name, np.bool_) for name in (
         "course", "excess", "feedforward", "warm_search", "delay_model", "feedforward_inversion",
-        "lag_model_reference",
+        "lag_model_reference", "sideslip_release",
     )]
 )  # fmt: skip
 
@@ -87,9 +88,11 @@ STEP_DONE, NEED_FLOOR, NEED_FILTER = 0, 1, 2
 FILTER_ROWS = 541
 #: Rows of the floor table: every speed band up to 540 km/h.
 FLOOR_ROWS = 120
-#: Size of `clothoid_step`'s scratch array: a table row, a projection, then the two lags' rows at this speed.
+#: Size of `clothoid_step`'s scratch array: a table row, a projection, the two lags' rows at this speed, then the
+#: release table's row (`VehicleTuning.release_table`).
 LAG_ROWS = 4 + TRACK_OUT_SIZE
-SCRATCH_SIZE = LAG_ROWS + 8
+RELEASE_ROW = LAG_ROWS + 8
+SCRATCH_SIZE = RELEASE_ROW + 1 + len(HANDLING_GRID_G)
 
 #: What the step holds between calls (`state`, one record, made by `initial_state`): the integrator's curvature
 #: command (1/m; NaN before the first step; with the lag-inverting feed-forward the feedback's alone); the speed
@@ -227,6 +230,7 @@ class StepArguments(NamedTuple):
     lags: np.ndarray
     measured_lags: np.ndarray
     lag_speeds: np.ndarray
+    releases: np.ndarray
     schedule: np.ndarray
     schedule_speeds: np.ndarray
     scores: np.ndarray
@@ -247,6 +251,7 @@ def clothoid_step(
     lags: np.ndarray,
     measured_lags: np.ndarray,
     lag_speeds: np.ndarray,
+    releases: np.ndarray,
     schedule: np.ndarray,
     schedule_speeds: np.ndarray,
     scores: np.ndarray,
@@ -323,9 +328,30 @@ def clothoid_step(
             measured_lag[:] = path_lag
         delay = p.known_delay
         dp.record_and_advance(model, history, t_s, p.dt, path_lag, measured_lag, delay, steering_kappa)
+        deviation = rate = 0.0
+        if p.sideslip_release and releases.shape[0] > 0 and p.course and vx_mps > p.min_speed:
+            release = scratch[RELEASE_ROW : RELEASE_ROW + releases.shape[1]]  # `sideslip_release.py`
+            table_row(lag_speeds, releases, speed * 3.6, False, release)
+            rate = release[0]
+            if rate > 0.0:  # braking or driving, now or within the dead time (`sideslip_release.py`)
+                here = scratch[4 : 4 + TRACK_OUT_SIZE]
+                track(path, record, st.here, x_m, y_m, here)
+                pushing = max(
+                    abs(planned_acceleration(path, record, here[0])),
+                    abs(planned_acceleration(path, record, here[0] + speed * delay)),
+                )
+                if pushing <= RELEASE_MIN_ACCEL_MPS2:
+                    rate = 0.0
+            if rate > 0.0:  # the measured sideslip less the steady turn's and the lags' transient
+                deviation = (
+                    math.atan2(vy_mps, vx_mps)
+                    - steady_sideslip(release, speed * yaw_rate_rad_s)
+                    - dp.lag_transient_sideslip(model, history, speed, p.dt, path_lag, measured_lag, delay)
+                )
         px, py, ph, kappa0 = dp.predicted_start(
-            model, history, x_m, y_m, heading, kappa0, speed, p.dt, path_lag, measured_lag, delay, p.yaw_rate_age
-        )
+            model, history, x_m, y_m, heading, kappa0, speed, p.dt, path_lag, measured_lag, delay, p.yaw_rate_age,
+            deviation, rate,
+        )  # fmt: skip
         kappa0 = min(max(kappa0, -kappa_max), kappa_max)
         horizon -= delay
     if horizon > 0.0:

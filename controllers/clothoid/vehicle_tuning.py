@@ -21,7 +21,8 @@ from controllers.clothoid.curvature_limits import CurvatureLimits
 from controllers.clothoid.filter_schedule import FilterSchedule
 from controllers.clothoid.lead_filter import LeadFilterParams
 from controllers.clothoid.loop_requirements import REQUIRED_GAIN_MARGIN_DB, REQUIRED_PHASE_MARGIN_DEG
-from controllers.clothoid.preview_model import PreviewResponse
+from controllers.clothoid.preview_model import HANDLING_GRID_G, PreviewResponse
+from controllers.clothoid.sideslip_release import SideslipRelease
 from controllers.clothoid.speed_tables import table_row
 from workbench.base.errors import WorkbenchInputError, shown_all, value_text
 from workbench.vehicles.steering_lag import SteeringLag
@@ -120,7 +121,8 @@ class VehicleTuning:
     empty when not identified), floors ((speed_kmh, the lookahead floor the margins design computed there, m), at
     some of the lags' speeds), floor_design (what they were computed for; None: no floors) and previews ((speed_kmh,
     the preview responses identified there) at the lags' speeds, all on one grid of taps; empty when not
-    identified)."""
+    identified) and releases ((speed_kmh, the sideslip's steady turns and release identified there,
+    `sideslip_release.py`) at the lags' speeds; empty when not identified)."""
 
     filter_schedule: FilterSchedule
     limits: CurvatureLimits
@@ -130,6 +132,7 @@ class VehicleTuning:
     floors: tuple[tuple[float, float], ...] = ()
     floor_design: FloorDesign | None = None
     previews: tuple[tuple[float, PreviewResponse], ...] = ()
+    releases: tuple[tuple[float, SideslipRelease], ...] = ()
 
     def __post_init__(self) -> None:
         if not isinstance(self.filter_schedule, FilterSchedule):
@@ -170,6 +173,16 @@ class VehicleTuning:
                     f"{shown_all(s for s, _ in previews)}"
                 )
         object.__setattr__(self, "previews", previews)
+        releases = tuple((float(speed), release) for speed, release in self.releases)
+        if releases and (
+            tuple(s for s, _ in releases) != self.lag_speeds_kmh
+            or not all(isinstance(r, SideslipRelease) for _, r in releases)
+        ):
+            raise WorkbenchInputError(
+                f"releases must be (speed_kmh, SideslipRelease) at the lags' speeds {shown_all(self.lag_speeds_kmh)}; "
+                f"got speeds {shown_all(s for s, _ in releases)}"
+            )
+        object.__setattr__(self, "releases", releases)
 
     @property
     def lag_explains_logs(self) -> bool:
@@ -208,6 +221,15 @@ class VehicleTuning:
         if not self.previews:
             return np.zeros((0, 0))
         return np.array([r.handling_gain for _, r in self.previews], dtype=float)
+
+    @functools.cached_property
+    def release_table(self) -> np.ndarray:
+        """The sideslip's release at the lags' speeds (n, 1 + len(HANDLING_GRID_G)): each row the release rate
+        (1/s; 0: none) then the steady sideslip on the grid (rad), `SideslipRelease.row`; no rows without
+        releases."""
+        if not self.releases:
+            return np.zeros((0, 1 + len(HANDLING_GRID_G)))
+        return np.array([release.row() for _, release in self.releases], dtype=float)
 
     def recorded_floor_m(
         self, inputs: FloorInputs, lock_curvature_1pm: float, curvature_limit_1pm: float = math.inf

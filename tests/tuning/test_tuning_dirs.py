@@ -19,6 +19,8 @@ import tuning.preset_tuning as preset_tuning
 from controllers.clothoid.curvature_limits import CurvatureLimits
 from controllers.clothoid.filter_schedule import DEFAULT_FILTER, FilterSchedule
 from controllers.clothoid.lead_filter import LeadFilterParams
+from controllers.clothoid.preview_model import HANDLING_GRID_G
+from controllers.clothoid.sideslip_release import SideslipRelease
 from controllers.clothoid.vehicle_tuning import VehicleTuning
 from tuning.cli import _parser as tuning_parser
 from tuning.filter_file import read_filter_file
@@ -197,6 +199,11 @@ def test_measured_lag_at_interpolates_like_lag_at() -> None:
     assert "measured lags" in mid.source
     with pytest.raises(WorkbenchInputError, match="measured_lags' speeds"):
         VehicleTuning(schedule, limits, path, "test", ((30.0, slow),))
+    grid = (0.0,) + (-0.01,) * (len(HANDLING_GRID_G) - 1)
+    with pytest.raises(WorkbenchInputError, match=r"releases must be \(speed_kmh, SideslipRelease\) at the lags'"):
+        VehicleTuning(schedule, limits, path, "test", releases=((30.0, SideslipRelease(grid)),))
+    with pytest.raises(WorkbenchInputError, match="releases must be"):
+        VehicleTuning(schedule, limits, path, "test", releases=((30.0, SideslipRelease(grid)), (60.0, 0.1)))
 
 
 def _copy_shipped(name: str, directory: Path) -> Path:
@@ -319,6 +326,34 @@ def test_the_handling_gain_is_read_checked_and_optional(tmp_path: Path) -> None:
         del row["preview_handling_gain"]
     _write_lead(directory, doc)
     assert np.all(read_vehicle_tuning(directory).handling_table == 1.0)
+
+
+def test_the_sideslip_release_is_read_checked_and_optional(tmp_path: Path) -> None:
+    """The shipped truck's release is its rows' steady sideslip and release rate (0: not identified) in
+    `VehicleTuning.release_table`; a row without it while others have it, or with a rate out of range, is refused
+    naming the row; a file without any (made before it was identified) reads as none."""
+    directory = _copy_shipped("tractor-semitrailer", tmp_path / "release")
+    doc = json.loads((directory / LEAD_FILE).read_text())
+    rows = doc["design"]["per_speed"]
+    table = read_vehicle_tuning(directory).release_table
+    for row, got in zip(rows, table, strict=True):
+        assert got[0] == pytest.approx(row["release_rate_1ps"], rel=1e-15)
+        assert got[1:].tolist() == row["release_steady_sideslip_rad"]
+    assert table[1, 0] > 5.0  # 20 km/h: the loaded truck's push released within 0.2 s
+    rows[3]["release_rate_1ps"] = -1.0
+    _write_lead(directory, doc)
+    with pytest.raises(WorkbenchInputError, match=r"per_speed\[3\] \(sideslip release\): release_rate_1ps must be"):
+        read_vehicle_tuning(directory)
+    del rows[3]["release_rate_1ps"]
+    _write_lead(directory, doc)
+    with pytest.raises(WorkbenchInputError, match=r"per_speed\[3\] lacks some of \['release_steady_sideslip_rad'"):
+        read_vehicle_tuning(directory)
+    for row in rows:
+        for key in [k for k in row if k.startswith("release_")]:
+            del row[key]
+    _write_lead(directory, doc)
+    tuning = read_vehicle_tuning(directory)
+    assert tuning.releases == () and tuning.release_table.shape == (0, 1 + len(HANDLING_GRID_G))
 
 
 def _longer_car(tmp_path: Path) -> Path:

@@ -211,3 +211,68 @@ def test_the_substeps_divide_the_period() -> None:
     assert dp.substeps_per_period(0.001) == 1
     assert dp.substeps_per_period(0.005) == 3  # 1.67 ms
     assert dp.history_length(0.02, 0.31) == 19
+
+
+def test_the_lags_transient_sideslip_is_their_integrated_sideslip_less_its_steady_value() -> None:
+    """The lags' transient sideslip in closed form (`lag_transient_sideslip`) against its definition, integrated on
+    the fine grid from scipy's lsim of both lags (random commands, a path lag slower than the yaw-rate lag, their
+    delays different): speed times the integral of the path curvature less the yaw-rate curvature since rest, less
+    the steady part (group delay_m - group delay_p) times the yaw-rate lag's change; within 2e-6 rad (the
+    trapezoid on 0.5 ms) at every step, and zero at rest."""
+    rng = np.random.default_rng(11)
+    steps, fine, speed, delay_s = 300, 0.0005, 8.0, 0.11
+    measured_lag = np.array([*MEASURED_LAG[:3], PATH_LAG[3]])
+    commands = np.repeat(rng.uniform(-0.05, 0.05, steps // 10), 10)
+    path, yaw = _plant(commands, PATH_LAG, delay_s, fine), _plant(commands, measured_lag, delay_s, fine)
+    integral = np.concatenate([[0.0], np.cumsum(0.5 * (path - yaw)[:-1] + 0.5 * (path - yaw)[1:]) * fine])
+
+    def group_delay(lag: np.ndarray) -> float:
+        return float(lag[2] + 2.0 * lag[1] / lag[0])
+
+    steady_per_yaw = group_delay(measured_lag) - group_delay(PATH_LAG)
+    per = round(PERIOD / fine)
+    model, history = np.full(dp.MODEL_SIZE, np.nan), np.empty(dp.history_length(PERIOD, delay_s + PATH_LAG[2]))
+    errors = []
+    for step in range(steps - 20):
+        i = step * per
+        dp.record_and_advance(model, history, step * PERIOD, PERIOD, PATH_LAG, measured_lag, delay_s, commands[0])
+        got = dp.lag_transient_sideslip(model, history, speed, PERIOD, PATH_LAG, measured_lag, delay_s)
+        expected = speed * (integral[i] - steady_per_yaw * (yaw[i] - yaw[0]))
+        if step == 0:
+            assert got == pytest.approx(0.0, abs=1e-15)
+        errors.append(abs(got - expected))
+        dp.send(model, history, commands[step])
+    assert max(errors) < 2e-6
+    assert np.abs(speed * integral).max() > 1e-2  # the sideslip the test checks is not small
+
+
+@pytest.mark.parametrize("rate_1ps", [2.0, 12.5, 1000.0])
+def test_a_released_deviation_turns_the_course_by_its_release(rate_1ps: float) -> None:
+    """On a straight, nothing commanded, a sideslip deviation d released at rate r over the dead time T turns the
+    predicted heading by -d (1 - exp(-r T)) (to rounding: the release is exact per substep), and the position is
+    the course's integral (against the closed form of a heading decaying exponentially, small angles to second
+    order: within half a substep's travel times the release and r times the substep, each substep an arc; measured
+    0.01 um at 2/s, 0.3 um at 12.5/s, 31 um at 1000/s); with no rate the prediction is the one without a
+    deviation, bit for bit."""
+    model, history = np.full(dp.MODEL_SIZE, np.nan), np.empty(dp.history_length(PERIOD, 0.4))
+    for step in range(30):
+        dp.record_and_advance(model, history, step * PERIOD, PERIOD, PATH_LAG, MEASURED_LAG, 0.11, 0.0)
+        dp.send(model, history, 0.0)
+    speed, deviation, delay_s = 10.0, 0.01, 0.11
+    x, y, heading, _ = dp.predicted_start(
+        model, history, 0.0, 0.0, 0.0, 0.0, speed, PERIOD, PATH_LAG, MEASURED_LAG, delay_s, 0.0, deviation, rate_1ps
+    )
+    released = deviation * (1.0 - math.exp(-rate_1ps * delay_s))
+    assert heading == pytest.approx(-released, rel=1e-12, abs=1e-15)
+    # heading(t) = -d (1 - exp(-r t)): y = -v d (T - (1 - exp(-r T)) / r), x = v T to first order
+    expected_y = -speed * deviation * (delay_s - (1.0 - math.exp(-rate_1ps * delay_s)) / rate_1ps)
+    substep = speed * dp.SUBSTEP_S  # each substep an arc: its heading ramps where the release steps
+    assert y == pytest.approx(expected_y, abs=max(1e-7, 0.5 * substep * released * min(1.0, rate_1ps * dp.SUBSTEP_S)))
+    assert x == pytest.approx(speed * delay_s, abs=speed * delay_s * deviation**2)
+    held = dp.predicted_start(
+        model, history, 0.0, 0.0, 0.0, 0.0, speed, PERIOD, PATH_LAG, MEASURED_LAG, delay_s, 0.0, deviation, 0.0
+    )
+    without = dp.predicted_start(
+        model, history, 0.0, 0.0, 0.0, 0.0, speed, PERIOD, PATH_LAG, MEASURED_LAG, delay_s, 0.0
+    )
+    assert held == without and without[1:3] == (0.0, 0.0)
