@@ -27,7 +27,8 @@ discretised exactly (zero-order hold) at the substep, per step at the speed's in
 the yaw rate (kappa(0)) is than the pose (`ClothoidConfig.yaw_rate_age_s`: a vehicle bus often delivers it later
 than the localisation its pose): read as the pose's age, a 10 ms older yaw rate entering a hairpin is 1 % of its
 curvature behind, which the feedback takes for the vehicle's own and steers against (the dynamic car on
-Zandvoort's hairpin: max |CTE| twice that with an aligned yaw rate).
+Zandvoort's hairpin: max |CTE| twice that with an aligned yaw rate). Where the speed plan brakes or drives, the
+sideslip the lags do not explain is released over T too (`sideslip_release.py`, `lag_transient_sideslip`).
 """
 
 from __future__ import annotations
@@ -189,8 +190,9 @@ def predicted_start(
 
     kappa0 is measured yaw_rate_age_s (s) before the pose (the yaw rate's latency less the pose's; negative: after
     it), so its prediction starts from the measured lag's model then (`_measured_at`). deviation_rad (rad): the
-    measured sideslip less the lags' (`lag_sideslip`), released at release_rate_1ps (1/s) over the dead time, each
-    substep's release turning the course (`sideslip_release.py`; 0: none)."""
+    measured sideslip's deviation from the steady turn's and the lags' transient (`lag_transient_sideslip`),
+    released at release_rate_1ps (1/s) over the dead time, each substep's release turning the course
+    (`sideslip_release.py`; 0: none)."""
     per, path, measured, d_path, d_measured = _substep_lags(period_s, path_lag, measured_lag, known_delay_s)
     h = period_s / per
     head = int(model[M_HEAD])
@@ -199,7 +201,7 @@ def predicted_start(
     ym0 = _measured_at(ym, dym, measured_lag, history, head, -round(yaw_rate_age_s / h), d_measured, per, h)
     kappa_now = kappa0 + measured_lag[3] * (ym - ym0)  # kappa(0) at the pose's time
     x, y, heading = x_m, y_m, heading_rad
-    kept = math.exp(-release_rate_1ps * h)  # of the deviation, over a substep
+    kept = math.exp(-release_rate_1ps * h) if deviation_rad != 0.0 else 1.0  # of the deviation, over a substep
     left = deviation_rad
     for offset in range(round(known_delay_s / h)):
         before = yp

@@ -263,7 +263,8 @@ def clothoid_step(
     (MEASUREMENT), with the parameters (PARAMS) and the state (STATE, advanced) on the compiled path
     (`path_search.CompiledPath`'s table and record); diagnostics (16) in the order of controller.DIAGNOSTIC_KEYS.
     scores, results: the search's work arrays (`lookahead.py`); history: the delay predictor's commands sent
-    (`delay_predictor.history_length` slots; any size without it). lags and measured_lags hold each speed's lag in
+    (`delay_predictor.history_length` slots; any size without it); releases: the sideslip's release at the lags'
+    speeds (`VehicleTuning.release_table`; no rows: none). lags and measured_lags hold each speed's lag in
     their first LAG_COLUMNS columns and, when the feed-forward and the reference curvature come from the preview
     responses (`preview_model.py`), its steering and its measured taps after them (lags may then end with the
     handling gain, `VehicleTuning.preview_lag_tables`: its columns beyond measured_lags'); with four columns they
@@ -329,7 +330,7 @@ def clothoid_step(
         delay = p.known_delay
         dp.record_and_advance(model, history, t_s, p.dt, path_lag, measured_lag, delay, steering_kappa)
         deviation = rate = 0.0
-        if p.sideslip_release and releases.shape[0] > 0 and p.course and vx_mps > p.min_speed:
+        if p.sideslip_release and delay > 0.0 and releases.shape[0] > 0 and p.course and vx_mps > p.min_speed:
             release = scratch[RELEASE_ROW : RELEASE_ROW + releases.shape[1]]  # `sideslip_release.py`
             table_row(lag_speeds, releases, speed * 3.6, False, release)
             rate = release[0]
