@@ -53,7 +53,6 @@ from controllers.clothoid.lead_filter import DiscreteLeadFilter, LeadFilterParam
 from controllers.clothoid.lookahead import MAX_CURVE_POINTS, candidate_count
 from controllers.clothoid.lookahead_filter import RATE_LIMIT
 from controllers.clothoid.path_feedforward import FeedforwardTiming
-from controllers.clothoid.preview_model import HANDLING_GRID_G
 from controllers.clothoid.vehicle_tuning import FloorInputs, VehicleTuning
 from controllers.config_checks import Choice, Flag, Instance, Number, check_options, option
 from controllers.search_space import Tunable
@@ -548,7 +547,7 @@ class ClothoidController(Controller[ClothoidConfig]):
         compiled = path.compiled()
         self._step_arguments = sk.StepArguments(
             self._measured, self._params, self._state, compiled.table, compiled.record, self._limits,
-            self._limit_speeds, self._lags, self._measured_lags, self._lag_speeds, self._releases, self._schedule,
+            self._limit_speeds, self._lags, self._measured_lags, self._lag_axis, self._schedule,
             self._schedule_speeds, self._scores, self._results, self._diag, self._history,
         )  # fmt: skip
         # The planned speeds' floors at reset, not in a step (~0.04 s a band, with the delay model 0.5 s).
@@ -571,10 +570,13 @@ class ClothoidController(Controller[ClothoidConfig]):
                     self._lags = self._lags[:, : self._measured_lags.shape[1]]
                 first, spacing, _, _ = self.tuning.preview_tables
                 self._params["preview_first_tap"], self._params["preview_spacing"] = first, spacing
-            self._releases = self.tuning.release_table
+            releases = self.tuning.release_table
         else:
             self._lag_speeds, self._lags, self._measured_lags = np.zeros(0), np.zeros((0, 4)), np.zeros((0, 4))
-            self._releases = np.zeros((0, 1 + len(HANDLING_GRID_G)))
+            releases = np.zeros((0, 0))
+        # the speeds, then the release table transposed (step_kernel.clothoid_step's lag_axis; only the speeds
+        # without releases)
+        self._lag_axis = np.vstack([self._lag_speeds, releases.T]) if releases.size else self._lag_speeds[None, :]
         if self.filter_schedule is not None:
             self._schedule_speeds, self._schedule = self.filter_schedule.table
         else:

@@ -229,8 +229,7 @@ class StepArguments(NamedTuple):
     limit_speeds: np.ndarray
     lags: np.ndarray
     measured_lags: np.ndarray
-    lag_speeds: np.ndarray
-    releases: np.ndarray
+    lag_axis: np.ndarray
     schedule: np.ndarray
     schedule_speeds: np.ndarray
     scores: np.ndarray
@@ -250,8 +249,7 @@ def clothoid_step(
     limit_speeds: np.ndarray,
     lags: np.ndarray,
     measured_lags: np.ndarray,
-    lag_speeds: np.ndarray,
-    releases: np.ndarray,
+    lag_axis: np.ndarray,
     schedule: np.ndarray,
     schedule_speeds: np.ndarray,
     scores: np.ndarray,
@@ -263,8 +261,10 @@ def clothoid_step(
     (MEASUREMENT), with the parameters (PARAMS) and the state (STATE, advanced) on the compiled path
     (`path_search.CompiledPath`'s table and record); diagnostics (16) in the order of controller.DIAGNOSTIC_KEYS.
     scores, results: the search's work arrays (`lookahead.py`); history: the delay predictor's commands sent
-    (`delay_predictor.history_length` slots; any size without it); releases: the sideslip's release at the lags'
-    speeds (`VehicleTuning.release_table`; no rows: none). lags and measured_lags hold each speed's lag in
+    (`delay_predictor.history_length` slots; any size without it). lag_axis: the lags' speeds (km/h) in its first
+    row, then the sideslip's release table transposed (`VehicleTuning.release_table`: a row of release rates, then
+    one per point of HANDLING_GRID_G; the speeds alone: none), one array because numba's dispatch costs each
+    argument about 0.1 us a step. lags and measured_lags hold each speed's lag in
     their first LAG_COLUMNS columns and, when the feed-forward and the reference curvature come from the preview
     responses (`preview_model.py`), its steering and its measured taps after them (lags may then end with the
     handling gain, `VehicleTuning.preview_lag_tables`: its columns beyond measured_lags'); with four columns they
@@ -274,6 +274,7 @@ def clothoid_step(
     yaw_rad, yaw_rate_rad_s, steer_wheel_rad = m.yaw, m.yaw_rate, m.steer_wheel
     floors, filters, buffers, scratch = st.floors, st.filters, st.buffers, st.scratch
     speed = math.hypot(vx_mps, vy_mps)  # Measurement.speed_mps
+    lag_speeds = lag_axis[0]
     spacing = record[0].spacing
     filtered = schedule.shape[0] > 0
 
@@ -330,16 +331,18 @@ def clothoid_step(
         delay = p.known_delay
         dp.record_and_advance(model, history, t_s, p.dt, path_lag, measured_lag, delay, steering_kappa)
         deviation = rate = 0.0
-        if p.sideslip_release and delay > 0.0 and releases.shape[0] > 0 and p.course and vx_mps > p.min_speed:
-            release = scratch[RELEASE_ROW : RELEASE_ROW + releases.shape[1]]  # `sideslip_release.py`
+        if p.sideslip_release and delay > 0.0 and lag_axis.shape[0] > 1 and p.course and vx_mps > p.min_speed:
+            releases = lag_axis[1:].T  # (speeds, the rate and the grid's sideslips): `sideslip_release.py`
+            release = scratch[RELEASE_ROW : RELEASE_ROW + releases.shape[1]]
             table_row(lag_speeds, releases, speed * 3.6, False, release)
             rate = release[0]
-            if rate > 0.0:  # braking or driving, now or within the dead time (`sideslip_release.py`)
-                here = scratch[4 : 4 + TRACK_OUT_SIZE]
-                track(path, record, st.here, x_m, y_m, here)
+            if rate > 0.0:  # braking or driving, now or within the dead time (`sideslip_release.py`), read at the
+                # last step's foot point of the measured position (the feed-forward's tracker; without the
+                # feed-forward, of the start pose): a period's travel is nothing to a plan's acceleration
+                s_here = st.here[TRACK_S] if p.feedforward else st.tracker[TRACK_S]
                 pushing = max(
-                    abs(planned_acceleration(path, record, here[0])),
-                    abs(planned_acceleration(path, record, here[0] + speed * delay)),
+                    abs(planned_acceleration(path, record, s_here)),
+                    abs(planned_acceleration(path, record, s_here + speed * delay)),
                 )
                 if pushing <= RELEASE_MIN_ACCEL_MPS2:
                     rate = 0.0
