@@ -10,10 +10,10 @@ import functools
 import hashlib
 import json
 import math
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from importlib import resources
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeVar
 
 from controllers.clothoid.filter_schedule import FilterSchedule
 from controllers.clothoid.loop_requirements import REQUIRED_GAIN_MARGIN_DB, REQUIRED_PHASE_MARGIN_DEG
@@ -62,6 +62,8 @@ MEASURED_LAG_KEYS = ("measured_omega_n_rad_s", "measured_zeta")
 PREVIEW_KEYS = ("preview_first_tap_s", "preview_tap_spacing_s", "preview_steering_taps", "preview_measured_taps")
 #: The preview responses' handling gain, optional (files made before it was identified: gains of one).
 HANDLING_KEY = "preview_handling_gain"
+#: What a per_speed model read by `_per_speed` is.
+T = TypeVar("T")
 #: The per_speed keys of the sideslip's release (`tuning.release_fit`): the steady sideslip on the handling grid
 #: (rad) and the release rate (1/s; 0: not identified); at every speed or at none (files made before it was
 #: identified: none).
@@ -244,44 +246,49 @@ def _previews(path: Path, design: Mapping[str, Any]) -> tuple[tuple[float, Previ
     """(speed_kmh, the preview responses) of design.per_speed (PREVIEW_KEYS, and HANDLING_KEY where given); empty
     when no row has them (files made before they were recorded), refused when only some rows have them or a row's
     are not a valid response."""
-    rows = design["per_speed"]  # checked by _lags
-    if not any(k in row for row in rows for k in PREVIEW_KEYS):
-        return ()
-    out = []
-    for i, row in enumerate(rows):
-        if any(k not in row for k in PREVIEW_KEYS):
-            raise WorkbenchInputError(
-                f"{path}: design.per_speed[{i}] lacks some of {list(PREVIEW_KEYS)}, which other speeds give; give "
-                "the preview responses at every speed or at none"
-            )
-        try:
-            handling = {"handling_gain": row[HANDLING_KEY]} if HANDLING_KEY in row else {}
-            response = PreviewResponse(*(row[k] for k in PREVIEW_KEYS), **handling)
-        except (WorkbenchInputError, TypeError, ValueError) as exc:
-            raise WorkbenchInputError(f"{path}: design.per_speed[{i}] (preview responses): {exc}") from None
-        out.append((float(row["speed_kmh"]), response))
-    return tuple(out)
+
+    def response(row: Mapping[str, Any]) -> PreviewResponse:
+        handling = {"handling_gain": row[HANDLING_KEY]} if HANDLING_KEY in row else {}
+        return PreviewResponse(*(row[k] for k in PREVIEW_KEYS), **handling)
+
+    return _per_speed(path, design, PREVIEW_KEYS, "the preview responses", "preview responses", response)
 
 
 def _releases(path: Path, design: Mapping[str, Any]) -> tuple[tuple[float, SideslipRelease], ...]:
     """(speed_kmh, the sideslip's release) of design.per_speed (RELEASE_KEYS; a release rate 0: not identified);
     empty when no row has them, refused when only some rows have them or a row's are not a valid release."""
+
+    def release(row: Mapping[str, Any]) -> SideslipRelease:
+        return SideslipRelease.from_rate(tuple(row["release_steady_sideslip_rad"]), row["release_rate_1ps"])
+
+    return _per_speed(path, design, RELEASE_KEYS, "the sideslip's release", "sideslip release", release)
+
+
+def _per_speed(
+    path: Path,
+    design: Mapping[str, Any],
+    keys: tuple[str, ...],
+    what: str,
+    label: str,
+    make: Callable[[Mapping[str, Any]], T],
+) -> tuple[tuple[float, T], ...]:
+    """(speed_kmh, make(row)) of each row of design.per_speed when any row has one of `keys`; every row must then
+    have all of them (else refused naming the row and `what`), and make's refusal names the row and `label`."""
     rows = design["per_speed"]  # checked by _lags
-    if not any(k in row for row in rows for k in RELEASE_KEYS):
+    if not any(k in row for row in rows for k in keys):
         return ()
     out = []
     for i, row in enumerate(rows):
-        if any(k not in row for k in RELEASE_KEYS):
+        if any(k not in row for k in keys):
             raise WorkbenchInputError(
-                f"{path}: design.per_speed[{i}] lacks some of {list(RELEASE_KEYS)}, which other speeds give; give the "
-                "sideslip's release at every speed or at none"
+                f"{path}: design.per_speed[{i}] lacks some of {list(keys)}, which other speeds give; give {what} at "
+                "every speed or at none"
             )
-        sideslip, rate = row["release_steady_sideslip_rad"], row["release_rate_1ps"]
         try:
-            release = SideslipRelease.from_rate(tuple(sideslip), rate)
+            made = make(row)
         except (WorkbenchInputError, TypeError, ValueError) as exc:
-            raise WorkbenchInputError(f"{path}: design.per_speed[{i}] (sideslip release): {exc}") from None
-        out.append((float(row["speed_kmh"]), release))
+            raise WorkbenchInputError(f"{path}: design.per_speed[{i}] ({label}): {exc}") from None
+        out.append((float(row["speed_kmh"]), made))
     return tuple(out)
 
 
