@@ -677,15 +677,21 @@ class ClothoidController(Controller[ClothoidConfig]):
         Returns
         -------
         LoopSettings
-            The sample time, the prediction time, the lead filter at this speed (None when off), the known delay
-            and the delay compensation.
+            The sample time, the prediction time, the lead filter at this speed (None when off), the known delay,
+            the delay compensation and the sideslip's release there where the controller may release it (while
+            the speed plan brakes or drives: sideslip_release on, a known delay with the model's compensation, the
+            course as heading and a release identified at this speed; else None).
         """
         from controllers.clothoid.loop_analysis import LoopSettings
 
         cfg = self.config
+        release = None
+        releasing = cfg.sideslip_release and cfg.heading == "course" and cfg.known_delay_s > 0.0
+        if releasing and cfg.predicts_with_model and self.tuning is not None:
+            release = self.tuning.release_at(speed_kmh)
         return LoopSettings(
             self._dt, cfg.prediction_time_s, lead=self._lead_at(speed_kmh), known_delay_s=cfg.known_delay_s,
-            delay_compensation=cfg.delay_compensation,
+            delay_compensation=cfg.delay_compensation, release=release,
         )  # fmt: skip
 
     def lookahead_floor_m(self, speed_mps: float) -> float:

@@ -56,6 +56,7 @@ from controllers.clothoid.loop_requirements import (
     UNCERTAIN_DELAY_MARGIN_FRACTION,
     predicts_with_model,
 )
+from controllers.clothoid.sideslip_release import SideslipRelease, steady_sideslip
 from workbench.base.errors import (
     WorkbenchInputError,
     require_choice,
@@ -83,7 +84,10 @@ class LoopSettings:
     s, rounded to whole periods), known_delay_s (the dead time it knows, measurement latency plus actuation dead
     time, s: the same pure delay in the loop; `ClothoidConfig.known_delay_s`), delay_compensation (how the pose is
     predicted over the known delay: "model", with the lags driven by the commands sent, `delay_predictor.py`, in
-    whole periods here; "arc", on kappa(0) over prediction_time_s + known_delay_s).
+    whole periods here; "arc", on kappa(0) over prediction_time_s + known_delay_s), release (the sideslip's release
+    at this speed, `sideslip_release.SideslipRelease`, acting in the loop as it does while the speed plan brakes or
+    drives, with "model" only: the plant then has a fourth output, its sideslip; None: not in the loop, as at a held
+    speed, where the controller does not release).
 
     Where a delay sits does not matter here: the loop is single-input (broken at the steering sent) and every
     output the controller measures (y, psi, kappa) comes out of the same plant, so a measurement latency z^-n P(z)
@@ -97,6 +101,7 @@ class LoopSettings:
     measurement_delay_s: float = 0.0
     known_delay_s: float = 0.0
     delay_compensation: str = "model"
+    release: SideslipRelease | None = None
 
     def __post_init__(self) -> None:
         require_in_range("sample_time_s", self.sample_time_s, 1e-4, 1.0, "s")
@@ -108,6 +113,11 @@ class LoopSettings:
             raise WorkbenchInputError(
                 f"initial_curvature must be one of {', '.join(INITIAL_CURVATURES)} for the analysis; got "
                 f"{self.initial_curvature!r}"
+            )
+        if self.release is not None and not self.predicts_with_model:
+            raise WorkbenchInputError(
+                "the sideslip's release acts over a known delay with delay_compensation 'model'; got "
+                f"{self.delay_compensation!r} with known_delay_s {self.known_delay_s:g} s"
             )
         if self.predicts_with_model and self.initial_curvature != "yaw-rate":
             raise WorkbenchInputError(
@@ -123,8 +133,9 @@ class LoopSettings:
     @property
     def nominal(self) -> LoopSettings:
         """The loop the delay compensation leaves when its model is the plant: with "model", the delay-free loop
-        (Smith's predictor takes the delay out of the characteristic equation); with "arc", this loop itself."""
-        return dataclasses.replace(self, known_delay_s=0.0) if self.predicts_with_model else self
+        (Smith's predictor takes the delay out of the characteristic equation; without a known delay nothing is
+        released); with "arc", this loop itself."""
+        return dataclasses.replace(self, known_delay_s=0.0, release=None) if self.predicts_with_model else self
 
 
 @dataclass(frozen=True)
@@ -246,11 +257,12 @@ class PlantLags:
 
 
 def _plant_continuous(
-    lags: PlantLags, speed_mps: float, path_curvature_1pm: float
+    lags: PlantLags, speed_mps: float, path_curvature_1pm: float, sideslip: bool = False
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(A, B, C) of the plant in continuous time, without its delays: states path lag (2), psi, y, measured lag (2),
     each lag as SteeringLag's [y, y'] realisation (its gain K here); inputs the steering reaching the path lag and
-    the measured lag; outputs (y, psi, kappa measured)."""
+    the measured lag; outputs (y, psi, kappa measured) and with `sideslip` the lags' part of the sideslip
+    (`_sideslip_line`)."""
     require_positive("speed_mps", speed_mps)
     v, kr = float(speed_mps), float(path_curvature_1pm)
     path, measured = lags.path, lags.measured or lags.path
@@ -259,9 +271,37 @@ def _plant_continuous(
     a_c[0:2, 0:2], b_c[0:2, 0] = path.companion_matrices()
     a_c[4:6, 4:6], b_c[4:6, 1] = measured.companion_matrices()
     a_c[2, 0], a_c[2, 3], a_c[3, 2] = v * path.steady_state_gain, -v * kr * kr, v
-    c_c = np.zeros((3, 6))
+    c_c = np.zeros((4 if sideslip else 3, 6))
     c_c[0, 3], c_c[1, 2], c_c[2, 4] = 1.0, 1.0, measured.steady_state_gain
+    if sideslip:
+        c_c[3] = v * measured.steady_state_gain * _integral_row(lags)
     return a_c, b_c, c_c
+
+
+def _steady_slope(release: SideslipRelease, lat_accel_mps2: float) -> float:
+    """The slope (rad per m/s^2) of the release's steady sideslip (`sideslip_release.steady_sideslip`) at this
+    lateral acceleration: a central difference over 0.001 m/s^2 (at a point of its piecewise-linear grid, the mean of
+    the two sides)."""
+    row = np.array(release.row())
+    step = 1e-3
+    return (steady_sideslip(row, lat_accel_mps2 + step) - steady_sideslip(row, lat_accel_mps2 - step)) / (2 * step)
+
+
+def _integral_row(lags: PlantLags) -> np.ndarray:
+    """The integral of the path lag's output less the measured lag's, over the lag states (path lag, psi, y,
+    measured lag), less the inputs' part (`_sideslip_line`): for y'' + 2 zeta wn y' + wn^2 y = wn^2 u(t - d) the
+    integral of u(t - d) - y is y' / wn^2 + (2 zeta / wn) y (`delay_predictor.lag_transient_sideslip`)."""
+    measured = lags.measured or lags.path
+    (wp, zp), (wm, zm) = (lags.path.omega_n_rad_s, lags.path.zeta), (measured.omega_n_rad_s, measured.zeta)
+    return np.array([-2.0 * zp / wp, -1.0 / wp**2, 0.0, 0.0, 2.0 * zm / wm, 1.0 / wm**2])
+
+
+def _sideslip_line(taps: tuple[int, int], weight: float) -> tuple[range, float]:
+    """The periods back (1 = the command sent a period ago) whose commands the integral of the two lags' inputs
+    holds, u(t - d_path) - u(t - d_measured) integrated (the commands between the two delays, taps in periods), and
+    each one's weight in the sideslip (rad per 1/m: weight x the period, signed)."""
+    low, high = sorted(taps)
+    return range(low + 1, high + 1), weight if taps[1] > taps[0] else -weight
 
 
 def _plant_parts(
@@ -273,41 +313,54 @@ def _plant_parts(
     path, measured = lags.path, lags.measured or lags.path
     extra = settings.measurement_delay_s + settings.known_delay_s
     taps = (_delay_steps(path.delay_s + extra, dt), _delay_steps(measured.delay_s + extra, dt))
-    return _discrete_plant(lags, float(speed_mps), float(path_curvature_1pm), dt)[0], taps
+    sideslip = settings.release is not None
+    return _discrete_plant(lags, float(speed_mps), float(path_curvature_1pm), dt, sideslip)[0], taps
 
 
 @lru_cache(maxsize=1024)
 def _discrete_plant(
-    lags: PlantLags, speed_mps: float, path_curvature_1pm: float, sample_time_s: float
+    lags: PlantLags, speed_mps: float, path_curvature_1pm: float, sample_time_s: float, sideslip: bool = False
 ) -> tuple[control.StateSpace, np.ndarray]:
-    """The plant without its delays at the controller period, and its frequency response on the margins' grid (n, 3,
-    2): cached, as the floor search asks for the same plant against several delays and lookaheads."""
-    a_c, b_c, c_c = _plant_continuous(lags, speed_mps, path_curvature_1pm)
-    a, b, c, d, _ = signal.cont2discrete((a_c, b_c, c_c, np.zeros((3, 2))), sample_time_s, method="zoh")
+    """The plant without its delays at the controller period, and its frequency response on the margins' grid (n,
+    outputs, 2): cached, as the floor search asks for the same plant against several delays and lookaheads."""
+    a_c, b_c, c_c = _plant_continuous(lags, speed_mps, path_curvature_1pm, sideslip)
+    d_c = np.zeros((c_c.shape[0], 2))
+    a, b, c, d, _ = signal.cont2discrete((a_c, b_c, c_c, d_c), sample_time_s, method="zoh")
     system = control.ss(a, b, c, d, sample_time_s)
     return system, _batched_response(system, _frequency_grid(sample_time_s)[1])
 
 
 def plant(lags: PlantLags, speed_mps: float, path_curvature_1pm: float, settings: LoopSettings) -> control.StateSpace:
     """The plant, discrete at the controller period: input the steering sent as kinematic curvature (1/m), outputs
-    (y m, psi rad, kappa 1/m) as the controller measures them (module docstring); the delays as a delay line."""
+    (y m, psi rad, kappa 1/m, and with settings.release beta rad) as the controller measures them (module
+    docstring); the delays as a delay line."""
     parts, taps = _plant_parts(lags, speed_mps, path_curvature_1pm, settings)
     a, b, c = np.asarray(parts.A), np.asarray(parts.B), np.asarray(parts.C)
-    n = max(taps)
+    m, n = a.shape[0], max(taps)
     # a delay line u -> d1 -> ... -> dn in front; input j of the lags takes tap taps[j] (0: u itself)
-    a_full = np.zeros((6 + n, 6 + n))
-    a_full[:6, :6] = a
-    b_full = np.zeros((6 + n, 1))
+    a_full = np.zeros((m + n, m + n))
+    a_full[:m, :m] = a
+    b_full = np.zeros((m + n, 1))
     for j, tap in enumerate(taps):
         if tap:
-            a_full[:6, 6 + tap - 1] += b[:, j]
+            a_full[:m, m + tap - 1] += b[:, j]
         else:
-            b_full[:6, 0] += b[:, j]
+            b_full[:m, 0] += b[:, j]
     if n:
-        b_full[6, 0] = 1.0
+        b_full[m, 0] = 1.0
         for i in range(1, n):
-            a_full[6 + i, 6 + i - 1] = 1.0
-    return control.ss(a_full, b_full, np.hstack([c, np.zeros((3, n))]), np.zeros((3, 1)), parts.dt)
+            a_full[m + i, m + i - 1] = 1.0
+    outputs = c.shape[0]
+    c_full = np.hstack([c, np.zeros((outputs, n))])
+    if settings.release is not None:  # the sideslip's part from the commands between the two lags' delays
+        back, weight = _sideslip_line(taps, _sideslip_weight(lags, speed_mps, settings))
+        c_full[3, [m + k - 1 for k in back]] += weight
+    return control.ss(a_full, b_full, c_full, np.zeros((outputs, 1)), parts.dt)
+
+
+def _sideslip_weight(lags: PlantLags, speed_mps: float, settings: LoopSettings) -> float:
+    """The sideslip (rad) per command (1/m) held a period between the two lags' delays: V K_m dt."""
+    return float(speed_mps) * (lags.measured or lags.path).steady_state_gain * settings.sample_time_s
 
 
 #: With the model's delay compensation, the controller's states before its line of commands sent: kappa_cmd, the
@@ -324,7 +377,10 @@ def _controller_step(
 ) -> tuple[int, Callable[[np.ndarray, np.ndarray], tuple[np.ndarray, float]]]:
     """(state size, step(state, [y, psi, kappa]) -> (next state, curvature sent)): the controller's step in deviation
     variables, linear, in the order `controller.py` runs it. State: [kappa_cmd, lead filter (3)], then with the
-    model's delay compensation the lags' model (path, measured: 2 each) and the commands sent (newest first)."""
+    model's delay compensation the lags' model (path, measured: 2 each) and the commands sent (newest first). With
+    settings.release the measurement holds the sideslip too ([y, psi, kappa, beta]) and its deviation from the
+    steady turn's and the lags' transient (`delay_predictor.lag_transient_sideslip`, in whole periods) is released
+    over the known delay (`delay_predictor.predicted_start`)."""
     dt, v = settings.sample_time_s, float(speed_mps)
     g_y, g_psi, g_k = gains
     if settings.lead is not None:
@@ -350,19 +406,38 @@ def _controller_step(
                 _delay_steps(measured_lag.delay_s + settings.known_delay_s, dt))  # fmt: skip
         ahead, sent = _delay_steps(settings.known_delay_s, dt), max(*taps, 1)
         lag_states = [0, 1, 4, 5]
+        release = settings.release
+        if release is not None:  # lag_transient_sideslip: the lags' integral from the model's states and the
+            # commands sent between the two lags' delays, less its steady value at the measured lag's state
+            integral_row = _integral_row(lags)[[0, 1, 4, 5]]
+            back, weight = _sideslip_line(taps, dt)
+            steady_part = integral_row[2] + integral_row[0] + (taps[1] - taps[0]) * dt  # per unit of y_m
+            kept = math.exp(-release.rate_1ps * dt)  # of the deviation, over a period
+            slope = _steady_slope(release, v * v * path_curvature_1pm)  # rad per m/s^2 of lateral acceleration
     core = _MODEL_CORE_STATES
     size = core + sent if model else 4
 
     def step(s: np.ndarray, meas: np.ndarray) -> tuple[np.ndarray, float]:
-        y, psi, kappa_meas = meas
+        y, psi, kappa_meas = meas[:3]
         kappa0 = kappa_meas if measured else s[0]
         if model:  # the course turned by the measured curvature plus the path lag's output less the measured
             # lag's now; kappa(0) the measured curvature plus the measured lag's change
             line = s[core:]
             z = np.array([s[4], s[5], psi, y, s[6], s[7]])
             held = kappa_meas - k_measured * s[6]
+            left = 0.0
+            if release is not None:  # the measured sideslip less the steady turn's (at V^2 kappa) and the lags'
+                # transient
+                inputs = weight * sum(line[k - 1] for k in back)
+                transient = v * k_measured * (integral_row @ s[4:8] + inputs - steady_part * s[6])
+                left = meas[3] - slope * v * v * kappa_meas - transient
             for j in range(ahead):  # the commands reaching each lag j periods from now (the last held beyond)
-                z = a_m @ z + b_m @ np.array([line[max(taps[0] - j - 1, 0)], line[max(taps[1] - j - 1, 0)], held])
+                turn = held
+                if release is not None:  # the deviation released over the period turns the course by as much
+                    released = left * (1.0 - kept)
+                    left -= released
+                    turn -= released / (v * dt)
+                z = a_m @ z + b_m @ np.array([line[max(taps[0] - j - 1, 0)], line[max(taps[1] - j - 1, 0)], turn])
             psi, y = z[2], z[3]
             kappa0 = kappa_meas + k_measured * (z[4] - s[6])
         yp, psip = y + psi * dp + 0.5 * kappa0 * dp * dp, psi + kappa0 * dp  # the chord formula, linearised
@@ -388,18 +463,19 @@ def _controller_step(
 def controller(
     settings: LoopSettings, lags: PlantLags, speed_mps: float, lookahead_m: float, path_curvature_1pm: float = 0.0
 ) -> control.StateSpace:
-    """The controller linearised (module docstring): inputs (y, psi, kappa), output the steering sent as curvature;
-    read off its linear step by unit probes."""
+    """The controller linearised (module docstring): inputs (y, psi, kappa, and with settings.release beta), output
+    the steering sent as curvature; read off its linear step by unit probes."""
     gains = clothoid_law_gains(lookahead_m, path_curvature_1pm)
     size, step = _controller_step(settings, lags, speed_mps, path_curvature_1pm, gains)
+    inputs = 3 if settings.release is None else 4
     a, c = np.zeros((size, size)), np.zeros((1, size))
-    b, d = np.zeros((size, 3)), np.zeros((1, 3))
+    b, d = np.zeros((size, inputs)), np.zeros((1, inputs))
     for i in range(size):
         e = np.zeros(size)
         e[i] = 1.0
-        a[:, i], c[0, i] = step(e, np.zeros(3))
-    for j in range(3):
-        e = np.zeros(3)
+        a[:, i], c[0, i] = step(e, np.zeros(inputs))
+    for j in range(inputs):
+        e = np.zeros(inputs)
         e[j] = 1.0
         b[:, j], d[0, j] = step(np.zeros(size), e)
     return control.ss(a, b, c, d, settings.sample_time_s)
@@ -537,7 +613,7 @@ def _frequency_grid(sample_time_s: float) -> tuple[np.ndarray, np.ndarray]:
 def _controller_with_response(
     lags: PlantLags, settings: LoopSettings, speed_mps: float, lookahead_m: float, path_curvature_1pm: float
 ) -> tuple[control.StateSpace, np.ndarray]:
-    """The controller (`controller`) and its frequency response on the grid, (n, 3): cached, since the floor search
+    """The controller (`controller`) and its frequency response on the grid, (n, inputs): cached, since the floor search
     asks for the same controller against several plant delays (`DelayRobustness`), and with the model's delay
     compensation it has some 30 states. The controller does not depend on settings.measurement_delay_s."""
     ctrl = controller(settings, lags, speed_mps, lookahead_m, path_curvature_1pm)
@@ -570,13 +646,17 @@ def loop_margins(
     from the delay-free plant (6 states), its delays as z^-n and the controller: the same numbers, a fraction of
     the work, for the controller's floor search."""
     _, taps = _plant_parts(lags, speed_mps, path_curvature_1pm, settings)
-    _, p = _discrete_plant(lags, float(speed_mps), float(path_curvature_1pm), settings.sample_time_s)  # (n, 3, 2)
+    sideslip = settings.release is not None
+    _, p = _discrete_plant(lags, float(speed_mps), float(path_curvature_1pm), settings.sample_time_s, sideslip)
     ctrl, c = _controller_with_response(
         lags, dataclasses.replace(settings, measurement_delay_s=0.0), speed_mps, lookahead_m, path_curvature_1pm
     )
     omega, z = _frequency_grid(settings.sample_time_s)
     delays = np.stack([z ** (-tap) for tap in taps], axis=1)  # (n, 2)
-    plant_response = np.einsum("nij,nj->ni", p, delays)  # (n, 3)
+    plant_response = np.einsum("nij,nj->ni", p, delays)  # (n, outputs)
+    if sideslip:  # the sideslip's part from the commands between the two lags' delays (`plant`)
+        back, weight = _sideslip_line(taps, _sideslip_weight(lags, speed_mps, settings))
+        plant_response[:, 3] += weight * sum(z ** (-k) for k in back)
     response = -np.einsum("ni,ni->n", c, plant_response)
     poles = control.feedback(-control.series(plant(lags, speed_mps, path_curvature_1pm, settings), ctrl), 1).poles()
     return _margins_from(omega, response, poles)
@@ -590,15 +670,19 @@ def _margin_checks(
     settings: LoopSettings, phase_margin_deg: float, gain_margin_db: float, delayed: DelayRobustness
 ) -> list[tuple[LoopSettings, float, float]]:
     """(loop, phase margin, gain margin) to keep: the nominal loop, then with the model the loop itself, with its
-    delay as known and as it may be (`lookahead_floor`)."""
+    delay as known and as it may be (`lookahead_floor`), without and with the sideslip's release in it where it has
+    one (`LoopSettings.release`)."""
     nominal = settings.nominal
     checks = [(nominal, phase_margin_deg, gain_margin_db)]
     if nominal is not settings:
-        checks.append((settings, delayed.phase_margin_deg, delayed.gain_margin_db))
+        # with a release, the loop at a held speed (nothing released) and the loop while the plan brakes or drives
+        loops = [settings] if settings.release is None else [dataclasses.replace(settings, release=None), settings]
         fraction = UNCERTAIN_DELAY_MARGIN_FRACTION
-        for error in delayed.delay_errors_s(settings.known_delay_s + settings.measurement_delay_s):
-            late = dataclasses.replace(settings, measurement_delay_s=settings.measurement_delay_s + error)
-            checks.append((late, fraction * delayed.phase_margin_deg, fraction * delayed.gain_margin_db))
+        for loop in loops:
+            checks.append((loop, delayed.phase_margin_deg, delayed.gain_margin_db))
+            for error in delayed.delay_errors_s(loop.known_delay_s + loop.measurement_delay_s):
+                late = dataclasses.replace(loop, measurement_delay_s=loop.measurement_delay_s + error)
+                checks.append((late, fraction * delayed.phase_margin_deg, fraction * delayed.gain_margin_db))
     return checks
 
 

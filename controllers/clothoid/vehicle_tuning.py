@@ -266,6 +266,19 @@ class VehicleTuning:
         speeds, lags, _ = self.lag_tables
         return _interpolated(self.lags, speed_kmh, "lags", self.source, speeds, lags)
 
+    def release_at(self, speed_kmh: float) -> SideslipRelease | None:
+        """The sideslip's release at speed_kmh (km/h), its table row (`release_table`) interpolated linearly in
+        speed as the compiled step reads it, clamped beyond the ends; None without releases or where none was
+        identified there (a rate of 0: nothing released)."""
+        _check_speed(speed_kmh)
+        if not self.releases:
+            return None
+        table = self.release_table
+        row = np.empty(table.shape[1])
+        table_row(np.array(self.lag_speeds_kmh, dtype=float), table, float(speed_kmh), False, row)
+        rate, *sideslip = row.tolist()
+        return SideslipRelease.from_rate(tuple(sideslip), rate) if rate > 0.0 else None
+
     def measured_lag_at(self, speed_kmh: float) -> SteeringLag | None:
         """The lag to the measured curvature (yaw rate / speed) at speed_kmh, interpolated as `lag_at`; None when the
         tuning has none (files made before it was recorded: the controller then uses the path lag)."""
