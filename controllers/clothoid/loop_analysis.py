@@ -13,6 +13,15 @@ in deviations from it: lateral offset y, heading error psi, curvature kappa.
   fit to a target on the path at the lookahead (so the arc's geometry is in them); kappa' V integrated by forward
   Euler; the lead filter of Eq. 6 (Tustin). The controller's state-space is read off its own linear step function
   by unit probes.
+- The sideslip's release (`sideslip_release.py`), where `LoopSettings.release` puts it in the loop (as while the
+  speed plan brakes or drives; at a held speed the controller releases nothing): the plant's sideslip, a fourth
+  output, is the lags' own (speed x K_m x the integral of the path lag's output less the measured lag's, in closed
+  form from their states and the commands between their delays: no integrator), and the controller releases its
+  deviation from the steady turn's (the release's slope about the operating lateral acceleration) and from the
+  model's transient over the known delay, turning the predicted course, as `delay_predictor.py` does in whole
+  periods. Where the release's steady sideslip is the lags' own and the delay is as told the deviation is zero and
+  the loop is the one without; with the vehicle's own steady sideslip and a dead time off it is a feedback of its
+  own, and the floor keeps the delayed margins with it as without (`lookahead_floor`).
 - The feed-forward (`path_feedforward.py`) is not in the loop: it is computed from the path and the speed alone,
   an input added to the loop, not a feedback. By default (`ClothoidConfig.feedforward_inversion`) the lag's inverse
   is added to the steering after the lead filter and the integrator holds the feedback alone; without it, its
@@ -411,7 +420,9 @@ def _controller_step(
             # commands sent between the two lags' delays, less its steady value at the measured lag's state
             integral_row = _integral_row(lags)[[0, 1, 4, 5]]
             back, weight = _sideslip_line(taps, dt)
-            steady_part = integral_row[2] + integral_row[0] + (taps[1] - taps[0]) * dt  # per unit of y_m
+            # its steady value per unit of y_m: the group delays' difference, 2 zeta_m / wn_m - 2 zeta_p / wn_p plus
+            # the delays' (the rows' coefficients of y_m and y_p)
+            steady_part = integral_row[2] + integral_row[0] + (taps[1] - taps[0]) * dt
             kept = math.exp(-release.rate_1ps * dt)  # of the deviation, over a period
             slope = _steady_slope(release, v * v * path_curvature_1pm)  # rad per m/s^2 of lateral acceleration
     core = _MODEL_CORE_STATES
@@ -734,7 +745,7 @@ def lookahead_floor(
     (`keeps_margins` tells that from a floor there that keeps them). The margins are those of the nominal loop
     (`LoopSettings.nominal`: with the model's delay compensation the delay-free one, which it leaves when its model
     is the vehicle); with that compensation the loop itself keeps `delayed`'s margins at the steering sent
-    (`DelayRobustness`). A bisection on the grid (margins mostly improve with the lookahead: the loop's gain falls
+    (`DelayRobustness`), without and with the sideslip's release in it where settings has one. A bisection on the grid (margins mostly improve with the lookahead: the loop's gain falls
     as L^-3), then a check every _FLOOR_CHECK_M above the result; a failure there restarts the bisection above
     it."""
     grid = np.arange(min_lookahead_m, max_lookahead_m + 1e-9, step_m)

@@ -1,10 +1,12 @@
 """The sideslip's release (`sideslip_release.py`): what a release accepts, its table row, the steady sideslip read
 from it (linear on the grid, in proportion beyond, odd in lateral acceleration); in the controller, nothing
 released where the plan holds the speed, and at a braked hairpin the delayed loop brought near the delay-free
-one."""
+one; in the loop analysis, the release of the lags' own sideslip changing nothing, the fast margins those of the
+whole loop, and the floor keeping the margins with the release in the loop where the controller may release."""
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -14,7 +16,16 @@ from hypothesis import strategies as st
 from scipy.constants import g as G_MPS2
 
 from controllers.base import Measurement
-from controllers.clothoid import ClothoidConfig
+from controllers.clothoid import ClothoidConfig, LeadFilterParams
+from controllers.clothoid.loop_analysis import (
+    LoopSettings,
+    PlantLags,
+    controller,
+    loop_margins,
+    loop_transfer,
+    margins,
+    plant,
+)
 from controllers.clothoid.preview_model import HANDLING_GRID_G
 from controllers.clothoid.sideslip_release import SideslipRelease, steady_sideslip
 from tuning.own_tuning import tuned_controller
@@ -26,6 +37,7 @@ from workbench.simulation.conditions import load_conditions
 from workbench.simulation.scenarios import Scenario
 from workbench.simulation.simulator import Simulation, SimulationConfig
 from workbench.vehicles import make_vehicle
+from workbench.vehicles.steering_lag import SteeringLag
 
 #: A rear axle slipping 0.5 deg per 0.1 g, a little more above 0.2 g.
 GRID = tuple(math.radians(-5.0 * a - (20.0 * (a - 0.2) ** 2 if a > 0.2 else 0.0)) for a in HANDLING_GRID_G)
@@ -141,3 +153,117 @@ def test_the_release_brings_a_braked_hairpin_near_the_delay_free_loop(vehicle: s
     assert [round(v, 3) for v in (without, with_release, delay_free)] == pytest.approx(measured, abs=0.002)
     for key in ("steer_oscillation_deg", "rms_steer_rate_deg_s"):
         assert getattr(metrics["with"], key) <= 1.02 * getattr(metrics["without"], key)
+
+
+# ---- the release in the loop analysis ----------------------------------------------------------------------------
+
+#: The loaded truck's lags at 30 km/h (test_clothoid_delay.py's) and a lead filter.
+TRUCK_LAGS = PlantLags(
+    SteeringLag(28.0, 2.0, 0.24, steady_state_gain=0.935), SteeringLag(9.42, 0.94, 0.062, steady_state_gain=0.942)
+)
+TRUCK_LEAD = LeadFilterParams(6.0, 1.2, 24.0)
+V = 30 / 3.6
+
+
+def _lags_own_release(lags: PlantLags, settings: LoopSettings, speed_mps: float) -> SideslipRelease:
+    """A release whose steady sideslip is the lags' own in whole periods (`delay_predictor.lag_transient_sideslip`'s
+    steady part, (group delay_m - group delay_p) x the measured curvature x V, over V^2 x that curvature)."""
+    path, measured = lags.path, lags.measured or lags.path
+    dt = settings.sample_time_s
+    taps = [round((lag.delay_s + settings.known_delay_s) / dt) for lag in (path, measured)]
+    part = 2 * measured.zeta / measured.omega_n_rad_s - 2 * path.zeta / path.omega_n_rad_s + (taps[1] - taps[0]) * dt
+    return SideslipRelease(tuple(part / speed_mps * a * G_MPS2 for a in HANDLING_GRID_G), 0.08)
+
+
+def _steering_after_an_offset(settings: LoopSettings, lookahead_m: float, steps: int = 150) -> np.ndarray:
+    """The steering sent (1/m) by the linearised loop (`loop_analysis.plant` and `controller`, about a straight at
+    30 km/h) over `steps` periods after the vehicle starts 0.1 m off the path, everything else at rest."""
+    plant_ss, controller_ss = plant(TRUCK_LAGS, V, 0.0, settings), controller(settings, TRUCK_LAGS, V, lookahead_m)
+    a, b, c = (np.asarray(m) for m in (plant_ss.A, plant_ss.B, plant_ss.C))
+    a_c, b_c, c_c, d_c = (np.asarray(m) for m in (controller_ss.A, controller_ss.B, controller_ss.C, controller_ss.D))
+    x, x_c, sent = np.zeros(a.shape[0]), np.zeros(a_c.shape[0]), []
+    x[3] = 0.1  # the plant's lateral offset (`loop_analysis._plant_continuous`)
+    for _ in range(steps):
+        measured = c @ x
+        u = float((c_c @ x_c + d_c @ measured)[0])
+        sent.append(u)
+        x, x_c = a @ x + b[:, 0] * u, a_c @ x_c + b_c @ measured
+    return np.array(sent)
+
+
+@pytest.mark.parametrize("lookahead_m", [6.0, 9.0, 14.0])
+def test_releasing_the_lags_own_sideslip_changes_nothing_in_the_loop(lookahead_m: float) -> None:
+    """Where the vehicle's steady sideslip is the lags' own and the dead time is as told, the plant's sideslip less
+    the model's transient is that steady sideslip whatever the steering: the deviation is identically zero, and the
+    loop with the release in it steers as the loop without, step for step (within 1e-12 of the largest command),
+    after the vehicle starts off the path. With the truck's own steady sideslip (more than its lags' in a turn) the
+    release is in the loop: the commands differ by more than 1 %."""
+    settings = LoopSettings(lead=TRUCK_LEAD, known_delay_s=0.11)
+    own = dataclasses.replace(settings, release=_lags_own_release(TRUCK_LAGS, settings, V))
+    without, with_own = (_steering_after_an_offset(s, lookahead_m) for s in (settings, own))
+    scale = np.abs(without).max()
+    assert np.abs(with_own - without).max() <= 1e-12 * scale
+    truck = read_vehicle_tuning(shipped_tuning_root() / TRUCK.name).release_at(30.0)
+    with_truck = _steering_after_an_offset(dataclasses.replace(settings, release=truck), lookahead_m)
+    assert np.abs(with_truck - without).max() > 0.01 * scale
+
+
+@pytest.mark.parametrize("error_s", [-0.05, 0.0, 0.05])
+@pytest.mark.parametrize("curvature_1pm", [0.0, 0.05])
+def test_the_release_loops_margins_are_those_of_the_whole_loop(error_s: float, curvature_1pm: float) -> None:
+    """The floor search's margins, composed from cached parts (the plant's sideslip output with its commands between
+    the two lags' delays as z^-k), are those of the whole loop transfer built with python-control, within 1e-6, with
+    the dead time as told and 50 ms off, about a straight and an arc."""
+    release = read_vehicle_tuning(shipped_tuning_root() / TRUCK.name).release_at(30.0)
+    settings = LoopSettings(lead=TRUCK_LEAD, known_delay_s=0.11, measurement_delay_s=error_s, release=release)
+    fast = loop_margins(TRUCK_LAGS, settings, V, 9.0, curvature_1pm)
+    whole = margins(loop_transfer(TRUCK_LAGS, settings, V, 9.0, curvature_1pm))
+    assert fast.stable == whole.stable
+    for name in ("phase_margin_deg", "gain_margin_db", "gain_reduction_margin_db", "crossover_rad_s"):
+        assert getattr(fast, name) == pytest.approx(getattr(whole, name), abs=1e-6), name
+
+
+def test_a_release_is_analysed_only_where_it_is_predicted_over_a_known_delay() -> None:
+    release = SideslipRelease(GRID, 0.08)
+    with pytest.raises(WorkbenchInputError, match="release acts over a known delay with delay_compensation 'model'"):
+        LoopSettings(known_delay_s=0.11, delay_compensation="arc", release=release)
+    with pytest.raises(WorkbenchInputError, match="known_delay_s 0 s"):
+        LoopSettings(release=release)
+    assert LoopSettings(known_delay_s=0.11, release=release).nominal.release is None  # delay-free: none released
+
+
+def test_the_controller_analyses_the_release_where_it_may_release() -> None:
+    """The truck's tuned controller puts its release at the speed into the loop it analyses with a known delay, the
+    release on and the course as heading; not without a known delay, with the release off, or at 10 km/h (none
+    identified there: the braked turn's push is under the smallest timed); its floor keeps the margins of both
+    loops (measured at 40 and 45 km/h: 10.5 and 12.5 m without the release, 11.5 and 15.0 m with it; 30 km/h
+    8.5 m either way)."""
+    tuning = read_vehicle_tuning(shipped_tuning_root() / TRUCK.name)
+    floors = {}
+    for name, config in (
+        ("with", ClothoidConfig(known_delay_s=0.11)),
+        ("without", ClothoidConfig(known_delay_s=0.11, sideslip_release=False)),
+        ("no delay", ClothoidConfig()),
+        ("yaw", ClothoidConfig(known_delay_s=0.11, heading="yaw")),
+    ):
+        controller = tuned_controller("clothoid", TRUCK, config)
+        controller.reset(BEND_PATH, 0.02)
+        settings = controller.loop_settings(40.0)
+        assert (settings.release == tuning.release_at(40.0)) if name == "with" else settings.release is None, name
+        floors[name] = [controller.lookahead_floor_m(kmh / 3.6) for kmh in (30.0, 40.0, 45.0)]
+    assert tuning.release_at(10.0) is None
+    assert floors["with"] == [8.5, 11.5, 15.0]
+    assert floors["without"] == [8.5, 10.5, 12.5]
+
+
+def test_the_release_between_identified_speeds_is_interpolated() -> None:
+    """`VehicleTuning.release_at` reads the release table as the compiled step does: an identified speed's release
+    itself, linear in speed between two."""
+    tuning = read_vehicle_tuning(shipped_tuning_root() / TRUCK.name)
+    releases = dict(tuning.releases)
+    assert tuning.release_at(30.0) == releases[30.0]
+    between = tuning.release_at(35.0)
+    assert between is not None
+    assert between.rate_1ps == pytest.approx(0.5 * (releases[30.0].rate_1ps + releases[40.0].rate_1ps), rel=1e-12)
+    expected = 0.5 * (np.array(releases[30.0].steady_sideslip_rad) + np.array(releases[40.0].steady_sideslip_rad))
+    assert np.array(between.steady_sideslip_rad) == pytest.approx(expected, rel=1e-12, abs=1e-15)
