@@ -745,9 +745,9 @@ def lookahead_floor(
     (`keeps_margins` tells that from a floor there that keeps them). The margins are those of the nominal loop
     (`LoopSettings.nominal`: with the model's delay compensation the delay-free one, which it leaves when its model
     is the vehicle); with that compensation the loop itself keeps `delayed`'s margins at the steering sent
-    (`DelayRobustness`), without and with the sideslip's release in it where settings has one. A bisection on the grid (margins mostly improve with the lookahead: the loop's gain falls
-    as L^-3), then a check every _FLOOR_CHECK_M above the result; a failure there restarts the bisection above
-    it."""
+    (`DelayRobustness`), without and with the sideslip's release in it where settings has one. A bisection on the
+    grid (margins mostly improve with the lookahead: the loop's gain falls as L^-3), then a check every
+    _FLOOR_CHECK_M above the result; a failure there restarts the bisection above it."""
     grid = np.arange(min_lookahead_m, max_lookahead_m + 1e-9, step_m)
     if grid.size == 0 or grid[-1] < max_lookahead_m - 1e-9:
         grid = np.append(grid, max_lookahead_m)
