@@ -212,12 +212,13 @@ def options_dict(options: PresetTuningOptions, model_type: str) -> dict[str, Any
 
 
 #: Rough generation time per schedule speed (s), by model type, for the message of a first use (measured with the
-#: margins design and a delay: 46-52 s for the ten speeds of the kinematic and dynamic bicycles and the truck, 4-5 s
-#: more for the limits; 115 s for the CommonRoad plant, pure Python).
+#: margins design, a delay and the sideslip's braked turn, the limits included, two tunings at once on two cores:
+#: 60-68 s for the truck's ten speeds, 74-75 s for the dynamic bicycle's; the kinematic bicycle's and the
+#: CommonRoad plant's, pure Python, measured before the braked turn was added, 46-52 s and 115 s).
 SECONDS_PER_SPEED = {
     "kinematic-bicycle": 5.0,
-    "dynamic-bicycle": 5.5,
-    "tractor-semitrailer": 5.0,
+    "dynamic-bicycle": 7.5,
+    "tractor-semitrailer": 6.5,
     "commonroad-mb": 12.0,
 }
 
