@@ -80,7 +80,7 @@ from pathlib import Path
 import numpy as np
 from benchmark_report import machine, write_results
 
-from tuning.own_tuning import tuned_controller
+from tuning.own_tuning import tuned_controller, tuning_for
 from workbench.simulation.conditions import CONDITIONS
 from workbench.simulation.scenarios import ScenarioOptions, make_scenario
 from workbench.simulation.simulator import Simulation, SimulationConfig
@@ -135,6 +135,17 @@ def plant_for(vehicle_name: str, switch: str):
     return type(vehicle)(dataclasses.replace(vehicle.params, **changes))
 
 
+def switched_plants(jobs: list[tuple[str, str, str, str, str]]) -> list[tuple[str, str]]:
+    """(vehicle, plant switch) of `jobs` (`jobs_for`'s), each once."""
+    return sorted({(v, sw) for v, _, sw, _, _ in jobs if sw in PLANT_SWITCHES})
+
+
+def tune_plant(plant: tuple[str, str]) -> None:
+    """Make (or read) the tuning of a vehicle with a plant switch (`plant_for`'s arguments) in the cache, so that
+    its runs read it: without this, two workers starting runs of the same switched plant would each make it."""
+    tuning_for(plant_for(*plant))
+
+
 def clothoid_config_for(switch: str, config):
     if switch == "floor_lowered":
         return dataclasses.replace(config, min_phase_margin_deg=30.0, min_gain_margin_db=3.0)
@@ -158,7 +169,6 @@ def nmpc_config_for(switch: str, plant):
     if switch not in MODEL_SWITCHES:
         return None
     from controllers.mpc.nmpc import NMPCConfig
-    from tuning.own_tuning import tuning_for
 
     return NMPCConfig(lag=tuning_for(plant).lag_at(SPEED_KMH))
 
@@ -280,7 +290,6 @@ def run_one(job: tuple[str, str, str, str, str]) -> tuple[Run, dict[str, list[fl
     errors = None
     if (controller_name, switch, conditions) == ("nmpc", "nominal", "ideal"):
         from controllers.clothoid.controller import ClothoidConfig
-        from tuning.own_tuning import tuning_for
 
         window = ClothoidConfig().feedforward_window_m
         errors = {"vehicle": vehicle_name, "scenario": scenario_name,
@@ -448,6 +457,7 @@ def main(argv: list[str] | None = None) -> int:
         parser.error(f"{', '.join(held_out)}: seeds {HELD_OUT_FIRST_SEED} and up are the held-out set, not for this")
     jobs = jobs_for(vehicles, scenarios, not args.no_automotive)
     with ProcessPoolExecutor(max_workers=args.workers) as pool:
+        list(pool.map(tune_plant, switched_plants(jobs)))  # each plant's tuning once, before the runs that read it
         results = list(pool.map(run_one, jobs, chunksize=2))
     runs = {(r.vehicle, r.scenario, r.switch, r.controller, r.conditions): r for r, _, _ in results}
     traces = {(r.vehicle, r.scenario, r.switch, r.controller, r.conditions): t for r, t, _ in results}

@@ -83,6 +83,17 @@ def test_the_plan_runs_the_nmpc_on_plant_model_and_delay_switches_only(breakdown
     assert all(j[4] == "automotive" for j in with_automotive if j[2] == "perfect_prediction")
 
 
+def test_each_switched_plant_is_tuned_once_before_its_runs(breakdown) -> None:
+    """Many runs drive each switched plant (both controllers, each scenario and conditions); its tuning is made once,
+    not by two workers at once."""
+    jobs = breakdown.jobs_for(["dynamic-bicycle", "tractor-semitrailer"], ["dlc", "figure8"], automotive=True)
+    plants = breakdown.switched_plants(jobs)
+    assert len(plants) == len(set(plants))
+    vehicles = ("dynamic-bicycle", "tractor-semitrailer")
+    assert set(plants) == {(v, sw) for v in vehicles for sw in breakdown.PLANT_SWITCHES}
+    assert sum(j[2] in breakdown.PLANT_SWITCHES for j in jobs) > len(plants)
+
+
 def _run(breakdown, scenario: str, switch: str, controller: str, cte: float, rms: float = 0.01):
     return breakdown.Run("tractor-semitrailer", scenario, switch, controller, "ideal", "completed", cte, rms,
                          0.0, 0.0, 0.0, 8.3, 0.3, 1.0, 10.0, False, 8.5, 0.1)  # fmt: skip
