@@ -28,13 +28,13 @@ def bracket(speeds: np.ndarray, speed: float) -> tuple[int, int, float]:
 
 @njit(cache=True)
 def table_row(speeds: np.ndarray, rows: np.ndarray, speed: float, clip: bool, out: np.ndarray) -> None:
-    """Row `speed` of the table (rows[i] at speeds[i], speeds increasing strictly) into out: a listed speed's row
-    as it stands, the first or last row beyond the ends, else each column a + t (b - a) between its neighbours
-    (`bracket`); with clip, kept within [min(a, b), max(a, b)] against rounding (a schedule's ranges are then kept
-    exactly)."""
+    """Row `speed` of the table (rows[i] at speeds[i], speeds increasing strictly), its first out.size columns, into
+    out: a listed speed's row as it stands, the first or last row beyond the ends, else each column a + t (b - a)
+    between its neighbours (`bracket`); with clip, kept within [min(a, b), max(a, b)] against rounding (a
+    schedule's ranges are then kept exactly)."""
     low, high, t = bracket(speeds, speed)
     if low == high:
-        out[:] = rows[low]
+        out[:] = rows[low, : out.size]
         return
     for k in range(out.size):
         a, b = rows[low, k], rows[high, k]

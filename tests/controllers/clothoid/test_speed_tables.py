@@ -35,3 +35,15 @@ def test_table_row_interpolates_between_the_bracketed_rows() -> None:
     for speed, expected in ((5.0, (1.0, 10.0)), (20.0, (2.0, 20.0)), (30.0, (3.0, 10.0)), (50.0, (4.0, 0.0))):
         table_row(speeds, rows, speed, False, out)
         assert tuple(out) == pytest.approx(expected, rel=1e-12)
+
+
+@pytest.mark.parametrize("speed", [5.0, 20.0, 30.0, 50.0])
+def test_table_row_reads_the_leading_columns_into_a_shorter_out(speed: float) -> None:
+    """The step reads the lags' four leading columns of rows that carry the preview taps beyond them: at a listed
+    speed and beyond the ends as between them (a truck measured at exactly an identified speed raised in its step)."""
+    speeds = np.array([10.0, 20.0, 40.0])
+    rows = np.array([[1.0, 10.0, 7.0], [2.0, 20.0, 7.0], [4.0, 0.0, 7.0]])
+    short, whole = np.empty(2), np.empty(3)
+    table_row(speeds, rows, speed, False, short)
+    table_row(speeds, rows, speed, False, whole)
+    assert tuple(short) == tuple(whole[:2])
