@@ -43,7 +43,7 @@ Loop analysis (30 km/h, `controllers/clothoid/loop_analysis.py`, about a straigh
 the closed-loop bandwidth (|T| = |L / (1 + L)| falling to -3 dB, the loop broken at the steering sent) with the
 identified lags and the lead filter of each switched plant's own tuning (no actuator lag, stiff tyres, both), and
 with the nominal lags altered: the measured curvature without the sideslip's lead (the measured lag = the path
-lag), no understeer (K = 1), the speed bands a braking truck passes (20 and 25 km/h), the floor lowered or off.
+lag), no understeer (K = 1), the speeds a braking truck passes (20 and 25 km/h), the floor lowered or off.
 The feed-forward does not enter the loop (its term depends on the path only), so it changes nothing there.
 
 The clothoid controller's models of the vehicle, checked along the NMPC's nominal run in ideal conditions (which

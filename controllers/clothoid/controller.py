@@ -73,12 +73,17 @@ SEARCH_STARTS = ("last", "ends")
 FEEDFORWARD_MODELS = ("auto", "lag", "preview")
 #: Below this speed (m/s) yaw rate / speed and the course angle are too noisy to use.
 MIN_SPEED_MPS = 0.5
-#: The lookahead floor is computed per band of this many km/h (and at least at the band's lower speed, 5 km/h).
-FLOOR_SPEED_BAND_KMH = 5.0
-#: A run moves to a lower band's (shorter) floor only this far (km/h) below the band's edge, to a higher one at its
-#: edge: the lookahead follows a falling floor at once (`lookahead_filter.py`), so a speed hovering at an edge (its
-#: noise, the speed loop's ripple) must not switch the floor, and the loop gain with it, to and fro.
-FLOOR_BAND_HYSTERESIS_KMH = 1.0
+#: The lookahead floor is computed at speed nodes this many km/h apart, each with the lead filter the step uses
+#: there, and interpolated linearly between the two about the speed driven (`step_kernel.floor_node`). The floor
+#: needed rises by up to 0.5 m a km/h (the loaded truck at 20-35 km/h): held over a band it lets the margins fall
+#: short at the band's upper end (a 5 km/h band's centre floor at its edge: the truck's phase margin 37 deg at
+#: 22.4 km/h); interpolated, they hold between nodes within 3 deg and 1 dB (`test_clothoid_hairpin_delay.py`), and
+#: the floor, with the loop gain, moves with the speed, not in steps to and fro as the speed hovers at an edge.
+#: Nodes 1 km/h apart would hold them within 2 deg and 0.6 dB, at 2.5 times the analysis (1.5-2 s a node with a
+#: known delay), which runs through every speed a run passes.
+FLOOR_SPEED_STEP_KMH = 2.5
+#: The lowest speed node (km/h): below it, its floor.
+FLOOR_MIN_SPEED_KMH = 5.0
 #: Longest lookahead (m) the floor search considers when the configured range has no margin at a speed.
 MAX_FLOOR_LOOKAHEAD_M = 40.0
 #: Lateral acceleration (g) of the arc about which the floor is checked besides the straight (the speed profile's
@@ -524,7 +529,7 @@ class ClothoidController(Controller[ClothoidConfig]):
         top = self._floor_search_top_m
         self._scores = np.empty(candidate_count(cfg.min_lookahead_m, top, cfg.lookahead_step_m))
         self._results = np.empty((self._scores.size, 8))  # each candidate's evaluation (lookahead.adaptive_search)
-        self._floors: dict[int, float] = {}  # per speed band, for the sample time _floors_dt
+        self._floors: dict[int, float] = {}  # per speed node, for the sample time _floors_dt
         self._floors_dt: float | None = None
         self._state = sk.initial_state()  # the compiled step's state (step_kernel.STATE)
         self._measured = np.zeros(1, sk.MEASUREMENT)  # the measurement as the compiled step reads it
@@ -550,9 +555,9 @@ class ClothoidController(Controller[ClothoidConfig]):
             self._limit_speeds, self._lags, self._measured_lags, self._lag_axis, self._schedule,
             self._schedule_speeds, self._scores, self._results, self._diag, self._history,
         )  # fmt: skip
-        # The planned speeds' floors at reset, not in a step (~0.04 s a band, with the delay model 0.5 s).
-        for band in self._planned_bands(path):
-            self._band_floor_m(band)
+        # The planned speeds' floors at reset, not in a step (0.1 s a node, with the delay model 1.5 s; cached).
+        for node in self._planned_nodes(path):
+            self._node_floor_m(node)
 
     def _tables(self) -> None:
         """The tables the compiled step reads (step_kernel.py): the limits, the identified lags and the lead
@@ -618,8 +623,8 @@ class ClothoidController(Controller[ClothoidConfig]):
             max_growth=cfg.max_lookahead_growth_m_per_m,
             max_shrink=cfg.max_lookahead_shrink_m_per_m,
             min_speed=MIN_SPEED_MPS,
-            band_kmh=FLOOR_SPEED_BAND_KMH,
-            band_hysteresis_kmh=FLOOR_BAND_HYSTERESIS_KMH,
+            floor_step_kmh=FLOOR_SPEED_STEP_KMH,
+            floor_min_kmh=FLOOR_MIN_SPEED_KMH,
             warm_search=cfg.search_start == "last",
             delay_model=cfg.predicts_with_model,
             feedforward_inversion=cfg.feedforward_inversion,
@@ -672,7 +677,8 @@ class ClothoidController(Controller[ClothoidConfig]):
         Parameters
         ----------
         speed_kmh : float, km/h
-            The speed whose lead filter (from the filter schedule) the settings hold.
+            The speed whose lead filter (from the filter schedule, at the whole km/h the step uses) the settings
+            hold.
 
         Returns
         -------
@@ -695,16 +701,17 @@ class ClothoidController(Controller[ClothoidConfig]):
         )  # fmt: skip
 
     def lookahead_floor_m(self, speed_mps: float) -> float:
-        """The shortest lookahead (m) that keeps the configured margins at this speed (per FLOOR_SPEED_BAND_KMH band,
-        computed once per band and run; min_lookahead_m without a tuning or with the margins set to 0). The analysis
-        is cached on all of `loop_settings`, the known delay included.
+        """The shortest lookahead (m) that keeps the configured margins at this speed: computed at the speed nodes
+        FLOOR_SPEED_STEP_KMH apart about it (once per node and run), linear between them, as the compiled step reads
+        it; min_lookahead_m without a tuning or with the margins set to 0. The analysis is cached on all of
+        `loop_settings`, the known delay included.
 
         Available after `reset`: the floor depends on the run's sample time.
 
         Parameters
         ----------
         speed_mps : float, m/s
-            The speed, >= 0; it selects its FLOOR_SPEED_BAND_KMH band (the lowest band below the first).
+            The speed, >= 0 (below FLOOR_MIN_SPEED_KMH, that speed's floor).
 
         Returns
         -------
@@ -712,16 +719,18 @@ class ClothoidController(Controller[ClothoidConfig]):
             The floor; above max_lookahead_m where the margins need a longer lookahead than the range allows
             (`run_warnings` tells).
         """
-        return self._band_floor_m(max(1, round(speed_mps * 3.6 / FLOOR_SPEED_BAND_KMH)))
+        node, weight = sk.floor_node(float(speed_mps), FLOOR_SPEED_STEP_KMH, FLOOR_MIN_SPEED_KMH)
+        floor = self._node_floor_m(node)
+        return floor + weight * (self._node_floor_m(node + 1) - floor) if weight > 0.0 else floor
 
-    def _band_floor_m(self, band: int) -> float:
-        """lookahead_floor_m of the speed band `band` (its speed band x FLOOR_SPEED_BAND_KMH)."""
+    def _node_floor_m(self, node: int) -> float:
+        """The floor at speed node `node` (node x FLOOR_SPEED_STEP_KMH km/h)."""
         cfg = self.config
-        floor = self._floors.get(band)
+        floor = self._floors.get(node)
         if floor is None:
-            floor = self._recorded_floor_m(band * FLOOR_SPEED_BAND_KMH)
+            floor = self._recorded_floor_m(node * FLOOR_SPEED_STEP_KMH)
             if floor is None:
-                inputs = self._floor_inputs(band)
+                inputs = self._floor_inputs(node)
                 if inputs is None:
                     floor = cfg.min_lookahead_m
                 else:
@@ -732,7 +741,7 @@ class ClothoidController(Controller[ClothoidConfig]):
                         lags, settings, v, cfg.min_lookahead_m, self._floor_search_top_m, cfg.lookahead_step_m,
                         curvatures, cfg.min_phase_margin_deg, cfg.min_gain_margin_db, delayed,
                     )  # fmt: skip
-            self._floors[band] = floor
+            self._floors[node] = floor
         return floor
 
     def _recorded_floor_m(self, speed_kmh: float) -> float | None:
@@ -761,8 +770,9 @@ class ClothoidController(Controller[ClothoidConfig]):
         return min(kappa_max, FLOOR_ARC_LATERAL_ACCEL_G * G_MPS2 / speed_mps**2)
 
     def _lead_at(self, speed_kmh: float) -> LeadFilterParams | None:
-        """The lead filter's parameters at this speed (km/h); None without a lead filter."""
-        return self.filter_schedule.at_speed(speed_kmh) if self.filter_schedule is not None else None
+        """The lead filter's parameters the step uses at this speed (km/h): the schedule's at the nearest whole km/h
+        (`step_kernel`: one filter per km/h, rounded half to even); None without a lead filter."""
+        return self.filter_schedule.at_speed(float(round(speed_kmh))) if self.filter_schedule is not None else None
 
     @property
     def _floor_search_top_m(self) -> float:
@@ -771,14 +781,14 @@ class ClothoidController(Controller[ClothoidConfig]):
         return max(self.config.max_lookahead_m, MAX_FLOOR_LOOKAHEAD_M)
 
     def _floor_inputs(
-        self, band: int
+        self, node: int
     ) -> tuple[PlantLags, LoopSettings, float, tuple[float, float], DelayRobustness] | None:
-        """What the floor of speed band `band` is analysed with: the lags, the loop settings, the speed (m/s), the
+        """What the floor of speed node `node` is analysed with: the lags, the loop settings, the speed (m/s), the
         path curvatures (the straight and the FLOOR_ARC_LATERAL_ACCEL_G arc, capped by the curvature limit) and the
         margins kept with the delay (`loop_analysis.DelayRobustness`); None without a tuning or with the margins
         set to 0 (no floor)."""
         cfg = self.config
-        speed_kmh = band * FLOOR_SPEED_BAND_KMH
+        speed_kmh = node * FLOOR_SPEED_STEP_KMH
         lags = self.plant_lags(speed_kmh)
         if lags is None or (cfg.min_phase_margin_deg <= 0.0 and cfg.min_gain_margin_db <= 0.0):
             return None
@@ -790,10 +800,10 @@ class ClothoidController(Controller[ClothoidConfig]):
         )
         return lags, self.loop_settings(speed_kmh), v, (0.0, self._floor_arc_1pm(v)), delayed
 
-    def _band_keeps_margins(self, band: int) -> bool:
-        """Whether the lookahead floor of speed band `band` keeps the configured margins (False: no lookahead up to
+    def _node_keeps_margins(self, node: int) -> bool:
+        """Whether the lookahead floor of speed node `node` keeps the configured margins (False: no lookahead up to
         the floor search's top does, and the floor is that top)."""
-        floor, inputs = self._band_floor_m(band), self._floor_inputs(band)
+        floor, inputs = self._node_floor_m(node), self._floor_inputs(node)
         if inputs is None or floor < self._floor_search_top_m - 1e-9:
             return True  # the search returns a floor below its top only where the margins hold
         from controllers.clothoid.loop_analysis import keeps_margins
@@ -805,15 +815,19 @@ class ClothoidController(Controller[ClothoidConfig]):
         )
 
     @staticmethod
-    def _planned_bands(path: ReferencePath) -> list[int]:
-        """The floor's speed bands of the path's planned speeds (none without them)."""
+    def _planned_nodes(path: ReferencePath) -> list[int]:
+        """The floor's speed nodes about the path's planned speeds (none without them): `lookahead_floor_m`'s."""
         if path.speed_mps is None:
             return []
-        return [int(b) for b in np.unique(np.maximum(1.0, np.round(path.speed_mps * 3.6 / FLOOR_SPEED_BAND_KMH)))]
+        nodes: set[int] = set()
+        for speed in np.unique(path.speed_mps):
+            node, weight = sk.floor_node(float(speed), FLOOR_SPEED_STEP_KMH, FLOOR_MIN_SPEED_KMH)
+            nodes.update((node, node + 1) if weight > 0.0 else (node,))
+        return sorted(nodes)
 
     def run_warnings(self, path: ReferencePath, sample_time_s: float) -> list[str]:
         """What to tell a person before a run on `path` (at its planned speeds) with steps every sample_time_s: the
-        speed bands whose lookahead floor lies above max_lookahead_m. There the lookahead is held at the floor, a
+        speeds whose lookahead floor lies above max_lookahead_m. There the lookahead is held at the floor, a
         constant lookahead outside the configured range, and the Fréchet search does not act; where no lookahead
         up to the floor search's top keeps the margins, it is held at that top without them. The run is not
         refused: the floor is what keeps the loop's margins with this tuning (a study of weak lead filters must
@@ -830,31 +844,38 @@ class ClothoidController(Controller[ClothoidConfig]):
         Returns
         -------
         list of str
-            One message naming the speed bands whose floor lies above max_lookahead_m and what to change; empty
+            One message naming the speeds whose floor lies above max_lookahead_m and what to change; empty
             when there is none.
         """
         cfg = self.config
         if cfg.lookahead_mode == "fixed" or path.speed_mps is None:
             return []
-        self.reset(path, sample_time_s)  # the planned bands' floors, as the run computes them (and keeps)
-        above = [(band, self._band_floor_m(band)) for band in self._planned_bands(path)]
-        above = [(band, floor) for band, floor in above if floor > cfg.max_lookahead_m + 1e-9]
+        self.reset(path, sample_time_s)  # the planned nodes' floors, as the run computes them (and keeps)
+        above = [(node, self._node_floor_m(node)) for node in self._planned_nodes(path)]
+        above = [(node, floor) for node, floor in above if floor > cfg.max_lookahead_m + 1e-9]
         if not above:
             return []
         top = self._floor_search_top_m
-        keeps = {band: self._band_keeps_margins(band) for band, _ in above}
-        kept = [floor for band, floor in above if keeps[band]]
-        spans: list[list] = []  # [first band, last band, what]: neighbouring bands that say the same, together
-        for band, floor in above:
-            what = f"floor {floor:g} m" if keeps[band] else f"floor none: no lookahead up to {top:g} m keeps them"
-            if spans and spans[-1][1] == band - 1 and spans[-1][2] == what:
-                spans[-1][1] = band
+        keeps = {node: self._node_keeps_margins(node) for node, _ in above}
+        kept = [floor for node, floor in above if keeps[node]]
+        spans: list[list] = []  # [first node, last node, floors]: neighbouring nodes that both keep or both do not
+        for node, floor in above:
+            if spans and spans[-1][1] == node - 1 and keeps[spans[-1][0]] == keeps[node]:
+                spans[-1][1] = node
+                spans[-1][2].append(floor)
             else:
-                spans.append([band, band, what])
+                spans.append([node, node, [floor]])
+
+        def what(first: int, floors: list[float]) -> str:
+            if not keeps[first]:
+                return f"floor none: no lookahead up to {top:g} m keeps them"
+            low, high = min(floors), max(floors)
+            return f"floor {low:g} m" if low == high else f"floor {low:g}-{high:g} m"
+
+        step = FLOOR_SPEED_STEP_KMH
         places = ", ".join(
-            f"{first * FLOOR_SPEED_BAND_KMH:g}{f'-{last * FLOOR_SPEED_BAND_KMH:g}' if last > first else ''} km/h "
-            f"({what})"
-            for first, last, what in spans
+            f"{first * step:g}{f'-{last * step:g}' if last > first else ''} km/h ({what(first, floors)})"
+            for first, last, floors in spans
         )
         remedies = []
         if kept:
@@ -911,7 +932,7 @@ class ClothoidController(Controller[ClothoidConfig]):
                 return command
             need = int(self._state["need"][0])
             if status == sk.NEED_FLOOR:
-                self._state["floors"][0, need] = self._band_floor_m(need)
+                self._state["floors"][0, need] = self._node_floor_m(need)
             else:
                 # the kernel asks for a lead filter only when there is a schedule to make it from
                 params = self.filter_schedule.at_speed(float(need))  # type: ignore[union-attr]

@@ -747,7 +747,27 @@ def lookahead_floor(
     is the vehicle); with that compensation the loop itself keeps `delayed`'s margins at the steering sent
     (`DelayRobustness`), without and with the sideslip's release in it where settings has one. A bisection on the
     grid (margins mostly improve with the lookahead: the loop's gain falls as L^-3), then a check every
-    _FLOOR_CHECK_M above the result; a failure there restarts the bisection above it."""
+    _FLOOR_CHECK_M above the result; a failure there restarts the bisection above it. Cached: a controller's speed
+    nodes are the same run after run."""
+    return _lookahead_floor(
+        lags, settings, float(speed_mps), float(min_lookahead_m), float(max_lookahead_m), float(step_m),
+        tuple(float(k) for k in path_curvatures_1pm), float(phase_margin_deg), float(gain_margin_db), delayed,
+    )  # fmt: skip
+
+
+@lru_cache(maxsize=4096)
+def _lookahead_floor(
+    lags: PlantLags,
+    settings: LoopSettings,
+    speed_mps: float,
+    min_lookahead_m: float,
+    max_lookahead_m: float,
+    step_m: float,
+    path_curvatures_1pm: tuple[float, ...],
+    phase_margin_deg: float,
+    gain_margin_db: float,
+    delayed: DelayRobustness,
+) -> float:
     grid = np.arange(min_lookahead_m, max_lookahead_m + 1e-9, step_m)
     if grid.size == 0 or grid[-1] < max_lookahead_m - 1e-9:
         grid = np.append(grid, max_lookahead_m)

@@ -1,8 +1,8 @@
 """The clothoid controller's whole step (Figure 2, `controller.py`) as one compiled call.
 
 Python only copies the measurement into its record, calls `clothoid_step`, and fills in what the step asks for and
-Python alone can make: a speed band's lookahead floor (`loop_analysis.py`, python-control) or a km/h's discretised
-lead filter (scipy). The step asks before it changes any state (`NEED_FLOOR`, `NEED_FILTER`; the band or km/h in
+Python alone can make: a speed node's lookahead floor (`loop_analysis.py`, python-control) or a km/h's discretised
+lead filter (scipy). The step asks before it changes any state (`NEED_FLOOR`, `NEED_FILTER`; the node or km/h in
 the state's `need`), so the caller fills the state's table and calls again with the same arguments.
 
 The step reads the path in its compiled form (`workbench.base.path_search.CompiledPath`), its parameters from one
@@ -58,7 +58,7 @@ PARAMS = np.dtype(
         "max_lookahead", "lookahead_step", "min_preview", "fixed_lookahead", "lookahead_gain", "max_turn",
         "frechet_threshold",
         "point_spacing", "tolerance_x", "tolerance_y", "kdot_max", "feedforward_window", "feedforward_time",
-        "reference_lead", "hysteresis", "max_growth", "max_shrink", "min_speed", "band_kmh", "band_hysteresis_kmh",
+        "reference_lead", "hysteresis", "max_growth", "max_shrink", "min_speed", "floor_step_kmh", "floor_min_kmh",
         "preview_first_tap", "preview_spacing",
     )]
     + [(name, np.int64) for name in ("lookahead_mode", "initial_curvature")]
@@ -86,8 +86,8 @@ def parameters(**fields: float | int | bool | None) -> np.ndarray:
 STEP_DONE, NEED_FLOOR, NEED_FILTER = 0, 1, 2
 #: km/h rows of the lead-filter table: every whole km/h up to the plausible measurement's top speed (540 km/h).
 FILTER_ROWS = 541
-#: Rows of the floor table: every speed band up to 540 km/h.
-FLOOR_ROWS = 120
+#: Rows of the floor table: a speed node every `floor_step_kmh` (2.5 km/h) up to 540 km/h, and the one above.
+FLOOR_ROWS = 218
 #: Size of `clothoid_step`'s scratch array: a table row, a projection, the two lags' rows at this speed, then the
 #: release table's row (`VehicleTuning.release_table`).
 LAG_ROWS = 4 + TRACK_OUT_SIZE
@@ -95,19 +95,18 @@ RELEASE_ROW = LAG_ROWS + 8
 SCRATCH_SIZE = RELEASE_ROW + 1 + len(HANDLING_GRID_G)
 
 #: What the step holds between calls (`state`, one record, made by `initial_state`): the integrator's curvature
-#: command (1/m; NaN before the first step; with the lag-inverting feed-forward the feedback's alone); the speed
-#: band whose floor applies (-1 before the first step); the lookahead filter's lookahead and floor (m); the lead
-#: filter's three states (rad, shared by the filters of every km/h: a bumpless switch); what a NEED_* return asks
-#: for (the speed band or the km/h); the adaptive search's last choice (m, where the next one starts); the delay
+#: command (1/m; NaN before the first step; with the lag-inverting feed-forward the feedback's alone); the
+#: lookahead filter's lookahead and floor (m); the lead filter's three states (rad, shared by the filters of every
+#: km/h: a bumpless switch); what a NEED_* return asks for (the floor's speed node or the km/h); the adaptive
+#: search's last choice (m, where the next one starts); the delay
 #: predictor's model (`delay_predictor.MODEL_SIZE`); the lag-inverting feed-forward's curvature sent last step
 #: (1/m); the path trackers' states of the start pose and of the measured position (`path_search.track`); the
-#: floors per speed band (m) and the lead filters per km/h (`DiscreteLeadFilter.coefficients`), NaN where Python
+#: floors per speed node (m) and the lead filters per km/h (`DiscreteLeadFilter.coefficients`), NaN where Python
 #: has not made them yet; the search's sampled curves (`lookahead.evaluate_candidate`) and scratch. NaN where
 #: nothing is known yet.
 STATE = np.dtype(
     [
         ("kappa_cmd", np.float64),
-        ("held_band", np.int64),
         ("lookahead", np.float64, (2,)),
         ("filter_x", np.float64, (3,)),
         ("need", np.int64),
@@ -126,14 +125,25 @@ STATE = np.dtype(
 MEASUREMENT = np.dtype([(name, np.float64) for name in ("t", "x", "y", "vx", "vy", "yaw", "yaw_rate", "steer_wheel")])
 
 
+@njit(cache=True)
+def floor_node(speed_mps: float, step_kmh: float, min_kmh: float) -> tuple[int, float]:
+    """(node, weight): the lookahead floor at this speed is the floor of speed node `node` (node x step_kmh km/h)
+    and weight of the way to the next one's, linear in the speed; below min_kmh, min_kmh's (weight 0); the top
+    node's beyond FLOOR_ROWS."""
+    x = max(speed_mps * 3.6, min_kmh) / step_kmh
+    node = min(int(x), FLOOR_ROWS - 2)
+    weight = min(x - node, 1.0)
+    return node, weight if weight > 1e-9 else 0.0  # a node's own speed, to the rounding of a km/h conversion
+
+
 def initial_state() -> np.ndarray:
-    """The step's state before its first step (STATE, one record): nothing known (NaN), no band held, both path
+    """The step's state before its first step (STATE, one record): nothing known (NaN), both path
     trackers at the path's start (`PathTracker.reset(0.0)`)."""
     state = np.zeros(1, STATE)
     for name in STATE.names or ():  # a structured dtype always has names
         if STATE[name].base == np.float64:
             state[name] = np.nan
-    state["held_band"], state["need"] = -1, 0
+    state["need"] = 0
     for tracker in ("tracker", "here"):
         state[tracker][0, TRACK_S], state[tracker][0, TRACK_PROGRESS] = 0.0, 0.0
     return state
@@ -285,12 +295,12 @@ def clothoid_step(
         if math.isnan(filters[kmh, 0]):
             st.need = kmh
             return 0.0, NEED_FILTER
-    x_band = speed * 3.6 / p.band_kmh
-    band, held = max(1, round(x_band)), int(st.held_band)
-    if held >= 0 and band < held and x_band > held - 0.5 - p.band_hysteresis_kmh / p.band_kmh:
-        band = held
-    if math.isnan(floors[band]):
-        st.need = band
+    node, weight = floor_node(speed, p.floor_step_kmh, p.floor_min_kmh)
+    if math.isnan(floors[node]):
+        st.need = node
+        return 0.0, NEED_FLOOR
+    if weight > 0.0 and math.isnan(floors[node + 1]):
+        st.need = node + 1
         return 0.0, NEED_FLOOR
 
     wheelbase, ratio = p.wheelbase, p.steering_ratio
@@ -364,8 +374,8 @@ def clothoid_step(
     track(path, record, st.tracker, px, py, foot)
     foot_index, cte = foot[0] / spacing, foot[6]
 
-    st.held_band = band
-    floor = max(floors[band], p.min_lookahead, p.min_preview * speed)
+    node_floor = floors[node] + weight * (floors[node + 1] - floors[node]) if weight > 0.0 else floors[node]
+    floor = max(node_floor, p.min_lookahead, p.min_preview * speed)
     top = max(p.max_lookahead, floor)
     mode = int(p.lookahead_mode)
     evaluations, reused = 0, -1

@@ -225,16 +225,17 @@ def test_the_lookahead_floor_is_a_preview_time_when_asked() -> None:
 
 def test_the_analysis_floor_keeps_the_margins_at_every_lookahead_the_controller_may_pick() -> None:
     """With the truck's tuning the controller never picks a lookahead below the floor the loop analysis gives, and
-    at that floor the loop keeps 45 deg and 6 dB; with the margins set to 0 there is no floor."""
+    at that floor (at a speed node: 27.5 km/h) the loop keeps 45 deg and 6 dB; with the margins set to 0 there is
+    no floor."""
     from controllers.clothoid.loop_analysis import loop_margins
 
+    speed_kmh = 27.5
     controller = ClothoidController(GEOMETRY, ClothoidConfig(tuning=TRUCK_TUNING))
     controller.reset(BEND, 0.02)
-    controller.step(_m(40.0, 0.0, 0.0, 8.0), BEND)
+    controller.step(_m(40.0, 0.0, 0.0, speed_kmh / 3.6), BEND)
     floor = controller.diagnostics["lookahead_floor_m"]
     assert controller.diagnostics["lookahead_m"] >= floor > 5.0
     assert floor <= 20.0  # the tuned lead filter leaves a range with margins
-    speed_kmh = controller._floors and 5.0 * next(iter(controller._floors))
     lags, settings = controller.plant_lags(speed_kmh), controller.loop_settings(speed_kmh)
     for lookahead in np.arange(floor, 20.0 + 1e-9, 1.0):
         assert loop_margins(lags, settings, speed_kmh / 3.6, float(lookahead)).meets(45.0, 6.0)

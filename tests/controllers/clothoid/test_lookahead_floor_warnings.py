@@ -93,8 +93,9 @@ def test_the_simulation_says_it_before_the_run_and_the_run_holds_the_floor() -> 
     trace = simulation.run().to_pandas()
     floors = trace["ctrl_lookahead_floor_m"].to_numpy()
     above = floors > 12.0
-    assert above.mean() > 0.5  # most of the run is in bands whose floor is above the range
-    assert floors[above].min() == controller.lookahead_floor_m(30.0 / 3.6)
+    assert above.mean() > 0.5  # most of the run is at speeds whose floor is above the range
+    speeds = trace["speed_mps"].to_numpy()[above]  # measured exactly (ideal conditions)
+    np.testing.assert_allclose(floors[above], [controller.lookahead_floor_m(v) for v in speeds], atol=1e-9)
     np.testing.assert_allclose(trace["ctrl_lookahead_m"][above], floors[above], atol=1e-9)  # held at the floor
 
 

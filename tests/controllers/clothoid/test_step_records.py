@@ -67,7 +67,7 @@ def test_the_controllers_parameters_are_its_options() -> None:
 
 def test_the_state_starts_empty_with_both_trackers_at_the_paths_start() -> None:
     state = sk.initial_state()[0]
-    assert state["held_band"] == -1 and math.isnan(state["kappa_cmd"]) and math.isnan(state["searched"])
+    assert state["need"] == 0 and math.isnan(state["kappa_cmd"]) and math.isnan(state["searched"])
     assert np.isnan(state["floors"]).all() and np.isnan(state["filters"]).all()
     for tracker in ("tracker", "here"):
         assert state[tracker][TRACK_S] == 0.0 and state[tracker][TRACK_PROGRESS] == 0.0
@@ -79,6 +79,6 @@ def test_a_reset_starts_the_state_again() -> None:
     controller.reset(STRAIGHT, 0.02)
     controller.step(Measurement(0.0, 5.0, 0.2, 8.0, 0.0, 0.0, 0.0, 0.0), STRAIGHT)
     stepped = controller._state[0]
-    assert stepped["held_band"] >= 1 and not math.isnan(stepped["kappa_cmd"]) and stepped["tracker"][TRACK_S] > 0.0
+    assert stepped["lookahead"][1] >= 5.0 and not math.isnan(stepped["kappa_cmd"]) and stepped["tracker"][TRACK_S] > 0.0
     controller.reset(STRAIGHT, 0.02)
     assert controller._state.tobytes() == sk.initial_state().tobytes()

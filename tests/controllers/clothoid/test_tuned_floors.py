@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from controllers.clothoid import loop_analysis
-from controllers.clothoid.controller import FLOOR_SPEED_BAND_KMH, ClothoidConfig, ClothoidController
+from controllers.clothoid.controller import FLOOR_SPEED_STEP_KMH, ClothoidConfig, ClothoidController
 from controllers.clothoid.vehicle_tuning import FloorDesign
 from tuning.own_tuning import shipped_tuning_dir, tuning_for
 from tuning.tuning_dirs import LEAD_FILE, MANIFEST_FILE, files_sha256, read_vehicle_tuning
@@ -50,10 +50,10 @@ def computed(monkeypatch: pytest.MonkeyPatch) -> list[tuple[float, float]]:
     return calls
 
 
-def _computed_floor_m(controller: ClothoidController, band: int, min_lookahead_m: float | None = None) -> float:
-    """The floor `loop_analysis.lookahead_floor` computes for the controller's band, on its own grid or on one from
-    min_lookahead_m (the reference a recorded floor must equal)."""
-    lags, settings, v, curvatures, delayed = controller._floor_inputs(band)
+def _computed_floor_m(controller: ClothoidController, node: int, min_lookahead_m: float | None = None) -> float:
+    """The floor `loop_analysis.lookahead_floor` computes for the controller's speed node, on its own grid or on one
+    from min_lookahead_m (the reference a recorded floor must equal)."""
+    lags, settings, v, curvatures, delayed = controller._floor_inputs(node)
     cfg = controller.config
     low = cfg.min_lookahead_m if min_lookahead_m is None else min_lookahead_m
     return loop_analysis.lookahead_floor(
@@ -73,15 +73,15 @@ def test_recorded_floors_are_used_at_every_identified_speed_and_equal_the_analys
     tuning = controller.tuning
     assert tuning is not None and tuning.floor_design is not None and len(tuning.floors) == 10
     for speed_kmh, recorded in tuning.floors:
-        band = round(speed_kmh / FLOOR_SPEED_BAND_KMH)
-        assert controller._band_floor_m(band) == recorded, speed_kmh
+        node = round(speed_kmh / FLOOR_SPEED_STEP_KMH)
+        assert controller._node_floor_m(node) == recorded, speed_kmh
         assert not computed, speed_kmh
     for speed_kmh, recorded in tuning.floors:  # the reference, computed on the controller's own grid
-        assert recorded == _computed_floor_m(controller, round(speed_kmh / FLOOR_SPEED_BAND_KMH)), speed_kmh
+        assert recorded == _computed_floor_m(controller, round(speed_kmh / FLOOR_SPEED_STEP_KMH)), speed_kmh
 
 
 def test_a_reset_reusing_every_floor_runs_no_loop_analysis(monkeypatch: pytest.MonkeyPatch) -> None:
-    """Paths planned at an identified speed: the reset fills the band's floor from the tuning, without importing
+    """Paths planned at an identified speed: the reset fills the node's floor from the tuning, without importing
     the loop analysis (python-control) or computing a floor."""
 
     def refused(*args: object, **kwargs: object) -> float:
@@ -95,7 +95,7 @@ def test_a_reset_reusing_every_floor_runs_no_loop_analysis(monkeypatch: pytest.M
         path = ReferencePath.from_xy(np.linspace(0.0, 100.0, 11), np.zeros(11), speed_mps=np.full(11, speed_kmh / 3.6))
         controller = ClothoidController(vehicle.geometry, ClothoidConfig(tuning=tuning, **TUNING_GRID))
         controller.reset(path, 0.02)
-        assert controller._floors == {round(speed_kmh / FLOOR_SPEED_BAND_KMH): recorded}
+        assert controller._floors == {round(speed_kmh / FLOOR_SPEED_STEP_KMH): recorded}
 
 
 @pytest.mark.parametrize(
@@ -104,7 +104,7 @@ def test_a_reset_reusing_every_floor_runs_no_loop_analysis(monkeypatch: pytest.M
 def test_a_floor_searched_on_another_grid_is_computed(grid: dict, computed: list[tuple[float, float]]) -> None:
     """A grid shifted off the design's or with another step visits other lookaheads: its floor is computed."""
     controller = _controller("tractor-semitrailer", **grid)
-    controller._band_floor_m(round(30.0 / FLOOR_SPEED_BAND_KMH))
+    controller._node_floor_m(round(30.0 / FLOOR_SPEED_STEP_KMH))
     assert len(computed) == 1
 
 
@@ -114,10 +114,10 @@ def test_a_floor_searched_from_a_lower_start_is_not_the_floor_from_a_higher_one(
     start. The kinematic bicycle's shipped floor at 90 km/h, 5.5 m (kept 5.5-7 m, lost 7.5-9 m), is 9.5 m from
     5 m; max(recorded, 5 m) would be 5.5 m."""
     controller = _controller("kinematic-bicycle")
-    band = round(90.0 / FLOOR_SPEED_BAND_KMH)
+    node = round(90.0 / FLOOR_SPEED_STEP_KMH)
     recorded = dict(controller.tuning.floors)[90.0]
-    assert _computed_floor_m(controller, band, TUNING_GRID["min_lookahead_m"]) == recorded
-    assert controller.lookahead_floor_m(90.0 / 3.6) == _computed_floor_m(controller, band) > recorded + 1.0
+    assert _computed_floor_m(controller, node, TUNING_GRID["min_lookahead_m"]) == recorded
+    assert controller.lookahead_floor_m(90.0 / 3.6) == _computed_floor_m(controller, node) > recorded + 1.0
 
 
 def test_floor_inputs_match_within_a_rounding() -> None:
@@ -143,11 +143,11 @@ def test_floors_are_computed_where_the_controller_analyses_another_loop(computed
     ):
         controller = _controller("tractor-semitrailer", **options)
         before = len(computed)
-        controller._band_floor_m(round(30.0 / FLOOR_SPEED_BAND_KMH))
+        controller._node_floor_m(round(30.0 / FLOOR_SPEED_STEP_KMH))
         assert len(computed) == before + 1, options
     controller = _controller("tractor-semitrailer", **TUNING_GRID)
     before = len(computed)
-    controller._band_floor_m(7)  # 35 km/h, between the identified 30 and 40
+    controller._node_floor_m(35)  # 35 km/h, between the identified 30 and 40
     assert len(computed) == before + 1
 
 
@@ -193,5 +193,5 @@ def test_a_design_with_other_margins_has_floors_the_controller_computes_with_its
     assert tuning.floor_design is not None and tuning.floor_design.phase_margin_deg == 50.0
     controller = ClothoidController(vehicle.geometry, ClothoidConfig(tuning=tuning, **TUNING_GRID))
     controller.reset(STRAIGHT, 0.02)
-    controller._band_floor_m(round(30.0 / FLOOR_SPEED_BAND_KMH))
+    controller._node_floor_m(round(30.0 / FLOOR_SPEED_STEP_KMH))
     assert len(computed) == 1
