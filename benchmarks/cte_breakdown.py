@@ -286,7 +286,9 @@ def run_one(job: tuple[str, str, str, str, str]) -> tuple[Run, dict[str, list[fl
         time.perf_counter() - start,
     )  # fmt: skip
     step = max(1, len(s) // 2000)
-    trace = {k: a[::step].tolist() for k, a in (("s", s), ("cte", cte), ("kappa", kappa), ("accel", accel))}
+    steer_deg = np.degrees(np.asarray(tr["steer_wheel_cmd_rad"], dtype=float))
+    columns = (("s", s), ("cte", cte), ("kappa", kappa), ("accel", accel), ("steer_deg", steer_deg))
+    trace = {k: a[::step].tolist() for k, a in columns}
     errors = None
     if (controller_name, switch, conditions) == ("nmpc", "nominal", "ideal"):
         from controllers.clothoid.controller import ClothoidConfig
@@ -408,7 +410,7 @@ def figure(vehicle: str, scenario: str, traces: dict, runs: dict, path: Path) ->
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, axes = plt.subplots(3, 1, figsize=(9, 6.5), sharex=True, gridspec_kw={"height_ratios": [3, 1, 1]})
+    fig, axes = plt.subplots(4, 1, figsize=(9, 8), sharex=True, gridspec_kw={"height_ratios": [3, 1.4, 1, 1]})
     for sw in SWITCHES:
         tr = traces.get((vehicle, scenario, sw, "clothoid", "ideal"))
         if tr is None:
@@ -430,11 +432,19 @@ def figure(vehicle: str, scenario: str, traces: dict, runs: dict, path: Path) ->
     axes[0].legend(fontsize=7, ncol=2)
     axes[0].set_title(f"{vehicle}, {scenario}, 30 km/h, ideal: the clothoid controller, one factor switched at a time")
     base = traces[(vehicle, scenario, "nominal", "clothoid", "ideal")]
-    axes[1].plot(base["s"], base["kappa"], color="tab:blue")
-    axes[1].set_ylabel("path κ (1/m)")
-    axes[2].plot(base["s"], base["accel"], color="tab:red")
-    axes[2].set_ylabel("long. accel (m/s²)")
-    axes[2].set_xlabel("distance along the path (m)")
+    for tr, r, style, who in (
+        (base, runs[(vehicle, scenario, "nominal", "clothoid", "ideal")], {"color": "k", "lw": 1.5}, "clothoid"),
+        (nmpc, runs[(vehicle, scenario, "nominal", "nmpc", "ideal")], {"color": "k", "ls": "--", "lw": 1.2}, "NMPC"),
+    ):  # the steering each nominal run took, beside the other's on the same run
+        label = f"{who}, nominal (oscillation {r.steer_oscillation_deg:.1f}°, RMS rate {r.rms_steer_rate_deg_s:.0f}°/s)"
+        axes[1].plot(tr["s"], tr["steer_deg"], label=label, **style)
+    axes[1].set_ylabel("steering wheel (°)")
+    axes[1].legend(fontsize=7)
+    axes[2].plot(base["s"], base["kappa"], color="tab:blue")
+    axes[2].set_ylabel("path κ (1/m)")
+    axes[3].plot(base["s"], base["accel"], color="tab:red")
+    axes[3].set_ylabel("long. accel (m/s²)")
+    axes[3].set_xlabel("distance along the path (m)")
     for ax in axes:
         ax.grid(alpha=0.3)
     fig.tight_layout()
